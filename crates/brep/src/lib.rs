@@ -1,0 +1,28 @@
+//! `brep`: a STEP solid read into an exact boundary representation that later stages can trust
+//! for adjacency, normals, point projection, meshing and mass properties.
+//!
+//! ```no_run
+//! let part = brep::read_step("part.step").expect("readable");
+//! for s in part.brep.solid_ids() {
+//!     let mesh = brep::mesh::mesh_faces(&part.brep, &part.brep.solid_faces(s), &Default::default()).unwrap();
+//!     let props = brep::mass::mass_properties(&part.brep, &mesh);
+//!     println!("{} mm³", props.volume);
+//! }
+//! ```
+#![warn(missing_docs)]
+
+pub mod curve;
+pub mod error;
+pub mod mass;
+pub mod math;
+pub mod mesh;
+pub mod p21;
+pub mod solid;
+pub mod step;
+pub mod surface;
+pub mod topology;
+pub mod validate;
+
+pub use error::ReadError;
+pub use solid::{read_step, read_step_bytes, SolidReport, StepPart};
+pub use topology::Brep;

@@ -1,0 +1,949 @@
+//! Watertight triangulation of faces.
+//!
+//! Every B-rep edge is discretised once, in 3-D, and both faces that use it take the same points,
+//! so the mesh has no cracks. Each face's loops are taken into the surface's `(u, v)` domain by
+//! projection, unwrapped across periods, bridged along singular lines (sphere poles, cone apexes),
+//! closed through a pole or paired with each other where they wrap around the surface, and
+//! triangulated there (constrained Delaunay, spade) with interior points spaced by the surface's
+//! curvature. The `(u, v)` triangles are kept: mass properties integrate the exact surface over
+//! them.
+
+use crate::curve::Curve;
+use crate::math::{Aabb, P3};
+use crate::surface::Surface;
+use crate::topology::{Brep, EdgeId, FaceId};
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use std::collections::HashMap;
+
+/// How finely to mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshOptions {
+    /// Largest distance between a chord and the surface it stands for, mm.
+    pub chord_tol: f64,
+    /// Largest turn of the tangent or normal between neighbouring points, radians.
+    pub angle_tol: f64,
+}
+
+impl MeshOptions {
+    /// A chord tolerance with a 15° angular limit.
+    pub fn with_tolerance(chord_tol: f64) -> Self {
+        MeshOptions {
+            chord_tol,
+            angle_tol: 15f64.to_radians(),
+        }
+    }
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        MeshOptions::with_tolerance(0.05)
+    }
+}
+
+/// Why a face could not be meshed.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// A face whose boundary makes no region on its surface.
+    #[error("face #{id}: {msg}")]
+    Face {
+        /// STEP `#id` of the face.
+        id: u64,
+        /// What went wrong.
+        msg: String,
+    },
+}
+
+/// The triangulation of one face in its parameter domain.
+#[derive(Debug, Clone)]
+pub struct FaceTriangulation {
+    /// The face.
+    pub face: FaceId,
+    /// `(u, v)` of each local vertex (unwrapped: periodic parameters may run past one period).
+    pub uv: Vec<[f64; 2]>,
+    /// Index into [`Mesh::positions`] of each local vertex.
+    pub vertex: Vec<u32>,
+    /// Triangles over local vertices, counter-clockwise about the face's outward normal. Some
+    /// may collapse to a point or line in 3-D at a pole; [`Mesh::triangles`] drops those.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A triangle mesh of a set of faces, sharing vertices along edges.
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    /// Vertex positions, mm.
+    pub positions: Vec<P3>,
+    /// Per-face triangulations.
+    pub faces: Vec<FaceTriangulation>,
+}
+
+impl Mesh {
+    /// All triangles as global vertex indices, without those that collapse in 3-D.
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let mut out = vec![];
+        for f in &self.faces {
+            for t in &f.triangles {
+                let g = [
+                    f.vertex[t[0] as usize],
+                    f.vertex[t[1] as usize],
+                    f.vertex[t[2] as usize],
+                ];
+                if g[0] != g[1] && g[1] != g[2] && g[0] != g[2] {
+                    out.push(g);
+                }
+            }
+        }
+        out
+    }
+
+    /// Edges of the 3-D mesh not shared by exactly two triangles in opposite directions:
+    /// `(boundary, non_manifold_or_misoriented)` counts. Both zero means watertight.
+    pub fn open_edges(&self) -> (usize, usize) {
+        let mut count: HashMap<(u32, u32), (i32, i32)> = HashMap::new();
+        for t in self.triangles() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                let e = count.entry(key).or_default();
+                if a < b {
+                    e.0 += 1
+                } else {
+                    e.1 += 1
+                }
+            }
+        }
+        let mut open = 0;
+        let mut bad = 0;
+        for (f, b) in count.values() {
+            if f + b == 1 {
+                open += 1;
+            } else if *f != 1 || *b != 1 {
+                bad += 1;
+            }
+        }
+        (open, bad)
+    }
+
+    /// The bounding box of the vertices.
+    pub fn bbox(&self) -> Aabb {
+        let mut b = Aabb::empty();
+        for p in &self.positions {
+            b.add(p);
+        }
+        b
+    }
+}
+
+/// A boundary point of a face in its parameter domain.
+#[derive(Debug, Clone, Copy)]
+struct Pt {
+    uv: [f64; 2],
+    idx: u32,
+    /// 0: regular; 1: `u` is free here (`S_u = 0`); 2: `v` is free (`S_v = 0`).
+    sing: u8,
+}
+
+/// Meshes the given faces. Faces sharing an edge share its vertices.
+pub fn mesh_faces(brep: &Brep, faces: &[FaceId], opts: &MeshOptions) -> Result<Mesh, MeshError> {
+    let mut m = Mesh::default();
+    let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
+    let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
+    for e in brep.edges_of(faces) {
+        let edge = brep.edge(e);
+        let mut ids = vec![];
+        for v in [edge.start, edge.end] {
+            if vert_idx[v.idx()].is_none() {
+                vert_idx[v.idx()] = Some(m.positions.len() as u32);
+                m.positions.push(brep.vertices[v.idx()].point);
+            }
+        }
+        let (Some(s), Some(t)) = (vert_idx[edge.start.idx()], vert_idx[edge.end.idx()]) else {
+            continue;
+        };
+        ids.push(s);
+        for p in discretize_edge(brep.edge_curve(e), edge.t_start, edge.t_end, opts) {
+            ids.push(m.positions.len() as u32);
+            m.positions.push(p);
+        }
+        ids.push(t);
+        edge_pts.insert(e, ids);
+    }
+    for v in brep.vertices_of(faces) {
+        if vert_idx[v.idx()].is_none() {
+            vert_idx[v.idx()] = Some(m.positions.len() as u32);
+            m.positions.push(brep.vertices[v.idx()].point);
+        }
+    }
+    for &f in faces {
+        let ft = mesh_face(brep, f, &edge_pts, &vert_idx, &mut m.positions, opts)?;
+        m.faces.push(ft);
+    }
+    Ok(m)
+}
+
+/// Points strictly inside an edge (its vertices excluded), spaced by the tolerances.
+pub fn discretize_edge(c: &Curve, t0: f64, t1: f64, opts: &MeshOptions) -> Vec<P3> {
+    let n0 = match c {
+        Curve::Line { .. } => 1,
+        Curve::Polyline(p) => p.len().saturating_sub(1).max(1),
+        Curve::Circle { radius, .. } => arc_segments((t1 - t0).abs(), *radius, opts),
+        Curve::Ellipse { a, b, .. } => arc_segments((t1 - t0).abs(), a.max(*b), opts) * 2,
+        Curve::Nurbs(n) => (n.spans * 2).clamp(4, 2000),
+        Curve::Trimmed { .. } | Curve::Hyperbola { .. } | Curve::Parabola { .. } => 8,
+    };
+    if matches!(c, Curve::Line { .. }) {
+        return vec![];
+    }
+    let mut ts: Vec<f64> = (0..=n0)
+        .map(|i| t0 + (t1 - t0) * i as f64 / n0 as f64)
+        .collect();
+    if !matches!(c, Curve::Circle { .. } | Curve::Polyline(_)) {
+        // Adaptive refinement by chord deviation and tangent turn.
+        let mut out = vec![ts[0]];
+        for w in ts.windows(2) {
+            refine(c, w[0], w[1], opts, 0, &mut out);
+        }
+        ts = out;
+    }
+    ts[1..ts.len() - 1].iter().map(|&t| c.eval(t)).collect()
+}
+
+fn arc_segments(angle: f64, radius: f64, opts: &MeshOptions) -> usize {
+    let by_chord = if opts.chord_tol < radius {
+        2.0 * (1.0 - opts.chord_tol / radius).acos()
+    } else {
+        std::f64::consts::PI
+    };
+    let step = by_chord.min(opts.angle_tol).max(1e-3);
+    ((angle / step).ceil() as usize).clamp(1, 100_000)
+}
+
+fn refine(c: &Curve, a: f64, b: f64, opts: &MeshOptions, depth: u32, out: &mut Vec<f64>) {
+    let m = 0.5 * (a + b);
+    if depth < 14 {
+        let pa = c.eval(a);
+        let pb = c.eval(b);
+        let pm = c.eval(m);
+        let chord = pb - pa;
+        let l = chord.norm();
+        let dev = if l > 1e-300 {
+            (pm - pa).cross(&chord).norm() / l
+        } else {
+            (pm - pa).norm()
+        };
+        let ta = c.deriv(a);
+        let tb = c.deriv(b);
+        let turn = if ta.norm() > 1e-300 && tb.norm() > 1e-300 {
+            ta.angle(&tb)
+        } else {
+            0.0
+        };
+        if dev > opts.chord_tol || turn > opts.angle_tol {
+            refine(c, a, m, opts, depth + 1, out);
+            refine(c, m, b, opts, depth + 1, out);
+            return;
+        }
+    }
+    out.push(b);
+}
+
+fn face_err(brep: &Brep, f: FaceId, msg: impl Into<String>) -> MeshError {
+    MeshError::Face {
+        id: brep.face(f).step_id,
+        msg: msg.into(),
+    }
+}
+
+fn singular_kind(s: &Surface, uv: [f64; 2]) -> u8 {
+    let (su, sv) = s.derivs(uv[0], uv[1]);
+    let (a, b) = (su.norm(), sv.norm());
+    if a < 1e-7 * b {
+        1
+    } else if b < 1e-7 * a {
+        2
+    } else {
+        0
+    }
+}
+
+fn mesh_face(
+    brep: &Brep,
+    f: FaceId,
+    edge_pts: &HashMap<EdgeId, Vec<u32>>,
+    vert_idx: &[Option<u32>],
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Result<FaceTriangulation, MeshError> {
+    let face = brep.face(f);
+    let s = brep.face_surface(f);
+    let periods = [s.u_period(), s.v_period()];
+    let sense = if face.same_sense { 1.0 } else { -1.0 };
+
+    // 1. Each loop into the parameter domain.
+    let mut loops: Vec<(Vec<Pt>, [i64; 2])> = vec![];
+    let mut pole_vertices: Vec<u32> = vec![];
+    let mut hint: Option<(f64, f64)> = None;
+    for &l in &face.loops {
+        let lp = &brep.loops[l.idx()];
+        if let Some(v) = lp.vertex {
+            if let Some(i) = vert_idx[v.idx()] {
+                pole_vertices.push(i);
+            }
+            continue;
+        }
+        // (points of each coedge) with raw uv.
+        let mut coedges: Vec<Vec<Pt>> = vec![];
+        for &c in &lp.coedges {
+            let ce = &brep.coedges[c.idx()];
+            let Some(ids) = edge_pts.get(&ce.edge) else {
+                continue;
+            };
+            let ids: Vec<u32> = if ce.forward {
+                ids.clone()
+            } else {
+                ids.iter().rev().copied().collect()
+            };
+            let mut pts = Vec::with_capacity(ids.len());
+            for i in ids {
+                let p = positions[i as usize];
+                let (u, v) = s.project(&p, hint);
+                if !(u.is_finite() && v.is_finite()) {
+                    return Err(face_err(
+                        brep,
+                        f,
+                        "a boundary point does not project onto the surface",
+                    ));
+                }
+                hint = Some((u, v));
+                pts.push(Pt {
+                    uv: [u, v],
+                    idx: i,
+                    sing: singular_kind(s, [u, v]),
+                });
+            }
+            // Free coordinates of singular points come from their neighbour on the same edge.
+            let n = pts.len();
+            for k in 0..n {
+                let sk = pts[k].sing;
+                if sk == 0 {
+                    continue;
+                }
+                let axis = (sk - 1) as usize;
+                let nb = if k + 1 < n && pts[k + 1].sing == 0 {
+                    Some(k + 1)
+                } else if k > 0 && pts[k - 1].sing == 0 {
+                    Some(k - 1)
+                } else {
+                    None
+                };
+                if let Some(j) = nb {
+                    let mut val = pts[j].uv[axis];
+                    if let Some(p) = periods[axis] {
+                        val = crate::math::nearest_periodic(val, pts[j].uv[axis], p);
+                    }
+                    pts[k].uv[axis] = val;
+                }
+            }
+            if std::env::var_os("BREP_DEBUG_FACE")
+                .is_some_and(|v| v.to_string_lossy() == face.step_id.to_string())
+            {
+                let e = brep.edge(ce.edge);
+                eprintln!(
+                    "coedge #{} edge #{} fwd={} curve={} t=[{:.4},{:.4}] n={} first={:?} last={:?}",
+                    ce.step_id,
+                    e.step_id,
+                    ce.forward,
+                    brep.edge_curve(ce.edge).kind(),
+                    e.t_start,
+                    e.t_end,
+                    pts.len(),
+                    pts.first().map(|p| p.uv),
+                    pts.last().map(|p| p.uv)
+                );
+            }
+            coedges.push(pts);
+        }
+        // Chain coedges: drop each coedge's last point unless it sits on a singular line (then
+        // both sides of the pole keep their own free coordinate).
+        let mut chain: Vec<Pt> = vec![];
+        for pts in &coedges {
+            let n = pts.len();
+            for (k, p) in pts.iter().enumerate() {
+                if k + 1 == n && p.sing == 0 {
+                    continue;
+                }
+                chain.push(*p);
+            }
+        }
+        if chain.len() < 2 {
+            continue;
+        }
+        let (pts, w) = unwrap_loop(chain, periods);
+        if std::env::var_os("BREP_DEBUG_FACE")
+            .is_some_and(|v| v.to_string_lossy() == face.step_id.to_string())
+        {
+            eprintln!("loop wrap={w:?} n={}", pts.len());
+            for p in &pts {
+                eprintln!(
+                    "  {:.4} {:.4} sing={} idx={}",
+                    p.uv[0], p.uv[1], p.sing, p.idx
+                );
+            }
+        }
+        loops.push((pts, w));
+    }
+
+    // 2. Pair or close loops that wrap around a periodic direction.
+    let mut polys: Vec<Vec<Pt>> = vec![];
+    let mut wrapping: Vec<(Vec<Pt>, [i64; 2])> = vec![];
+    for (pts, w) in loops {
+        if w == [0, 0] {
+            polys.push(pts);
+        } else {
+            wrapping.push((pts, w));
+        }
+    }
+    let (sing_v, sing_u) = s.singular_lines();
+    while let Some((a, wa)) = wrapping.pop() {
+        let axis = if wa[0] != 0 { 0 } else { 1 };
+        let per = periods[axis].unwrap_or(0.0);
+        if let Some(j) = wrapping.iter().position(|(_, wb)| wb[axis] == -wa[axis]) {
+            let (b, _) = wrapping.swap_remove(j);
+            polys.push(join_wrapping(a, b, axis, per));
+        } else {
+            // Close through the singular line on the side the face lies.
+            let lines = if axis == 0 { &sing_v } else { &sing_u };
+            let other = 1 - axis;
+            let level = a.iter().map(|p| p.uv[other]).sum::<f64>() / a.len() as f64;
+            // Travelling +axis with the face on the left means the face is on the +other side
+            // for axis u; for axis v the left is the -u side.
+            let dir = wa[axis].signum() as f64 * sense * if axis == 0 { 1.0 } else { -1.0 };
+            let pick = lines
+                .iter()
+                .copied()
+                .filter(|x| (x - level) * dir > 0.0)
+                .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
+                .or_else(|| {
+                    lines
+                        .iter()
+                        .copied()
+                        .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
+                });
+            let Some(line) = pick else {
+                return Err(face_err(
+                    brep,
+                    f,
+                    "a boundary loop wraps around the surface and nothing closes it",
+                ));
+            };
+            let first = a[0].uv;
+            let mut uv_end = first;
+            uv_end[axis] += wa[axis] as f64 * per;
+            let mut c1 = uv_end;
+            c1[other] = line;
+            let mut c2 = first;
+            c2[other] = line;
+            let p3 = s.eval(c1[0], c1[1]);
+            let pole = pole_vertices
+                .iter()
+                .copied()
+                .find(|&i| (positions[i as usize] - p3).norm() < 1e-6 * (1.0 + p3.coords.norm()))
+                .unwrap_or_else(|| {
+                    positions.push(p3);
+                    (positions.len() - 1) as u32
+                });
+            let sk = if axis == 0 { 1 } else { 2 };
+            let mut poly = a;
+            let start = poly[0];
+            poly.push(Pt {
+                uv: uv_end,
+                idx: start.idx,
+                sing: start.sing,
+            });
+            poly.push(Pt {
+                uv: c1,
+                idx: pole,
+                sing: sk,
+            });
+            poly.push(Pt {
+                uv: c2,
+                idx: pole,
+                sing: sk,
+            });
+            polys.push(poly);
+        }
+    }
+    if polys.is_empty() {
+        return Err(face_err(
+            brep,
+            f,
+            "no boundary loop makes a region on the surface",
+        ));
+    }
+    // A face bounded by one loop with pole bridges: the bridges' period shifts must give the
+    // region on the face's side.
+    if polys.len() == 1 {
+        fix_bridge_orientation(&mut polys[0], periods, sense);
+    }
+
+    triangulate(brep, f, s, polys, positions, opts, sense)
+}
+
+/// Unwraps a closed chain of points: periodic coordinates are made continuous, runs between
+/// pole bridges are shifted to lie next to each other. Returns the points and how many periods
+/// the loop winds in `u` and `v`.
+fn unwrap_loop(mut chain: Vec<Pt>, periods: [Option<f64>; 2]) -> (Vec<Pt>, [i64; 2]) {
+    let n = chain.len();
+    let is_break = |a: &Pt, b: &Pt| a.sing != 0 && a.sing == b.sing;
+    // Rotate so the chain starts right after a bridge, if there is one.
+    if let Some(k) = (0..n).find(|&k| is_break(&chain[k], &chain[(k + 1) % n])) {
+        chain.rotate_left((k + 1) % n);
+    }
+    let has_break = (0..n).any(|k| is_break(&chain[k], &chain[(k + 1) % n]));
+    let mut out: Vec<Pt> = Vec::with_capacity(n);
+    for k in 0..n {
+        let mut p = chain[k];
+        if let Some(prev) = out.last() {
+            let bridge = is_break(&chain[k - 1], &chain[k]);
+            for axis in 0..2 {
+                if let Some(per) = periods[axis] {
+                    // Across a bridge only the fixed coordinate must stay continuous; the free
+                    // one starts a new run next to where the previous one ended.
+                    p.uv[axis] = crate::math::nearest_periodic(p.uv[axis], prev.uv[axis], per);
+                    let _ = bridge;
+                }
+            }
+        }
+        out.push(p);
+    }
+    let mut wrap = [0i64; 2];
+    if !has_break {
+        for axis in 0..2 {
+            if let Some(per) = periods[axis] {
+                let last = out[n - 1].uv[axis];
+                let back = crate::math::nearest_periodic(out[0].uv[axis], last, per);
+                wrap[axis] = ((back - out[0].uv[axis]) / per).round() as i64;
+            }
+        }
+    }
+    (out, wrap)
+}
+
+/// Joins a loop winding `+1` with one winding `-1` (a band around a cylinder) into one polygon
+/// through a cut at the first loop's start.
+fn join_wrapping(a: Vec<Pt>, b: Vec<Pt>, axis: usize, per: f64) -> Vec<Pt> {
+    let wa = a.clone();
+    let first = wa[0];
+    let mut end = first;
+    // The loop that winds forward ends one period on.
+    let forward = {
+        let n = wa.len();
+        let last = wa[n - 1].uv[axis];
+        crate::math::nearest_periodic(first.uv[axis], last, per) > first.uv[axis]
+    };
+    end.uv[axis] += if forward { per } else { -per };
+    // Start `b` at its point nearest the cut, shifted next to `end`.
+    let target = end.uv[axis];
+    let (j, _) = b
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            (
+                i,
+                (crate::math::nearest_periodic(p.uv[axis], target, per) - target).abs(),
+            )
+        })
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .unwrap_or((0, 0.0));
+    let m = b.len();
+    let mut out = a;
+    out.push(end);
+    let mut prev = target;
+    for k in 0..=m {
+        let mut p = b[(j + k) % m];
+        p.uv[axis] = crate::math::nearest_periodic(p.uv[axis], prev, per);
+        prev = p.uv[axis];
+        out.push(p);
+    }
+    out
+}
+
+fn signed_area(poly: &[Pt]) -> f64 {
+    let n = poly.len();
+    let mut a = 0.0;
+    for k in 0..n {
+        let p = poly[k].uv;
+        let q = poly[(k + 1) % n].uv;
+        a += p[0] * q[1] - q[0] * p[1];
+    }
+    0.5 * a
+}
+
+fn fix_bridge_orientation(poly: &mut [Pt], periods: [Option<f64>; 2], sense: f64) {
+    let n = poly.len();
+    let is_break = |a: &Pt, b: &Pt| a.sing != 0 && a.sing == b.sing;
+    let starts: Vec<usize> = (1..n)
+        .filter(|&k| is_break(&poly[k - 1], &poly[k]))
+        .collect();
+    if starts.is_empty() || signed_area(poly) * sense > 1e-12 {
+        return;
+    }
+    let mut best = (signed_area(poly) * sense, None);
+    for &k in &starts {
+        let axis = (poly[k].sing - 1) as usize;
+        let Some(per) = periods[axis] else { continue };
+        for shift in [per, -per] {
+            let mut trial = poly.to_vec();
+            for p in &mut trial[k..] {
+                p.uv[axis] += shift;
+            }
+            let a = signed_area(&trial) * sense;
+            if a > best.0 {
+                best = (a, Some((k, axis, shift)));
+            }
+        }
+    }
+    if let (_, Some((k, axis, shift))) = best {
+        for p in &mut poly[k..] {
+            p.uv[axis] += shift;
+        }
+    }
+}
+
+/// Segments of the boundary, bucketed in horizontal bands, for inside tests and distances.
+struct Boundary {
+    segs: Vec<([f64; 2], [f64; 2])>,
+    y0: f64,
+    band: f64,
+    bands: Vec<Vec<u32>>,
+}
+
+impl Boundary {
+    fn new(polys: &[Vec<[f64; 2]>], bb: (f64, f64)) -> Self {
+        let mut segs = vec![];
+        for p in polys {
+            let n = p.len();
+            for k in 0..n {
+                let a = p[k];
+                let b = p[(k + 1) % n];
+                if a != b {
+                    segs.push((a, b));
+                }
+            }
+        }
+        let nb = ((segs.len() as f64).sqrt() as usize).clamp(1, 512);
+        let band = ((bb.1 - bb.0) / nb as f64).max(1e-300);
+        let mut bands = vec![vec![]; nb];
+        for (i, (a, b)) in segs.iter().enumerate() {
+            let lo = (((a[1].min(b[1]) - bb.0) / band).floor().max(0.0) as usize).min(nb - 1);
+            let hi = (((a[1].max(b[1]) - bb.0) / band).floor().max(0.0) as usize).min(nb - 1);
+            for bandv in bands.iter_mut().take(hi + 1).skip(lo) {
+                bandv.push(i as u32);
+            }
+        }
+        Boundary {
+            segs,
+            y0: bb.0,
+            band,
+            bands,
+        }
+    }
+
+    fn band_of(&self, y: f64) -> usize {
+        (((y - self.y0) / self.band).floor().max(0.0) as usize).min(self.bands.len() - 1)
+    }
+
+    /// Even-odd inside test by a ray towards +x.
+    fn inside(&self, p: [f64; 2]) -> bool {
+        let mut c = false;
+        for &i in &self.bands[self.band_of(p[1])] {
+            let (a, b) = self.segs[i as usize];
+            if (a[1] > p[1]) != (b[1] > p[1]) {
+                let x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+                if x > p[0] {
+                    c = !c;
+                }
+            }
+        }
+        c
+    }
+
+    /// Whether a boundary segment passes within `r` of `p`.
+    fn near(&self, p: [f64; 2], r: f64) -> bool {
+        let lo = self.band_of(p[1] - r);
+        let hi = self.band_of(p[1] + r);
+        for band in &self.bands[lo..=hi] {
+            for &i in band {
+                let (a, b) = self.segs[i as usize];
+                let d = [b[0] - a[0], b[1] - a[1]];
+                let l2 = d[0] * d[0] + d[1] * d[1];
+                let t = if l2 > 0.0 {
+                    (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let q = [a[0] + t * d[0] - p[0], a[1] + t * d[1] - p[1]];
+                if q[0] * q[0] + q[1] * q[1] < r * r {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// Parameter steps `(du, dv)` that keep chords within tolerance, from sampled second differences.
+fn grid_steps(s: &Surface, ub: (f64, f64), vb: (f64, f64), opts: &MeshOptions) -> (f64, f64) {
+    if matches!(s, Surface::Plane { .. }) {
+        return (f64::INFINITY, f64::INFINITY);
+    }
+    let n = 8;
+    let (mut du, mut dv) = (f64::INFINITY, f64::INFINITY);
+    let hu = (ub.1 - ub.0).max(1e-9) * 1e-3;
+    let hv = (vb.1 - vb.0).max(1e-9) * 1e-3;
+    for i in 0..=n {
+        for j in 0..=n {
+            // Sample cell centres: second differences at a clamped domain edge are meaningless.
+            let u = ub.0 + (ub.1 - ub.0) * (i as f64 + 0.5) / (n + 1) as f64;
+            let v = vb.0 + (vb.1 - vb.0) * (j as f64 + 0.5) / (n + 1) as f64;
+            let p = s.eval(u, v);
+            let (su, sv) = s.derivs(u, v);
+            let suu =
+                (s.eval(u + hu, v).coords - p.coords * 2.0 + s.eval(u - hu, v).coords) / (hu * hu);
+            let svv =
+                (s.eval(u, v + hv).coords - p.coords * 2.0 + s.eval(u, v - hv).coords) / (hv * hv);
+            let (muu, mvv) = (suu.norm(), svv.norm());
+            if muu > 1e-9 * (1.0 + su.norm()) {
+                du = du.min((8.0 * opts.chord_tol / muu).sqrt());
+                if su.norm() > 1e-12 {
+                    du = du.min(opts.angle_tol * su.norm() / muu);
+                }
+            }
+            if mvv > 1e-9 * (1.0 + sv.norm()) {
+                dv = dv.min((8.0 * opts.chord_tol / mvv).sqrt());
+                if sv.norm() > 1e-12 {
+                    dv = dv.min(opts.angle_tol * sv.norm() / mvv);
+                }
+            }
+        }
+    }
+    (du, dv)
+}
+
+fn triangulate(
+    brep: &Brep,
+    f: FaceId,
+    s: &Surface,
+    polys: Vec<Vec<Pt>>,
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+    sense: f64,
+) -> Result<FaceTriangulation, MeshError> {
+    // Scale (u, v) so that a unit step is about a unit length on the surface.
+    let (mut su, mut sv, mut n) = (0.0, 0.0, 0.0);
+    let (mut ub, mut vb) = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
+    for p in polys.iter().flatten() {
+        ub = (ub.0.min(p.uv[0]), ub.1.max(p.uv[0]));
+        vb = (vb.0.min(p.uv[1]), vb.1.max(p.uv[1]));
+        if p.sing == 0 {
+            let (a, b) = s.derivs(p.uv[0], p.uv[1]);
+            su += a.norm();
+            sv += b.norm();
+            n += 1.0;
+        }
+    }
+    let (su, sv) = if n > 0.0 && su > 0.0 && sv > 0.0 {
+        (su / n, sv / n)
+    } else {
+        (1.0, 1.0)
+    };
+    let scaled: Vec<Vec<[f64; 2]>> = polys
+        .iter()
+        .map(|p| p.iter().map(|q| [q.uv[0] * su, q.uv[1] * sv]).collect())
+        .collect();
+    let bnd = Boundary::new(&scaled, (vb.0 * sv, vb.1 * sv));
+
+    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+        ConstrainedDelaunayTriangulation::new();
+    let mut local_uv: Vec<[f64; 2]> = vec![];
+    let mut local_vertex: Vec<u32> = vec![];
+    let mut handle_local: HashMap<usize, usize> = HashMap::new();
+    let mut insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+                      xy: [f64; 2],
+                      uv: [f64; 2],
+                      idx: u32| {
+        match cdt.insert(Point2::new(xy[0], xy[1])) {
+            Ok(h) => {
+                let e = handle_local.entry(h.index()).or_insert_with(|| {
+                    local_uv.push(uv);
+                    local_vertex.push(idx);
+                    local_uv.len() - 1
+                });
+                Some((h, *e))
+            }
+            Err(_) => None,
+        }
+    };
+
+    // Boundary points, with pole bridges subdivided so the fan at a pole is well shaped.
+    let mut constraints_failed = 0usize;
+    for poly in &polys {
+        let mut handles = vec![];
+        let m = poly.len();
+        for k in 0..m {
+            let p = poly[k];
+            let q = poly[(k + 1) % m];
+            let Some((h, _)) = insert(&mut cdt, [p.uv[0] * su, p.uv[1] * sv], p.uv, p.idx) else {
+                return Err(face_err(
+                    brep,
+                    f,
+                    "boundary point is not a finite parameter",
+                ));
+            };
+            handles.push(h);
+            if p.sing != 0 && p.sing == q.sing {
+                let axis = (p.sing - 1) as usize;
+                let span = (q.uv[axis] - p.uv[axis]).abs();
+                let steps = ((span / 0.2).ceil() as usize).clamp(1, 64);
+                for j in 1..steps {
+                    let t = j as f64 / steps as f64;
+                    let uv = [
+                        p.uv[0] + t * (q.uv[0] - p.uv[0]),
+                        p.uv[1] + t * (q.uv[1] - p.uv[1]),
+                    ];
+                    if let Some((h, _)) = insert(&mut cdt, [uv[0] * su, uv[1] * sv], uv, p.idx) {
+                        handles.push(h);
+                    }
+                }
+            }
+        }
+        let hn = handles.len();
+        for k in 0..hn {
+            let (a, b) = (handles[k], handles[(k + 1) % hn]);
+            if a != b && cdt.try_add_constraint(a, b).is_empty() {
+                constraints_failed += 1;
+            }
+        }
+    }
+
+    // Interior grid points.
+    let (du, dv) = grid_steps(s, ub, vb, opts);
+    let nu = if du.is_finite() {
+        ((ub.1 - ub.0) / du).ceil().clamp(1.0, 400.0) as usize
+    } else {
+        1
+    };
+    let nv = if dv.is_finite() {
+        ((vb.1 - vb.0) / dv).ceil().clamp(1.0, 400.0) as usize
+    } else {
+        1
+    };
+    if nu > 1 || nv > 1 {
+        let (gu, gv) = ((ub.1 - ub.0) / nu as f64, (vb.1 - vb.0) / nv as f64);
+        let margin = 0.35
+            * (if nu > 1 { gu * su } else { f64::INFINITY }).min(if nv > 1 {
+                gv * sv
+            } else {
+                f64::INFINITY
+            });
+        // A direction that needs no subdivision still gets points where the other one does, at
+        // a spacing that keeps triangles from being needles.
+        let (nu, nv) = (nu.max(1), nv.max(1));
+        for i in 0..=nu {
+            for j in 0..=nv {
+                let uv = [ub.0 + gu * i as f64, vb.0 + gv * j as f64];
+                let xy = [uv[0] * su, uv[1] * sv];
+                if (nu > 1 && (i == 0 || i == nu)) || (nv > 1 && (j == 0 || j == nv)) {
+                    continue;
+                }
+                if !bnd.inside(xy) || bnd.near(xy, margin) {
+                    continue;
+                }
+                let p = s.eval(uv[0], uv[1]);
+                let idx = positions.len() as u32;
+                positions.push(p);
+                insert(&mut cdt, xy, uv, idx);
+            }
+        }
+    }
+
+    // Which triangles are inside: count constraint crossings from the hull (odd = inside). This
+    // is exact where the boundary's points are collinear to rounding; the centroid test is the
+    // fallback when a boundary segment could not be inserted (crossing loops in bad files).
+    let depth = (constraints_failed == 0).then(|| constraint_depth(&cdt));
+    let mut triangles = vec![];
+    for face in cdt.inner_faces() {
+        let vs = face.vertices();
+        let inside = match &depth {
+            Some(d) => d[face.fix().index()] % 2 == 1,
+            None => bnd.inside([
+                (vs[0].position().x + vs[1].position().x + vs[2].position().x) / 3.0,
+                (vs[0].position().y + vs[1].position().y + vs[2].position().y) / 3.0,
+            ]),
+        };
+        if !inside {
+            continue;
+        }
+        let mut t = [0u32; 3];
+        let mut known = true;
+        for k in 0..3 {
+            match handle_local.get(&vs[k].fix().index()) {
+                Some(&l) => t[k] = l as u32,
+                None => known = false,
+            }
+        }
+        if !known {
+            continue;
+        }
+        if sense < 0.0 {
+            t.swap(1, 2);
+        }
+        triangles.push(t);
+    }
+    Ok(FaceTriangulation {
+        face: f,
+        uv: local_uv,
+        vertex: local_vertex,
+        triangles,
+    })
+}
+
+/// Fewest constraint edges crossed from outside the hull to each face (0-1 breadth-first search).
+fn constraint_depth(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<u32> {
+    let mut depth = vec![u32::MAX; cdt.num_all_faces()];
+    let mut queue = std::collections::VecDeque::new();
+    for e in cdt.convex_hull() {
+        if let Some(f) = e.rev().face().as_inner() {
+            let d = u32::from(e.is_constraint_edge());
+            let i = f.fix().index();
+            if d < depth[i] {
+                depth[i] = d;
+                queue.push_back((f.fix(), d));
+            }
+        }
+    }
+    while let Some((fh, d)) = queue.pop_front() {
+        if d > depth[fh.index()] {
+            continue;
+        }
+        for e in cdt.face(fh).adjacent_edges() {
+            let Some(nf) = e.rev().face().as_inner() else {
+                continue;
+            };
+            let c = u32::from(e.is_constraint_edge());
+            let nd = d + c;
+            let i = nf.fix().index();
+            if nd < depth[i] {
+                depth[i] = nd;
+                if c == 0 {
+                    queue.push_front((nf.fix(), nd));
+                } else {
+                    queue.push_back((nf.fix(), nd));
+                }
+            }
+        }
+    }
+    depth
+}

@@ -1,0 +1,808 @@
+//! Exact surfaces with their natural parametrisation, as ISO 10303-42 defines it, so that the
+//! natural normal `S_u × S_v` is the one a face's `same_sense` refers to.
+
+use crate::curve::{p3, v3, Curve};
+use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
+use std::f64::consts::{FRAC_PI_2, TAU};
+use truck_geometry::prelude as tg;
+
+/// A rational B-spline surface (truck's homogeneous representation).
+pub type NurbsSurface = tg::NurbsSurface<tg::Vector4>;
+
+/// A surface `(u, v) ↦ S(u, v)`.
+#[derive(Debug, Clone)]
+pub enum Surface {
+    /// `o + u·x + v·y`.
+    Plane {
+        /// Placement.
+        frame: Frame,
+    },
+    /// `o + r(cos u·x + sin u·y) + v·z`.
+    Cylinder {
+        /// Placement; `z` is the axis.
+        frame: Frame,
+        /// Radius.
+        radius: f64,
+    },
+    /// `o + (r + v tan α)(cos u·x + sin u·y) + v·z`.
+    Cone {
+        /// Placement; `z` is the axis.
+        frame: Frame,
+        /// Radius in the plane `v = 0`.
+        radius: f64,
+        /// Semi-angle α in radians.
+        semi_angle: f64,
+    },
+    /// `o + r cos v(cos u·x + sin u·y) + r sin v·z`.
+    Sphere {
+        /// Placement.
+        frame: Frame,
+        /// Radius.
+        radius: f64,
+    },
+    /// `o + (R + r cos v)(cos u·x + sin u·y) + r sin v·z`.
+    Torus {
+        /// Placement; `z` is the axis.
+        frame: Frame,
+        /// Major radius `R`.
+        major: f64,
+        /// Minor radius `r`.
+        minor: f64,
+    },
+    /// A profile `λ(v)` rotated by `u` about an axis.
+    Revolution(Box<Revolution>),
+    /// `λ(u) + v·d`.
+    Extrusion {
+        /// The profile.
+        profile: Box<Curve>,
+        /// Unit extrusion direction.
+        dir: V3,
+    },
+    /// A (rational) B-spline surface.
+    Nurbs(Box<NurbsSurfaceData>),
+    /// `B(u,v) + d·N_B(u,v)`.
+    Offset {
+        /// The surface offset.
+        basis: Box<Surface>,
+        /// Signed distance along the basis' natural normal.
+        distance: f64,
+    },
+}
+
+/// A surface of revolution: `u` is the angle, `v` the profile's parameter.
+#[derive(Debug, Clone)]
+pub struct Revolution {
+    /// The profile curve `λ(v)`.
+    pub profile: Curve,
+    /// A point on the axis.
+    pub origin: P3,
+    /// Unit axis direction.
+    pub axis: V3,
+    /// Unit radial direction of the profile's half-plane (angle 0 of the projection).
+    pub e1: V3,
+}
+
+impl Revolution {
+    /// Builds the revolution, finding the profile's half-plane.
+    pub fn new(profile: Curve, origin: P3, axis: V3) -> Self {
+        let (a, b) = profile.range();
+        let (a, b) = if a.is_finite() && b.is_finite() {
+            (a, b)
+        } else {
+            (0.0, 1.0)
+        };
+        let mut e1 = None;
+        let mut best = 0.0;
+        for i in 0..=32 {
+            let w = profile.eval(a + (b - a) * i as f64 / 32.0) - origin;
+            let r = w - axis * w.dot(&axis);
+            if r.norm() > best {
+                best = r.norm();
+                e1 = Some(r / best);
+            }
+        }
+        let e1 = e1.unwrap_or_else(|| crate::math::any_perpendicular(&axis));
+        Revolution {
+            profile,
+            origin,
+            axis,
+            e1,
+        }
+    }
+    fn parts(&self, v: f64) -> (f64, V3) {
+        let w = self.profile.eval(v) - self.origin;
+        let a = w.dot(&self.axis);
+        (a, w - self.axis * a)
+    }
+}
+
+/// A B-spline surface with its parameter ranges and closure cached.
+#[derive(Debug, Clone)]
+pub struct NurbsSurfaceData {
+    /// The surface.
+    pub surface: NurbsSurface,
+    /// `u` range.
+    pub u: (f64, f64),
+    /// `v` range.
+    pub v: (f64, f64),
+    /// Knot spans in `u` and `v`.
+    pub spans: (usize, usize),
+    /// Degrees in `u` and `v`.
+    pub degree: (usize, usize),
+    /// Whether `S(u0, v) = S(u1, v)` for all `v`.
+    pub closed_u: bool,
+    /// Whether `S(u, v0) = S(u, v1)` for all `u`.
+    pub closed_v: bool,
+}
+
+fn knot_range(kv: &tg::KnotVec, degree: usize) -> ((f64, f64), usize) {
+    let n = kv.len();
+    let d = degree.min(n.saturating_sub(1) / 2);
+    let mut spans = 0;
+    for i in d..n.saturating_sub(d + 1) {
+        if kv[i + 1] > kv[i] {
+            spans += 1;
+        }
+    }
+    ((kv[d], kv[n - 1 - d]), spans.max(1))
+}
+
+impl NurbsSurfaceData {
+    /// Wraps a truck NURBS surface, finding its ranges and whether it closes on itself.
+    pub fn new(surface: NurbsSurface) -> Self {
+        let (du, dv) = (surface.udegree(), surface.vdegree());
+        let (u, su) = knot_range(surface.uknot_vec(), du);
+        let (v, sv) = knot_range(surface.vknot_vec(), dv);
+        let mut d = NurbsSurfaceData {
+            surface,
+            u,
+            v,
+            spans: (su, sv),
+            degree: (du, dv),
+            closed_u: false,
+            closed_v: false,
+        };
+        let size = d.size_estimate();
+        let tol = 1e-7 * size.max(1e-3);
+        d.closed_u = (0..=8).all(|i| {
+            let t = v.0 + (v.1 - v.0) * i as f64 / 8.0;
+            (d.raw(u.0, t) - d.raw(u.1, t)).norm() <= tol
+        });
+        d.closed_v = (0..=8).all(|i| {
+            let t = u.0 + (u.1 - u.0) * i as f64 / 8.0;
+            (d.raw(t, v.0) - d.raw(t, v.1)).norm() <= tol
+        });
+        d
+    }
+    fn size_estimate(&self) -> f64 {
+        let mut bb = crate::math::Aabb::empty();
+        for i in 0..=4 {
+            for j in 0..=4 {
+                let p = self.raw(
+                    self.u.0 + (self.u.1 - self.u.0) * i as f64 / 4.0,
+                    self.v.0 + (self.v.1 - self.v.0) * j as f64 / 4.0,
+                );
+                bb.add(&p);
+            }
+        }
+        bb.diagonal()
+    }
+    fn raw(&self, u: f64, v: f64) -> P3 {
+        p3(self.surface.subs(u, v))
+    }
+    fn clamp_uv(&self, u: f64, v: f64) -> (f64, f64) {
+        let u = if self.closed_u {
+            wrap(u, self.u.0, self.u.1 - self.u.0)
+        } else {
+            u.clamp(self.u.0, self.u.1)
+        };
+        let v = if self.closed_v {
+            wrap(v, self.v.0, self.v.1 - self.v.0)
+        } else {
+            v.clamp(self.v.0, self.v.1)
+        };
+        (u, v)
+    }
+}
+
+impl Surface {
+    /// The point at `(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> P3 {
+        match self {
+            Surface::Plane { frame } => frame.at(u, v, 0.0),
+            Surface::Cylinder { frame, radius } => frame.at(radius * u.cos(), radius * u.sin(), v),
+            Surface::Cone {
+                frame,
+                radius,
+                semi_angle,
+            } => {
+                let r = radius + v * semi_angle.tan();
+                frame.at(r * u.cos(), r * u.sin(), v)
+            }
+            Surface::Sphere { frame, radius } => frame.at(
+                radius * v.cos() * u.cos(),
+                radius * v.cos() * u.sin(),
+                radius * v.sin(),
+            ),
+            Surface::Torus {
+                frame,
+                major,
+                minor,
+            } => {
+                let r = major + minor * v.cos();
+                frame.at(r * u.cos(), r * u.sin(), minor * v.sin())
+            }
+            Surface::Revolution(rev) => {
+                let (a, r) = rev.parts(v);
+                rev.origin + rev.axis * a + r * u.cos() + rev.axis.cross(&r) * u.sin()
+            }
+            Surface::Extrusion { profile, dir } => profile.eval(u) + dir * v,
+            Surface::Nurbs(n) => {
+                let (u, v) = n.clamp_uv(u, v);
+                n.raw(u, v)
+            }
+            Surface::Offset { basis, distance } => {
+                let n = basis.normal(u, v).unwrap_or_else(V3::zeros);
+                basis.eval(u, v) + n * *distance
+            }
+        }
+    }
+
+    /// The first partial derivatives `(S_u, S_v)`.
+    pub fn derivs(&self, u: f64, v: f64) -> (V3, V3) {
+        match self {
+            Surface::Plane { frame } => (frame.x, frame.y),
+            Surface::Cylinder { frame, radius } => {
+                (frame.vec(-radius * u.sin(), radius * u.cos(), 0.0), frame.z)
+            }
+            Surface::Cone {
+                frame,
+                radius,
+                semi_angle,
+            } => {
+                let t = semi_angle.tan();
+                let r = radius + v * t;
+                (
+                    frame.vec(-r * u.sin(), r * u.cos(), 0.0),
+                    frame.vec(t * u.cos(), t * u.sin(), 1.0),
+                )
+            }
+            Surface::Sphere { frame, radius } => (
+                frame.vec(-radius * v.cos() * u.sin(), radius * v.cos() * u.cos(), 0.0),
+                frame.vec(
+                    -radius * v.sin() * u.cos(),
+                    -radius * v.sin() * u.sin(),
+                    radius * v.cos(),
+                ),
+            ),
+            Surface::Torus {
+                frame,
+                major,
+                minor,
+            } => {
+                let r = major + minor * v.cos();
+                (
+                    frame.vec(-r * u.sin(), r * u.cos(), 0.0),
+                    frame.vec(
+                        -minor * v.sin() * u.cos(),
+                        -minor * v.sin() * u.sin(),
+                        minor * v.cos(),
+                    ),
+                )
+            }
+            Surface::Revolution(rev) => {
+                let (_, r) = rev.parts(v);
+                let w1 = rev.profile.deriv(v);
+                let a1 = w1.dot(&rev.axis);
+                let r1 = w1 - rev.axis * a1;
+                let ax = rev.axis;
+                (
+                    -r * u.sin() + ax.cross(&r) * u.cos(),
+                    ax * a1 + r1 * u.cos() + ax.cross(&r1) * u.sin(),
+                )
+            }
+            Surface::Extrusion { profile, dir } => (profile.deriv(u), *dir),
+            Surface::Nurbs(n) => {
+                let (u, v) = n.clamp_uv(u, v);
+                (v3(n.surface.uder(u, v)), v3(n.surface.vder(u, v)))
+            }
+            Surface::Offset { .. } => {
+                let h = 1e-6;
+                let su = (self.eval(u + h, v) - self.eval(u - h, v)) / (2.0 * h);
+                let sv = (self.eval(u, v + h) - self.eval(u, v - h)) / (2.0 * h);
+                (su, sv)
+            }
+        }
+    }
+
+    /// The natural unit normal `S_u × S_v / |S_u × S_v|`, or `None` where it degenerates (a pole,
+    /// an apex). Poles of spheres, cones and revolved profiles touching the axis get their limit.
+    pub fn normal(&self, u: f64, v: f64) -> Option<V3> {
+        match self {
+            Surface::Sphere { frame, .. } => {
+                Some(frame.vec(v.cos() * u.cos(), v.cos() * u.sin(), v.sin()))
+            }
+            Surface::Offset { basis, .. } => basis.normal(u, v),
+            _ => {
+                let (su, sv) = self.derivs(u, v);
+                let n = su.cross(&sv);
+                let scale = su.norm() * sv.norm();
+                if scale > 0.0 && n.norm() > 1e-12 * scale {
+                    return Some(n / n.norm());
+                }
+                // Degenerate: step a little into the domain and take the limit.
+                let (du, dv) = self.param_scale();
+                for (a, b) in [(0.0, 1e-5), (0.0, -1e-5), (1e-5, 0.0), (-1e-5, 0.0)] {
+                    let (su, sv) = self.derivs(u + a * du, v + b * dv);
+                    let n = su.cross(&sv);
+                    if n.norm() > 1e-14 * (1.0 + su.norm() * sv.norm()) && n.norm() > 0.0 {
+                        return Some(n / n.norm());
+                    }
+                }
+                None
+            }
+        }
+    }
+
+    /// A typical parameter length in `u` and `v` (to size finite differences and steps).
+    fn param_scale(&self) -> (f64, f64) {
+        match self {
+            Surface::Nurbs(n) => (n.u.1 - n.u.0, n.v.1 - n.v.0),
+            Surface::Revolution(r) => {
+                let (a, b) = r.profile.range();
+                (
+                    1.0,
+                    if a.is_finite() && b.is_finite() {
+                        b - a
+                    } else {
+                        1.0
+                    },
+                )
+            }
+            Surface::Extrusion { profile, .. } => {
+                let (a, b) = profile.range();
+                (
+                    if a.is_finite() && b.is_finite() {
+                        b - a
+                    } else {
+                        1.0
+                    },
+                    1.0,
+                )
+            }
+            Surface::Offset { basis, .. } => basis.param_scale(),
+            _ => (1.0, 1.0),
+        }
+    }
+
+    /// The period in `u`, where the surface closes on itself in `u`.
+    pub fn u_period(&self) -> Option<f64> {
+        match self {
+            Surface::Cylinder { .. }
+            | Surface::Cone { .. }
+            | Surface::Sphere { .. }
+            | Surface::Torus { .. }
+            | Surface::Revolution(_) => Some(TAU),
+            Surface::Extrusion { profile, .. } => {
+                if let Some(p) = profile.period() {
+                    Some(p)
+                } else if profile.is_closed(1e-7) {
+                    let (a, b) = profile.range();
+                    Some(b - a)
+                } else {
+                    None
+                }
+            }
+            Surface::Nurbs(n) => n.closed_u.then_some(n.u.1 - n.u.0),
+            Surface::Offset { basis, .. } => basis.u_period(),
+            Surface::Plane { .. } => None,
+        }
+    }
+
+    /// The period in `v`, where the surface closes on itself in `v`.
+    pub fn v_period(&self) -> Option<f64> {
+        match self {
+            Surface::Torus { .. } => Some(TAU),
+            Surface::Revolution(r) if r.profile.period().is_some() => r.profile.period(),
+            Surface::Nurbs(n) => n.closed_v.then_some(n.v.1 - n.v.0),
+            Surface::Offset { basis, .. } => basis.v_period(),
+            _ => None,
+        }
+    }
+
+    /// The finite parameter bounds of the surface, per direction (`None` where unbounded or
+    /// periodic).
+    pub fn bounds(&self) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+        match self {
+            Surface::Sphere { .. } => (None, Some((-FRAC_PI_2, FRAC_PI_2))),
+            Surface::Revolution(r) => {
+                let (a, b) = r.profile.range();
+                (None, (a.is_finite() && b.is_finite()).then_some((a, b)))
+            }
+            Surface::Extrusion { profile, .. } => {
+                let (a, b) = profile.range();
+                ((a.is_finite() && b.is_finite()).then_some((a, b)), None)
+            }
+            Surface::Nurbs(n) => (Some(n.u), Some(n.v)),
+            Surface::Offset { basis, .. } => basis.bounds(),
+            _ => (None, None),
+        }
+    }
+
+    /// Parameter values where the surface collapses: `(v values where S_u = 0, u values where
+    /// S_v = 0)`. A sphere's poles, a cone's apex, a revolved profile touching the axis, a
+    /// B-spline with a collapsed boundary row.
+    pub fn singular_lines(&self) -> (Vec<f64>, Vec<f64>) {
+        match self {
+            Surface::Sphere { .. } => (vec![-FRAC_PI_2, FRAC_PI_2], vec![]),
+            Surface::Cone {
+                radius, semi_angle, ..
+            } => {
+                let t = semi_angle.tan();
+                if t.abs() > 1e-12 {
+                    (vec![-radius / t], vec![])
+                } else {
+                    (vec![], vec![])
+                }
+            }
+            Surface::Offset { basis, .. } => basis.singular_lines(),
+            Surface::Plane { .. } | Surface::Cylinder { .. } | Surface::Torus { .. } => {
+                (vec![], vec![])
+            }
+            _ => {
+                let (bu, bv) = self.bounds();
+                let mut vs = vec![];
+                let mut us = vec![];
+                let size = self.size_hint();
+                let tol = 1e-7 * size.max(1e-3);
+                let (ur, vr) = self.sample_ranges();
+                if let Some((a, b)) = bv {
+                    for v in [a, b] {
+                        let p0 = self.eval(ur.0, v);
+                        if (0..=8).all(|i| {
+                            (self.eval(ur.0 + (ur.1 - ur.0) * i as f64 / 8.0, v) - p0).norm() <= tol
+                        }) {
+                            vs.push(v);
+                        }
+                    }
+                }
+                if let Some((a, b)) = bu {
+                    for u in [a, b] {
+                        let p0 = self.eval(u, vr.0);
+                        if (0..=8).all(|i| {
+                            (self.eval(u, vr.0 + (vr.1 - vr.0) * i as f64 / 8.0) - p0).norm() <= tol
+                        }) {
+                            us.push(u);
+                        }
+                    }
+                }
+                (vs, us)
+            }
+        }
+    }
+
+    fn sample_ranges(&self) -> ((f64, f64), (f64, f64)) {
+        let (bu, bv) = self.bounds();
+        let du = self.u_period().map(|p| (0.0, p));
+        let dv = self.v_period().map(|p| (0.0, p));
+        (
+            bu.or(du).unwrap_or((0.0, 1.0)),
+            bv.or(dv).unwrap_or((0.0, 1.0)),
+        )
+    }
+
+    fn size_hint(&self) -> f64 {
+        let (ur, vr) = self.sample_ranges();
+        let mut bb = crate::math::Aabb::empty();
+        for i in 0..=4 {
+            for j in 0..=4 {
+                bb.add(&self.eval(
+                    ur.0 + (ur.1 - ur.0) * i as f64 / 4.0,
+                    vr.0 + (vr.1 - vr.0) * j as f64 / 4.0,
+                ));
+            }
+        }
+        bb.diagonal()
+    }
+
+    /// A short name of the surface kind, as `inspect` counts them.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Surface::Plane { .. } => "plane",
+            Surface::Cylinder { .. } => "cylinder",
+            Surface::Cone { .. } => "cone",
+            Surface::Sphere { .. } => "sphere",
+            Surface::Torus { .. } => "torus",
+            Surface::Revolution(_) => "revolution",
+            Surface::Extrusion { .. } => "extrusion",
+            Surface::Nurbs(_) => "bspline",
+            Surface::Offset { .. } => "offset",
+        }
+    }
+
+    /// The parameters `(u, v)` of the point of the surface nearest to `p`. Periodic parameters
+    /// come back in any period: callers unwrap them. `hint` seeds the search for B-splines and
+    /// other surfaces without a closed-form inverse.
+    pub fn project(&self, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
+        match self {
+            Surface::Plane { frame } => {
+                let l = frame.local(p);
+                (l.x, l.y)
+            }
+            Surface::Cylinder { frame, .. } => {
+                let l = frame.local(p);
+                (l.y.atan2(l.x), l.z)
+            }
+            Surface::Cone {
+                frame,
+                radius,
+                semi_angle,
+            } => {
+                let l = frame.local(p);
+                let t = semi_angle.tan();
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                let v = ((rho - radius) * t + l.z) / (1.0 + t * t);
+                let r = radius + v * t;
+                // On the other nappe the angle turns by π.
+                let u = if r >= 0.0 {
+                    l.y.atan2(l.x)
+                } else {
+                    (-l.y).atan2(-l.x)
+                };
+                (u, v)
+            }
+            Surface::Sphere { frame, .. } => {
+                let l = frame.local(p);
+                (l.y.atan2(l.x), l.z.atan2((l.x * l.x + l.y * l.y).sqrt()))
+            }
+            Surface::Torus { frame, major, .. } => {
+                let l = frame.local(p);
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                (l.y.atan2(l.x), l.z.atan2(rho - major))
+            }
+            Surface::Revolution(rev) => {
+                let w = p - rev.origin;
+                let a = w.dot(&rev.axis);
+                let r = w - rev.axis * a;
+                let e2 = rev.axis.cross(&rev.e1);
+                let phi = r.dot(&e2).atan2(r.dot(&rev.e1));
+                let q = rev.origin + rev.axis * a + rev.e1 * r.norm();
+                let v = match hint {
+                    Some((_, hv)) => rev.profile.project_near(&q, hv),
+                    None => rev.profile.project(&q),
+                };
+                let (_, rv) = rev.parts(v);
+                let phi_v = rv.dot(&e2).atan2(rv.dot(&rev.e1));
+                self.polish(p, (phi - phi_v, v))
+            }
+            Surface::Extrusion { profile, dir } => {
+                let mut v = 0.0;
+                let mut u = hint.map(|h| h.0).unwrap_or_else(|| profile.project(p));
+                for _ in 0..3 {
+                    u = profile.project_near(&(p - dir * v), u);
+                    v = (p - profile.eval(u)).dot(dir);
+                }
+                self.polish(p, (u, v))
+            }
+            Surface::Nurbs(n) => {
+                let start = match hint {
+                    Some(h) => {
+                        let q = self.polish(p, h);
+                        if (self.eval(q.0, q.1) - p).norm() < 1e-6 * (1.0 + p.coords.norm()) {
+                            return q;
+                        }
+                        self.grid_start(p, n)
+                    }
+                    None => self.grid_start(p, n),
+                };
+                self.polish(p, start)
+            }
+            Surface::Offset { basis, .. } => {
+                let uv = basis.project(p, hint);
+                self.polish(p, uv)
+            }
+        }
+    }
+
+    fn grid_start(&self, p: &P3, n: &NurbsSurfaceData) -> (f64, f64) {
+        let nu = (n.spans.0 * (n.degree.0 + 1)).clamp(8, 64);
+        let nv = (n.spans.1 * (n.degree.1 + 1)).clamp(8, 64);
+        let mut best = (f64::INFINITY, (n.u.0, n.v.0));
+        for i in 0..=nu {
+            let u = n.u.0 + (n.u.1 - n.u.0) * i as f64 / nu as f64;
+            for j in 0..=nv {
+                let v = n.v.0 + (n.v.1 - n.v.0) * j as f64 / nv as f64;
+                let d = (n.raw(u, v) - p).norm_squared();
+                if d < best.0 {
+                    best = (d, (u, v));
+                }
+            }
+        }
+        best.1
+    }
+
+    /// Gauss–Newton steps towards the foot point of `p`, staying inside bounded ranges.
+    fn polish(&self, p: &P3, (mut u, mut v): (f64, f64)) -> (f64, f64) {
+        let (bu, bv) = self.bounds();
+        let (pu, pv) = (self.u_period(), self.v_period());
+        let clamp_u = |x: f64| {
+            if pu.is_none() {
+                bu.map(|(a, b)| x.clamp(a, b)).unwrap_or(x)
+            } else {
+                x
+            }
+        };
+        let clamp_v = |x: f64| {
+            if pv.is_none() {
+                bv.map(|(a, b)| x.clamp(a, b)).unwrap_or(x)
+            } else {
+                x
+            }
+        };
+        let mut dist = (self.eval(u, v) - p).norm();
+        for _ in 0..40 {
+            let d = self.eval(u, v) - p;
+            let (su, sv) = self.derivs(u, v);
+            let a11 = su.norm_squared();
+            let a12 = su.dot(&sv);
+            let a22 = sv.norm_squared();
+            let b1 = -su.dot(&d);
+            let b2 = -sv.dot(&d);
+            let det = a11 * a22 - a12 * a12;
+            let (du, dv) = if det.abs() > 1e-18 * (a11 * a22).max(1e-300) {
+                ((b1 * a22 - b2 * a12) / det, (a11 * b2 - a12 * b1) / det)
+            } else if a11 > a22 && a11 > 0.0 {
+                (b1 / a11, 0.0)
+            } else if a22 > 0.0 {
+                (0.0, b2 / a22)
+            } else {
+                break;
+            };
+            if !du.is_finite() || !dv.is_finite() {
+                break;
+            }
+            // Backtrack so the distance never grows.
+            let mut f = 1.0;
+            let mut improved = false;
+            for _ in 0..8 {
+                let nu = clamp_u(u + f * du);
+                let nv = clamp_v(v + f * dv);
+                let nd = (self.eval(nu, nv) - p).norm();
+                if nd <= dist {
+                    let small = (nu - u).abs() + (nv - v).abs() < 1e-13;
+                    u = nu;
+                    v = nv;
+                    dist = nd;
+                    improved = !small;
+                    break;
+                }
+                f *= 0.5;
+            }
+            if !improved {
+                break;
+            }
+        }
+        (u, v)
+    }
+
+    /// Shifts a periodic parameter pair so it lies nearest to `reference`.
+    pub fn unwrap_near(&self, uv: (f64, f64), reference: (f64, f64)) -> (f64, f64) {
+        let u = self
+            .u_period()
+            .map(|p| nearest_periodic(uv.0, reference.0, p))
+            .unwrap_or(uv.0);
+        let v = self
+            .v_period()
+            .map(|p| nearest_periodic(uv.1, reference.1, p))
+            .unwrap_or(uv.1);
+        (u, v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame() -> Frame {
+        Frame::from_axes(
+            P3::new(1.0, -2.0, 0.5),
+            Some(V3::new(0.3, 0.2, 1.0)),
+            Some(V3::x()),
+        )
+        .unwrap()
+    }
+
+    fn check_round_trip(s: &Surface, uvs: &[(f64, f64)]) {
+        for &(u, v) in uvs {
+            let p = s.eval(u, v);
+            let (pu, pv) = s.project(&p, None);
+            let q = s.eval(pu, pv);
+            assert!(
+                (p - q).norm() < 1e-7,
+                "{} at ({u},{v}): {:?} vs {:?}",
+                s.kind(),
+                p,
+                q
+            );
+            // The analytic derivative agrees with a finite difference.
+            let (su, sv) = s.derivs(u, v);
+            let h = 1e-6;
+            let fu = (s.eval(u + h, v) - s.eval(u - h, v)) / (2.0 * h);
+            let fv = (s.eval(u, v + h) - s.eval(u, v - h)) / (2.0 * h);
+            assert!(
+                (su - fu).norm() < 1e-5 * (1.0 + su.norm()),
+                "{} S_u",
+                s.kind()
+            );
+            assert!(
+                (sv - fv).norm() < 1e-5 * (1.0 + sv.norm()),
+                "{} S_v",
+                s.kind()
+            );
+        }
+    }
+
+    #[test]
+    fn analytic_surfaces_project_and_differentiate() {
+        let uvs = [(0.3, 0.2), (2.0, -0.4), (-2.5, 0.9), (4.0, 0.1)];
+        check_round_trip(&Surface::Plane { frame: frame() }, &uvs);
+        check_round_trip(
+            &Surface::Cylinder {
+                frame: frame(),
+                radius: 3.0,
+            },
+            &uvs,
+        );
+        check_round_trip(
+            &Surface::Cone {
+                frame: frame(),
+                radius: 3.0,
+                semi_angle: 0.4,
+            },
+            &uvs,
+        );
+        check_round_trip(
+            &Surface::Sphere {
+                frame: frame(),
+                radius: 3.0,
+            },
+            &uvs,
+        );
+        check_round_trip(
+            &Surface::Torus {
+                frame: frame(),
+                major: 5.0,
+                minor: 1.5,
+            },
+            &uvs,
+        );
+        let f = frame();
+        let profile = Curve::Line {
+            origin: f.at(2.0, 0.0, 0.0),
+            dir: (f.x + f.z).normalize(),
+        };
+        let rev = Surface::Revolution(Box::new(Revolution::new(profile, f.origin, f.z)));
+        check_round_trip(&rev, &uvs);
+        let ext = Surface::Extrusion {
+            profile: Box::new(Curve::Circle {
+                frame: f,
+                radius: 2.0,
+            }),
+            dir: (f.z + f.x * 0.2).normalize(),
+        };
+        check_round_trip(&ext, &uvs);
+    }
+
+    #[test]
+    fn sphere_normal_points_outward_and_poles_are_singular() {
+        let s = Surface::Sphere {
+            frame: Frame::world(P3::origin()),
+            radius: 2.0,
+        };
+        let n = s.normal(0.0, 0.0).unwrap();
+        assert!((n - V3::x()).norm() < 1e-12);
+        assert_eq!(s.singular_lines().0.len(), 2);
+        let (su, _) = s.derivs(1.0, FRAC_PI_2);
+        assert!(su.norm() < 1e-12);
+    }
+}

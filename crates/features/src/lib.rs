@@ -1,0 +1,1 @@
+//! features: placeholder until its issue lands.

@@ -1,0 +1,1 @@
+//! robot-post: placeholder until its issue lands.
