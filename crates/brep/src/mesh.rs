@@ -277,6 +277,19 @@ fn mesh_face(
     let s = brep.face_surface(f);
     let periods = [s.u_period(), s.v_period()];
     let sense = if face.same_sense { 1.0 } else { -1.0 };
+    // Which B-rep edges each boundary point lies on (vertices: all their edges in this face).
+    let mut edge_of: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &l in &face.loops {
+        for &c in &brep.loops[l.idx()].coedges {
+            let e = brep.coedges[c.idx()].edge;
+            for &i in edge_pts.get(&e).into_iter().flatten() {
+                let v = edge_of.entry(i).or_default();
+                if !v.contains(&e.0) {
+                    v.push(e.0);
+                }
+            }
+        }
+    }
 
     // 1. Each loop into the parameter domain.
     let mut loops: Vec<(Vec<Pt>, [i64; 2])> = vec![];
@@ -472,20 +485,28 @@ fn mesh_face(
             polys.push(poly);
         }
     }
-    if polys.is_empty() {
-        return Err(face_err(
-            brep,
-            f,
-            "no boundary loop makes a region on the surface",
-        ));
+    // Inner loops were unwrapped near their own first point: shift each by whole periods into
+    // the outer loop (the one enclosing the largest area).
+    if polys.len() > 1 && (periods[0].is_some() || periods[1].is_some()) {
+        align_loops(&mut polys, periods);
     }
     // A face bounded by one loop with pole bridges: the bridges' period shifts must give the
     // region on the face's side.
     if polys.len() == 1 {
         fix_bridge_orientation(&mut polys[0], periods, sense);
     }
+    if polys.is_empty() {
+        // No edge loop at all (a whole sphere or torus bounded by a vertex loop, or nothing):
+        // the face is the surface's whole closed domain.
+        match full_domain(s, &pole_vertices, positions, opts) {
+            Some(poly) => polys.push(poly),
+            None => {
+                return Err(face_err(brep, f, "no boundary loop makes a region on the surface"));
+            }
+        }
+    }
 
-    triangulate(brep, f, s, polys, positions, opts, sense)
+    triangulate(brep, f, s, polys, &edge_of, positions, opts, sense)
 }
 
 /// Unwraps a closed chain of points: periodic coordinates are made continuous, runs between
@@ -734,6 +755,7 @@ fn triangulate(
     f: FaceId,
     s: &Surface,
     polys: Vec<Vec<Pt>>,
+    edge_of: &HashMap<u32, Vec<u32>>,
     positions: &mut Vec<P3>,
     opts: &MeshOptions,
     sense: f64,
@@ -767,24 +789,9 @@ fn triangulate(
 
     let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
         ConstrainedDelaunayTriangulation::new();
-    let mut local_uv: Vec<[f64; 2]> = vec![];
-    let mut local_vertex: Vec<u32> = vec![];
-    let mut handle_local: HashMap<usize, usize> = HashMap::new();
-    let mut insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
-                      xy: [f64; 2],
-                      uv: [f64; 2],
-                      idx: u32| {
-        match cdt.insert(Point2::new(xy[0], xy[1])) {
-            Ok(h) => {
-                let e = handle_local.entry(h.index()).or_insert_with(|| {
-                    local_uv.push(uv);
-                    local_vertex.push(idx);
-                    local_uv.len() - 1
-                });
-                Some((h, *e))
-            }
-            Err(_) => None,
-        }
+    let mut loc = Local::default();
+    let insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>, loc: &mut Local, xy: [f64; 2], uv: [f64; 2], idx: u32| {
+        loc.insert(cdt, xy, uv, idx)
     };
 
     // Boundary points, with pole bridges subdivided so the fan at a pole is well shaped.
@@ -795,7 +802,7 @@ fn triangulate(
         for k in 0..m {
             let p = poly[k];
             let q = poly[(k + 1) % m];
-            let Some((h, _)) = insert(&mut cdt, [p.uv[0] * su, p.uv[1] * sv], p.uv, p.idx) else {
+            let Some((h, _)) = insert(&mut cdt, &mut loc, [p.uv[0] * su, p.uv[1] * sv], p.uv, p.idx) else {
                 return Err(face_err(
                     brep,
                     f,
@@ -813,7 +820,7 @@ fn triangulate(
                         p.uv[0] + t * (q.uv[0] - p.uv[0]),
                         p.uv[1] + t * (q.uv[1] - p.uv[1]),
                     ];
-                    if let Some((h, _)) = insert(&mut cdt, [uv[0] * su, uv[1] * sv], uv, p.idx) {
+                    if let Some((h, _)) = insert(&mut cdt, &mut loc, [uv[0] * su, uv[1] * sv], uv, p.idx) {
                         handles.push(h);
                     }
                 }
@@ -864,7 +871,7 @@ fn triangulate(
                 let p = s.eval(uv[0], uv[1]);
                 let idx = positions.len() as u32;
                 positions.push(p);
-                insert(&mut cdt, xy, uv, idx);
+                insert(&mut cdt, &mut loc, xy, uv, idx);
             }
         }
     }
@@ -872,42 +879,101 @@ fn triangulate(
     // Which triangles are inside: count constraint crossings from the hull (odd = inside). This
     // is exact where the boundary's points are collinear to rounding; the centroid test is the
     // fallback when a boundary segment could not be inserted (crossing loops in bad files).
-    let depth = (constraints_failed == 0).then(|| constraint_depth(&cdt));
-    let mut triangles = vec![];
-    for face in cdt.inner_faces() {
-        let vs = face.vertices();
-        let inside = match &depth {
-            Some(d) => d[face.fix().index()] % 2 == 1,
-            None => bnd.inside([
-                (vs[0].position().x + vs[1].position().x + vs[2].position().x) / 3.0,
-                (vs[0].position().y + vs[1].position().y + vs[2].position().y) / 3.0,
-            ]),
-        };
-        if !inside {
-            continue;
-        }
-        let mut t = [0u32; 3];
-        let mut known = true;
-        for k in 0..3 {
-            match handle_local.get(&vs[k].fix().index()) {
-                Some(&l) => t[k] = l as u32,
-                None => known = false,
+    // A chord between two points of the same B-rep edge could be drawn by the face on the other
+    // side of that edge too, giving four triangles on one segment: split such chords with a
+    // point of this face's own until none is left.
+    let mut rounds = 0;
+    loop {
+        let depth = (constraints_failed == 0).then(|| constraint_depth(&cdt));
+        let mut triangles = vec![];
+        let mut splits: Vec<[f64; 2]> = vec![];
+        let mut seen = std::collections::HashSet::new();
+        for face in cdt.inner_faces() {
+            let vs = face.vertices();
+            let inside = match &depth {
+                Some(d) => d[face.fix().index()] % 2 == 1,
+                None => bnd.inside([
+                    (vs[0].position().x + vs[1].position().x + vs[2].position().x) / 3.0,
+                    (vs[0].position().y + vs[1].position().y + vs[2].position().y) / 3.0,
+                ]),
+            };
+            if !inside {
+                continue;
             }
+            let mut t = [0u32; 3];
+            let mut known = true;
+            for k in 0..3 {
+                match loc.handle_local.get(&vs[k].fix().index()) {
+                    Some(&l) => t[k] = l as u32,
+                    None => known = false,
+                }
+            }
+            if !known {
+                continue;
+            }
+            if rounds < 4 {
+                for e in face.adjacent_edges() {
+                    if e.is_constraint_edge() {
+                        continue;
+                    }
+                    let (ha, hb) = (e.from().fix().index(), e.to().fix().index());
+                    let (Some(&la), Some(&lb)) = (loc.handle_local.get(&ha), loc.handle_local.get(&hb)) else { continue };
+                    let (ga, gb) = (loc.vertex[la], loc.vertex[lb]);
+                    let shared = match (edge_of.get(&ga), edge_of.get(&gb)) {
+                        (Some(ea), Some(eb)) => ea.iter().any(|x| eb.contains(x)),
+                        _ => false,
+                    };
+                    if shared && seen.insert((ha.min(hb), ha.max(hb))) {
+                        let (pa, pb) = (e.from().position(), e.to().position());
+                        splits.push([(pa.x + pb.x) * 0.5, (pa.y + pb.y) * 0.5]);
+                    }
+                }
+            }
+            if sense < 0.0 {
+                t.swap(1, 2);
+            }
+            triangles.push(t);
         }
-        if !known {
-            continue;
+        if splits.is_empty() {
+            return Ok(FaceTriangulation { face: f, uv: loc.uv, vertex: loc.vertex, triangles });
         }
-        if sense < 0.0 {
-            t.swap(1, 2);
+        for xy in splits {
+            let uv = [xy[0] / su, xy[1] / sv];
+            let idx = positions.len() as u32;
+            positions.push(s.eval(uv[0], uv[1]));
+            insert(&mut cdt, &mut loc, xy, uv, idx);
         }
-        triangles.push(t);
+        rounds += 1;
     }
-    Ok(FaceTriangulation {
-        face: f,
-        uv: local_uv,
-        vertex: local_vertex,
-        triangles,
-    })
+}
+
+/// Local vertices of one face's triangulation, keyed by spade's vertex handles.
+#[derive(Default)]
+struct Local {
+    uv: Vec<[f64; 2]>,
+    vertex: Vec<u32>,
+    handle_local: HashMap<usize, usize>,
+}
+
+impl Local {
+    fn insert(
+        &mut self,
+        cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+        xy: [f64; 2],
+        uv: [f64; 2],
+        idx: u32,
+    ) -> Option<(spade::handles::FixedVertexHandle, usize)> {
+        // spade refuses magnitudes below 2^-142; such values are zero for us.
+        let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
+        let h = cdt.insert(Point2::new(snap(xy[0]), snap(xy[1]))).ok()?;
+        let (uvs, verts) = (&mut self.uv, &mut self.vertex);
+        let e = *self.handle_local.entry(h.index()).or_insert_with(|| {
+            uvs.push(uv);
+            verts.push(idx);
+            uvs.len() - 1
+        });
+        Some((h, e))
+    }
 }
 
 /// Fewest constraint edges crossed from outside the hull to each face (0-1 breadth-first search).
@@ -946,4 +1012,136 @@ fn constraint_depth(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<
         }
     }
     depth
+}
+
+/// The boundary of a surface's whole parameter domain, for faces without edge loops: a closed
+/// surface (both directions periodic, or periodic one way and collapsing to poles the other).
+/// Seam sides share their vertices with the opposite side and pole sides collapse to one
+/// vertex, so the result is watertight.
+fn full_domain(s: &Surface, pole_vertices: &[u32], positions: &mut Vec<P3>, opts: &MeshOptions) -> Option<Vec<Pt>> {
+    let (bu, bv) = s.bounds();
+    let (pu, pv) = (s.u_period(), s.v_period());
+    let ur = pu.map(|p| (0.0, p)).or(bu)?;
+    let vr = pv.map(|p| (0.0, p)).or(bv)?;
+    let (du, dv) = grid_steps(s, ur, vr, opts);
+    let nu = if du.is_finite() { ((ur.1 - ur.0) / du).ceil().clamp(4.0, 400.0) as usize } else { 4 };
+    let nv = if dv.is_finite() { ((vr.1 - vr.0) / dv).ceil().clamp(4.0, 400.0) as usize } else { 4 };
+    let size = {
+        let mut b = Aabb::empty();
+        for i in 0..=4 {
+            for j in 0..=4 {
+                b.add(&s.eval(ur.0 + (ur.1 - ur.0) * i as f64 / 4.0, vr.0 + (vr.1 - vr.0) * j as f64 / 4.0));
+            }
+        }
+        b.diagonal()
+    };
+    let new_vertex = |p: P3, positions: &mut Vec<P3>| -> u32 {
+        if let Some(&i) = pole_vertices.iter().find(|&&i| (positions[i as usize] - p).norm() <= 1e-7 * size.max(1e-9)) {
+            return i;
+        }
+        positions.push(p);
+        (positions.len() - 1) as u32
+    };
+    // A side collapses when all its points coincide.
+    let collapsed = |pts: &[P3]| pts.iter().all(|p| (p - pts[0]).norm() <= 1e-7 * size.max(1e-9));
+    let side_u = |v: f64| -> Vec<P3> { (0..=nu).map(|i| s.eval(ur.0 + (ur.1 - ur.0) * i as f64 / nu as f64, v)).collect() };
+    let side_v = |u: f64| -> Vec<P3> { (0..=nv).map(|j| s.eval(u, vr.0 + (vr.1 - vr.0) * j as f64 / nv as f64)).collect() };
+    let (bottom, top) = (side_u(vr.0), side_u(vr.1));
+    let (left, _right) = (side_v(ur.0), side_v(ur.1));
+    let bottom_pole = collapsed(&bottom);
+    let top_pole = collapsed(&top);
+    if pu.is_none() || !(pv.is_some() || (bottom_pole && top_pole)) {
+        return None;
+    }
+    // Vertex indices: the left seam (shared with the right), the bottom and top sides.
+    let mut left_idx = vec![0u32; nv + 1];
+    let bottom_idx: Vec<u32> = if bottom_pole {
+        vec![new_vertex(bottom[0], positions); nu + 1]
+    } else {
+        bottom.iter().map(|p| new_vertex(*p, positions)).collect()
+    };
+    let top_idx: Vec<u32> = if pv.is_some() {
+        bottom_idx.clone()
+    } else if top_pole {
+        vec![new_vertex(top[0], positions); nu + 1]
+    } else {
+        top.iter().map(|p| new_vertex(*p, positions)).collect()
+    };
+    left_idx[0] = bottom_idx[0];
+    left_idx[nv] = top_idx[0];
+    for j in 1..nv {
+        left_idx[j] = new_vertex(left[j], positions);
+    }
+    let right_idx = |j: usize| if j == 0 { bottom_idx[nu] } else if j == nv { top_idx[nu] } else { left_idx[j] };
+    let u_at = |i: usize| ur.0 + (ur.1 - ur.0) * i as f64 / nu as f64;
+    let v_at = |j: usize| vr.0 + (vr.1 - vr.0) * j as f64 / nv as f64;
+    let mut poly = vec![];
+    for i in 0..nu {
+        poly.push(Pt { uv: [u_at(i), vr.0], idx: bottom_idx[i], sing: if bottom_pole { 1 } else { 0 } });
+    }
+    for j in 0..nv {
+        poly.push(Pt { uv: [ur.1, v_at(j)], idx: right_idx(j), sing: 0 });
+    }
+    for i in (1..=nu).rev() {
+        poly.push(Pt { uv: [u_at(i), vr.1], idx: top_idx[i], sing: if top_pole { 1 } else { 0 } });
+    }
+    for j in (1..=nv).rev() {
+        poly.push(Pt { uv: [ur.0, v_at(j)], idx: left_idx[j], sing: 0 });
+    }
+    Some(poly)
+}
+
+/// Shifts every loop but the outer one (largest enclosed area) by whole periods so that it lies
+/// inside the outer loop.
+fn align_loops(polys: &mut [Vec<Pt>], periods: [Option<f64>; 2]) {
+    let outer = (0..polys.len())
+        .max_by(|&a, &b| signed_area(&polys[a]).abs().total_cmp(&signed_area(&polys[b]).abs()))
+        .unwrap_or(0);
+    let outer_pts: Vec<[f64; 2]> = polys[outer].iter().map(|p| p.uv).collect();
+    let inside = |q: [f64; 2]| {
+        let n = outer_pts.len();
+        let mut c = false;
+        for k in 0..n {
+            let (a, b) = (outer_pts[k], outer_pts[(k + 1) % n]);
+            if (a[1] > q[1]) != (b[1] > q[1]) {
+                let x = a[0] + (q[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+                if x > q[0] {
+                    c = !c;
+                }
+            }
+        }
+        c
+    };
+    let centre = |pts: &[Pt]| {
+        let n = pts.len().max(1) as f64;
+        let s = pts.iter().fold([0.0, 0.0], |acc, p| [acc[0] + p.uv[0], acc[1] + p.uv[1]]);
+        [s[0] / n, s[1] / n]
+    };
+    let oc = centre(&polys[outer]);
+    for (i, poly) in polys.iter_mut().enumerate() {
+        if i == outer {
+            continue;
+        }
+        let pu = periods[0].unwrap_or(0.0);
+        let pv = periods[1].unwrap_or(0.0);
+        let ku: &[f64] = if periods[0].is_some() { &[0.0, -1.0, 1.0, -2.0, 2.0] } else { &[0.0] };
+        let kv: &[f64] = if periods[1].is_some() { &[0.0, -1.0, 1.0, -2.0, 2.0] } else { &[0.0] };
+        let c = centre(poly);
+        // Prefer a shift that puts the loop's points inside the outer loop; else the nearest.
+        let mut best = (usize::MAX, f64::INFINITY, 0.0, 0.0);
+        for &a in ku {
+            for &b in kv {
+                let (du, dv) = (a * pu, b * pv);
+                let outside = poly.iter().filter(|p| !inside([p.uv[0] + du, p.uv[1] + dv])).count();
+                let dist = (c[0] + du - oc[0]).hypot(c[1] + dv - oc[1]);
+                if (outside, dist) < (best.0, best.1) {
+                    best = (outside, dist, du, dv);
+                }
+            }
+        }
+        for p in poly.iter_mut() {
+            p.uv[0] += best.2;
+            p.uv[1] += best.3;
+        }
+    }
 }

@@ -61,6 +61,43 @@ pub fn check_shell(brep: &Brep, shell: ShellId) -> ShellReport {
             }
         }
     }
+    // Some writers (OpenCASCADE for certain reversed faces) write a face's loops against its
+    // `same_sense`. Such a face disagrees with every neighbour; read it as reversed.
+    let mismatched = |uses: &HashMap<EdgeId, (u32, u32)>, e: EdgeId| {
+        let (f, b) = uses[&e];
+        f + b == 2 && (f == 2 || b == 2)
+    };
+    let mut reversed_faces = vec![];
+    for &f in &sh.faces {
+        let face = brep.face(f);
+        let mut own: Vec<EdgeId> = vec![];
+        let mut seams: Vec<EdgeId> = vec![];
+        for &l in &face.loops {
+            for &c in &brep.loops[l.idx()].coedges {
+                let e = brep.coedges[c.idx()].edge;
+                if own.contains(&e) {
+                    seams.push(e);
+                } else {
+                    own.push(e);
+                }
+            }
+        }
+        own.retain(|e| !seams.contains(e));
+        if !own.is_empty() && own.iter().all(|&e| mismatched(&uses, e)) {
+            reversed_faces.push((f, own));
+        }
+    }
+    for (f, own) in &reversed_faces {
+        for e in own {
+            if let Some(u) = uses.get_mut(e) {
+                *u = (1, 1);
+            }
+        }
+        findings.push(format!(
+            "face #{}: loops are written against the face's orientation; read as reversed",
+            brep.face(*f).step_id
+        ));
+    }
     let mut closed = !sh.faces.is_empty();
     let mut edge_ids: Vec<(u64, String)> = vec![];
     for (e, (f, b)) in &uses {
@@ -69,8 +106,7 @@ pub fn check_shell(brep: &Brep, shell: ShellId) -> ShellReport {
             let id = brep.edge(*e).step_id;
             let what = match f + b {
                 1 => "is used by one face only (open edge)".to_string(),
-                2 => "is used twice in the same direction (inconsistent face orientation)"
-                    .to_string(),
+                2 => "is used twice in the same direction (inconsistent face orientation)".to_string(),
                 n => format!("is used {n} times (non-manifold)"),
             };
             edge_ids.push((id, what));
