@@ -3,7 +3,6 @@
 use crate::math::{nearest_periodic, Frame, P3, V3};
 use std::f64::consts::TAU;
 use truck_geometry::prelude as tg;
-use truck_geometry::prelude::ParametricCurve;
 
 /// A rational B-spline curve (truck's homogeneous representation).
 pub type NurbsCurve = tg::NurbsCurve<tg::Vector4>;
@@ -79,6 +78,8 @@ pub struct NurbsData {
     pub spans: usize,
     /// Degree.
     pub degree: usize,
+    /// The same curve for fast local evaluation.
+    pub local: crate::nurbs::LocalCurve,
 }
 
 impl NurbsData {
@@ -96,6 +97,11 @@ impl NurbsData {
             }
         }
         NurbsData {
+            local: crate::nurbs::LocalCurve {
+                knots: curve.knot_vec().to_vec(),
+                degree,
+                cps: curve.control_points().iter().map(|c| [c.x, c.y, c.z, c.w]).collect(),
+            },
             curve,
             t0,
             t1,
@@ -105,9 +111,11 @@ impl NurbsData {
     }
 }
 
+#[cfg(test)]
 pub(crate) fn p3(p: tg::Point3) -> P3 {
     P3::new(p.x, p.y, p.z)
 }
+#[cfg(test)]
 pub(crate) fn v3(v: tg::Vector3) -> V3 {
     V3::new(v.x, v.y, v.z)
 }
@@ -121,7 +129,10 @@ impl Curve {
             Curve::Ellipse { frame, a, b } => frame.at(a * t.cos(), b * t.sin(), 0.0),
             Curve::Hyperbola { frame, a, b } => frame.at(a * t.cosh(), b * t.sinh(), 0.0),
             Curve::Parabola { frame, focal } => frame.at(focal * t * t, 2.0 * focal * t, 0.0),
-            Curve::Nurbs(n) => p3(n.curve.subs(t.clamp(n.t0, n.t1))),
+            Curve::Nurbs(n) => {
+                let [p, _, _] = n.local.ders(t.clamp(n.t0, n.t1));
+                P3::new(p[0], p[1], p[2])
+            }
             Curve::Polyline(pts) => {
                 let (i, f) = poly_index(pts.len(), t);
                 pts[i] + (pts[i + 1] - pts[i]) * f
@@ -138,7 +149,10 @@ impl Curve {
             Curve::Ellipse { frame, a, b } => frame.vec(-a * t.sin(), b * t.cos(), 0.0),
             Curve::Hyperbola { frame, a, b } => frame.vec(a * t.sinh(), b * t.cosh(), 0.0),
             Curve::Parabola { frame, focal } => frame.vec(2.0 * focal * t, 2.0 * focal, 0.0),
-            Curve::Nurbs(n) => v3(n.curve.der(t.clamp(n.t0, n.t1))),
+            Curve::Nurbs(n) => {
+                let [_, d, _] = n.local.ders(t.clamp(n.t0, n.t1));
+                V3::new(d[0], d[1], d[2])
+            }
             Curve::Polyline(pts) => {
                 let (i, _) = poly_index(pts.len(), t);
                 pts[i + 1] - pts[i]
@@ -155,7 +169,10 @@ impl Curve {
             Curve::Ellipse { frame, a, b } => frame.vec(-a * t.cos(), -b * t.sin(), 0.0),
             Curve::Hyperbola { frame, a, b } => frame.vec(a * t.cosh(), b * t.sinh(), 0.0),
             Curve::Parabola { frame, focal } => frame.vec(2.0 * focal, 0.0, 0.0),
-            Curve::Nurbs(n) => v3(n.curve.der2(t.clamp(n.t0, n.t1))),
+            Curve::Nurbs(n) => {
+                let [_, _, d] = n.local.ders(t.clamp(n.t0, n.t1));
+                V3::new(d[0], d[1], d[2])
+            }
             Curve::Trimmed { basis, t0, t1 } => {
                 basis.deriv2(t0 + t * (t1 - t0)) * (t1 - t0).powi(2)
             }

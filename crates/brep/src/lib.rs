@@ -16,6 +16,7 @@ pub mod error;
 pub mod mass;
 pub mod math;
 pub mod mesh;
+pub mod nurbs;
 pub mod p21;
 pub mod solid;
 pub mod step;

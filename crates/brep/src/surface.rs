@@ -1,7 +1,7 @@
 //! Exact surfaces with their natural parametrisation, as ISO 10303-42 defines it, so that the
 //! natural normal `S_u × S_v` is the one a face's `same_sense` refers to.
 
-use crate::curve::{p3, v3, Curve};
+use crate::curve::Curve;
 use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
 use truck_geometry::prelude as tg;
@@ -133,6 +133,10 @@ pub struct NurbsSurfaceData {
     pub closed_u: bool,
     /// Whether `S(u, v0) = S(u, v1)` for all `u`.
     pub closed_v: bool,
+    /// The same surface for fast local evaluation.
+    pub local: crate::nurbs::LocalSurface,
+    /// A grid of sample points, made on first use, that seeds point projection.
+    pub samples: std::sync::OnceLock<(usize, usize, Vec<P3>)>,
 }
 
 fn knot_range(kv: &tg::KnotVec, degree: usize) -> ((f64, f64), usize) {
@@ -153,6 +157,13 @@ impl NurbsSurfaceData {
         let (du, dv) = (surface.udegree(), surface.vdegree());
         let (u, su) = knot_range(surface.uknot_vec(), du);
         let (v, sv) = knot_range(surface.vknot_vec(), dv);
+        let local = crate::nurbs::LocalSurface {
+            ku: surface.uknot_vec().to_vec(),
+            kv: surface.vknot_vec().to_vec(),
+            degree: (du, dv),
+            n: (surface.control_points().len(), surface.control_points().first().map_or(0, |r| r.len())),
+            cps: surface.control_points().iter().flatten().map(|c| [c.x, c.y, c.z, c.w]).collect(),
+        };
         let mut d = NurbsSurfaceData {
             surface,
             u,
@@ -161,6 +172,8 @@ impl NurbsSurfaceData {
             degree: (du, dv),
             closed_u: false,
             closed_v: false,
+            local,
+            samples: std::sync::OnceLock::new(),
         };
         let size = d.size_estimate();
         let tol = 1e-7 * size.max(1e-3);
@@ -188,7 +201,8 @@ impl NurbsSurfaceData {
         bb.diagonal()
     }
     fn raw(&self, u: f64, v: f64) -> P3 {
-        p3(self.surface.subs(u, v))
+        let [p, _, _] = self.local.eval_d1(u, v);
+        P3::new(p[0], p[1], p[2])
     }
     fn clamp_uv(&self, u: f64, v: f64) -> (f64, f64) {
         let u = if self.closed_u {
@@ -304,7 +318,8 @@ impl Surface {
             Surface::Extrusion { profile, dir } => (profile.deriv(u), *dir),
             Surface::Nurbs(n) => {
                 let (u, v) = n.clamp_uv(u, v);
-                (v3(n.surface.uder(u, v)), v3(n.surface.vder(u, v)))
+                let [_, a, b] = n.local.eval_d1(u, v);
+                (V3::new(a[0], a[1], a[2]), V3::new(b[0], b[1], b[2]))
             }
             Surface::Offset { .. } => {
                 let h = 1e-6;
@@ -588,7 +603,8 @@ impl Surface {
                 let start = match hint {
                     Some(h) => {
                         let q = self.polish(p, h);
-                        if (self.eval(q.0, q.1) - p).norm() < 1e-6 * (1.0 + p.coords.norm()) {
+                        // Points of other writers lie off the surface by their modelling tolerance.
+                        if (self.eval(q.0, q.1) - p).norm() < 1e-4f64.max(1e-6 * (1.0 + p.coords.norm())) {
                             return q;
                         }
                         self.grid_start(p, n)
@@ -605,20 +621,30 @@ impl Surface {
     }
 
     fn grid_start(&self, p: &P3, n: &NurbsSurfaceData) -> (f64, f64) {
-        let nu = (n.spans.0 * (n.degree.0 + 1)).clamp(8, 64);
-        let nv = (n.spans.1 * (n.degree.1 + 1)).clamp(8, 64);
-        let mut best = (f64::INFINITY, (n.u.0, n.v.0));
-        for i in 0..=nu {
-            let u = n.u.0 + (n.u.1 - n.u.0) * i as f64 / nu as f64;
-            for j in 0..=nv {
-                let v = n.v.0 + (n.v.1 - n.v.0) * j as f64 / nv as f64;
-                let d = (n.raw(u, v) - p).norm_squared();
-                if d < best.0 {
-                    best = (d, (u, v));
+        let (nu, nv, pts) = n.samples.get_or_init(|| {
+            let nu = (n.spans.0 * (n.degree.0 + 1)).clamp(8, 64);
+            let nv = (n.spans.1 * (n.degree.1 + 1)).clamp(8, 64);
+            let mut pts = Vec::with_capacity((nu + 1) * (nv + 1));
+            for i in 0..=nu {
+                let u = n.u.0 + (n.u.1 - n.u.0) * i as f64 / nu as f64;
+                for j in 0..=nv {
+                    let v = n.v.0 + (n.v.1 - n.v.0) * j as f64 / nv as f64;
+                    pts.push(n.raw(u, v));
                 }
             }
-        }
-        best.1
+            (nu, nv, pts)
+        });
+        let best = pts
+            .iter()
+            .enumerate()
+            .map(|(k, q)| ((q - p).norm_squared(), k))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(0, |x| x.1);
+        let (i, j) = (best / (nv + 1), best % (nv + 1));
+        (
+            n.u.0 + (n.u.1 - n.u.0) * i as f64 / *nu as f64,
+            n.v.0 + (n.v.1 - n.v.0) * j as f64 / *nv as f64,
+        )
     }
 
     /// Gauss–Newton steps towards the foot point of `p`, staying inside bounded ranges.
@@ -702,6 +728,41 @@ impl Surface {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::curve::{p3, v3};
+    use truck_geometry::prelude::ParametricSurface;
+
+    #[test]
+    fn local_evaluation_agrees_with_truck() {
+        // A rational bicubic-by-quadratic patch with interior knots and uneven weights.
+        let ku = tg::KnotVec::from(vec![0.0, 0.0, 0.0, 0.0, 0.4, 0.7, 1.0, 1.0, 1.0, 1.0]);
+        let kv = tg::KnotVec::from(vec![0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0]);
+        let cps: Vec<Vec<tg::Vector4>> = (0..6)
+            .map(|i| {
+                (0..4)
+                    .map(|j| {
+                        let w = 1.0 + 0.3 * ((i * 3 + j) % 4) as f64;
+                        let (x, y, z) = (i as f64, j as f64, ((i * j) % 3) as f64 - 1.0);
+                        tg::Vector4::new(x * w, y * w, z * w, w)
+                    })
+                    .collect()
+            })
+            .collect();
+        let bs = tg::BSplineSurface::new((ku, kv), cps);
+        let surf = NurbsSurface::new(bs);
+        let data = NurbsSurfaceData::new(surf.clone());
+        let s = Surface::Nurbs(Box::new(data));
+        for i in 0..=10 {
+            for j in 0..=10 {
+                let (u, v) = (i as f64 / 10.0, j as f64 / 10.0);
+                let ours = s.eval(u, v);
+                let theirs = p3(surf.subs(u, v));
+                assert!((ours - theirs).norm() < 1e-10, "point at ({u},{v})");
+                let (su, sv) = s.derivs(u, v);
+                assert!((su - v3(surf.uder(u, v))).norm() < 1e-8, "S_u at ({u},{v})");
+                assert!((sv - v3(surf.vder(u, v))).norm() < 1e-8, "S_v at ({u},{v})");
+            }
+        }
+    }
 
     fn frame() -> Frame {
         Frame::from_axes(
