@@ -1,0 +1,165 @@
+//! Entities truck-stepio 0.3 ignores or mishandles (the file's length and angle units,
+//! OFFSET_SURFACE, RECTANGULAR_TRIMMED_SURFACE with and without reversed sense, TRIMMED_CURVE,
+//! SURFACE_OF_LINEAR_EXTRUSION), each pinned by rewriting entities of a fixture in a way that
+//! must leave the solid unchanged, or scale it exactly. Closed edges and seams (cylinder.step),
+//! a seam ending at a sphere's pole (sphere_boss.step), a whole sphere bounded by a vertex loop
+//! (sphere.step) and BREP_WITH_VOIDS (void_box.step) are covered by the fixture tests.
+
+use brep::solid::report_solid;
+use brep::topology::SolidId;
+use std::path::PathBuf;
+
+fn fixture(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
+    std::fs::read_to_string(p).expect("fixture")
+}
+
+/// Replaces one exact line (the whole entity) and appends extra entities to the DATA section.
+fn rewrite(text: &str, replace: &[(&str, &str)], extra: &str) -> String {
+    let mut t = text.to_string();
+    for (old, new) in replace {
+        assert!(t.contains(old), "fixture no longer contains {old:?}");
+        t = t.replacen(old, new, 1);
+    }
+    let data = t.find("DATA;").expect("DATA section");
+    let end = data + t[data..].find("ENDSEC;").expect("ENDSEC");
+    t.insert_str(end, extra);
+    t
+}
+
+fn volume_of(text: &str) -> (f64, bool, bool) {
+    let part = brep::read_step_bytes(text.as_bytes()).expect("reads");
+    let r = report_solid(&part.brep, SolidId(0)).expect("meshes");
+    (r.volume, r.closed, r.watertight)
+}
+
+fn assert_same_solid(original: &str, changed: &str) {
+    assert_same_solid_within(original, changed, 1e-6);
+}
+
+/// Where the rewrite changes how an edge is discretised (a trimmed circle is sampled adaptively,
+/// a circle by its exact count), the two figures differ by the analysis mesh, not by the solid.
+fn assert_same_solid_within(original: &str, changed: &str, rel: f64) {
+    let (v0, ..) = volume_of(original);
+    let (v1, closed, watertight) = volume_of(changed);
+    assert!(closed && watertight, "changed solid closed={closed} watertight={watertight}");
+    assert!((v1 - v0).abs() <= rel * v0, "volume changed: {v0} -> {v1}");
+}
+
+#[test]
+fn offset_surface_is_its_basis_moved_along_the_normal() {
+    let box_step = fixture("box.step");
+    // Face #17 lies on the plane x = 0 (#32, normal +x). Put it on a plane at x = -2 offset by +2.
+    let changed = rewrite(
+        &box_step,
+        &[("#32 = PLANE('',#33);", "#32 = OFFSET_SURFACE('',#900001,2.,.F.);")],
+        "#900001 = PLANE('',#900002);\n#900002 = AXIS2_PLACEMENT_3D('',#900003,#35,#36);\n#900003 = CARTESIAN_POINT('',(-2.,0.,0.));\n",
+    );
+    assert_same_solid(&box_step, &changed);
+    // The wrong distance must show: the face no longer meets its edges, the solid grows.
+    let wrong = changed.replace("OFFSET_SURFACE('',#900001,2.,.F.)", "OFFSET_SURFACE('',#900001,0.,.F.)");
+    let (v, ..) = volume_of(&wrong);
+    assert!((v - 6000.0).abs() > 1.0, "a zero offset should change the volume, got {v}");
+}
+
+#[test]
+fn rectangular_trimmed_surface_keeps_its_basis_and_sense() {
+    let box_step = fixture("box.step");
+    let wrapped = rewrite(
+        &box_step,
+        &[("#32 = PLANE('',#33);", "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.T.,.T.);")],
+        "#900001 = PLANE('',#33);\n",
+    );
+    assert_same_solid(&box_step, &wrapped);
+    // u_sense .F. reverses the natural normal; flipping the face's same_sense too keeps the solid.
+    let reversed = rewrite(
+        &box_step,
+        &[
+            ("#32 = PLANE('',#33);", "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.F.,.T.);"),
+            ("#17 = ADVANCED_FACE('',(#18),#32,.F.);", "#17 = ADVANCED_FACE('',(#18),#32,.T.);"),
+        ],
+        "#900001 = PLANE('',#33);\n",
+    );
+    assert_same_solid(&box_step, &reversed);
+}
+
+#[test]
+fn trimmed_curve_edges_read_like_their_basis() {
+    let box_step = fixture("box.step");
+    let changed = rewrite(
+        &box_step,
+        &[("#27 = LINE('',#28,#29);", "#27 = TRIMMED_CURVE('',#900010,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(10.)),.T.,.PARAMETER.);")],
+        "#900010 = LINE('',#28,#29);\n",
+    );
+    assert_same_solid(&box_step, &changed);
+}
+
+#[test]
+fn trimmed_circle_parameters_follow_the_angle_unit() {
+    let cyl = fixture("cylinder.step");
+    // Angles in degrees: the trimmed full circle is (0°, 360°).
+    let changed = rewrite(
+        &cyl,
+        &[
+            ("#25 = CIRCLE('',#26,10.);", "#25 = TRIMMED_CURVE('',#900010,(PARAMETER_VALUE(0.)),(PARAMETER_VALUE(360.)),.T.,.PARAMETER.);"),
+            (
+                "#115 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );",
+                "#115 = ( CONVERSION_BASED_UNIT('DEGREE',#900020) NAMED_UNIT(#900022) PLANE_ANGLE_UNIT() );",
+            ),
+        ],
+        "#900010 = CIRCLE('',#26,10.);\n#900020 = PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#900021);\n#900021 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );\n#900022 = DIMENSIONAL_EXPONENTS(0.,0.,0.,0.,0.,0.,0.);\n",
+    );
+    assert_same_solid_within(&cyl, &changed, 1e-4);
+}
+
+#[test]
+fn cone_semi_angle_follows_the_angle_unit() {
+    let cone = fixture("cone.step");
+    let deg = 0.463647609001f64.to_degrees();
+    let changed = rewrite(
+        &cone,
+        &[
+            ("#32 = CONICAL_SURFACE('',#33,10.,0.463647609001);", &format!("#32 = CONICAL_SURFACE('',#33,10.,{deg:.12});")),
+            (
+                "#84 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );",
+                "#84 = ( CONVERSION_BASED_UNIT('DEGREE',#900020) NAMED_UNIT(#900022) PLANE_ANGLE_UNIT() );",
+            ),
+        ],
+        "#900020 = PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#900021);\n#900021 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );\n#900022 = DIMENSIONAL_EXPONENTS(0.,0.,0.,0.,0.,0.,0.);\n",
+    );
+    assert_same_solid(&cone, &changed);
+}
+
+#[test]
+fn linear_extrusion_of_a_circle_is_the_cylinder() {
+    let cyl = fixture("cylinder.step");
+    let changed = rewrite(
+        &cyl,
+        &[("#31 = CYLINDRICAL_SURFACE('',#32,10.);", "#31 = SURFACE_OF_LINEAR_EXTRUSION('',#900040,#900042);")],
+        "#900040 = CIRCLE('',#32,10.);\n#900042 = VECTOR('',#900043,1.);\n#900043 = DIRECTION('',(0.,0.,1.));\n",
+    );
+    assert_same_solid(&cyl, &changed);
+}
+
+#[test]
+fn length_units_scale_everything_to_millimetres() {
+    let box_step = fixture("box.step");
+    let unit = "#346 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );";
+    let cases: [(&str, &str, f64); 3] = [
+        ("#346 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.METRE.) );", "", 1000.0),
+        ("#346 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.CENTI.,.METRE.) );", "", 10.0),
+        (
+            "#346 = ( CONVERSION_BASED_UNIT('FOOT',#900030) LENGTH_UNIT() NAMED_UNIT(#900032) );",
+            "#900030 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(304.8),#900031);\n#900031 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n#900032 = DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);\n",
+            304.8,
+        ),
+    ];
+    for (new, extra, scale) in cases {
+        let changed = rewrite(&box_step, &[(unit, new)], extra);
+        let part = brep::read_step_bytes(changed.as_bytes()).expect("reads");
+        assert!((part.brep.units[0].mm_per_unit - scale).abs() < 1e-9 * scale);
+        let (v, ..) = volume_of(&changed);
+        let want = 6000.0 * scale.powi(3);
+        assert!((v - want).abs() <= 1e-6 * want, "{new}: volume {v}, want {want}");
+    }
+}
