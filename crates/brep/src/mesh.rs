@@ -22,15 +22,15 @@ pub struct MeshOptions {
     pub chord_tol: f64,
     /// Largest turn of the tangent or normal between neighbouring points, radians.
     pub angle_tol: f64,
+    /// A finer chord tolerance for edges only (mass properties integrate the exact surface
+    /// inside faces, so only the boundaries need to be fine); `None` uses `chord_tol`.
+    pub edge_chord_tol: Option<f64>,
 }
 
 impl MeshOptions {
     /// A chord tolerance with a 15° angular limit.
     pub fn with_tolerance(chord_tol: f64) -> Self {
-        MeshOptions {
-            chord_tol,
-            angle_tol: 15f64.to_radians(),
-        }
+        MeshOptions { chord_tol, angle_tol: 15f64.to_radians(), edge_chord_tol: None }
     }
 }
 
@@ -123,6 +123,23 @@ impl Mesh {
         (open, bad)
     }
 
+    /// The generalised winding number of the closed mesh around `p`: about 1 inside, 0 outside
+    /// (the sum of the solid angles the triangles subtend, after Van Oosterom & Strackee), robust
+    /// where a ray cast would graze an edge.
+    pub fn winding_number(&self, p: &P3) -> f64 {
+        let mut total = 0.0;
+        for t in self.triangles() {
+            let a = self.positions[t[0] as usize] - p;
+            let b = self.positions[t[1] as usize] - p;
+            let c = self.positions[t[2] as usize] - p;
+            let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+            let num = a.dot(&b.cross(&c));
+            let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
+            total += 2.0 * num.atan2(den);
+        }
+        total / (4.0 * std::f64::consts::PI)
+    }
+
     /// The bounding box of the vertices.
     pub fn bbox(&self) -> Aabb {
         let mut b = Aabb::empty();
@@ -180,8 +197,84 @@ pub fn mesh_faces(brep: &Brep, faces: &[FaceId], opts: &MeshOptions) -> Result<M
     Ok(m)
 }
 
+/// A face's trimmed domain: closed polygons in the surface's `(u, v)` parameters (periodic
+/// parameters unwrapped so the polygons do not jump), edges sampled within `opts`.
+#[derive(Debug, Clone)]
+pub struct FaceDomain {
+    /// Boundary polygons; the region is what an even number of them does not enclose.
+    pub loops: Vec<Vec<[f64; 2]>>,
+    /// Periods of `u` and `v`, where the surface closes on itself.
+    pub periods: [Option<f64>; 2],
+}
+
+impl FaceDomain {
+    /// Whether `(u, v)` (in any period) lies in the face.
+    pub fn contains(&self, uv: [f64; 2]) -> bool {
+        let ks = |p: Option<f64>| if p.is_some() { vec![0.0, -1.0, 1.0, -2.0, 2.0] } else { vec![0.0] };
+        for a in ks(self.periods[0]) {
+            for b in ks(self.periods[1]) {
+                let q = [uv[0] + a * self.periods[0].unwrap_or(0.0), uv[1] + b * self.periods[1].unwrap_or(0.0)];
+                let mut inside = false;
+                for l in &self.loops {
+                    let n = l.len();
+                    for k in 0..n {
+                        let (p0, p1) = (l[k], l[(k + 1) % n]);
+                        if (p0[1] > q[1]) != (p1[1] > q[1]) {
+                            let x = p0[0] + (q[1] - p0[1]) * (p1[0] - p0[0]) / (p1[1] - p0[1]);
+                            if x > q[0] {
+                                inside = !inside;
+                            }
+                        }
+                    }
+                }
+                if inside {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The trimmed parameter domain of one face.
+pub fn face_domain(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<FaceDomain, MeshError> {
+    let mut positions: Vec<P3> = vec![];
+    let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
+    let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
+    for e in brep.edges_of(&[f]) {
+        let edge = brep.edge(e);
+        for v in [edge.start, edge.end] {
+            if vert_idx[v.idx()].is_none() {
+                vert_idx[v.idx()] = Some(positions.len() as u32);
+                positions.push(brep.vertices[v.idx()].point);
+            }
+        }
+        let (Some(s), Some(t)) = (vert_idx[edge.start.idx()], vert_idx[edge.end.idx()]) else { continue };
+        let mut ids = vec![s];
+        for p in discretize_edge(brep.edge_curve(e), edge.t_start, edge.t_end, opts) {
+            ids.push(positions.len() as u32);
+            positions.push(p);
+        }
+        ids.push(t);
+        edge_pts.insert(e, ids);
+    }
+    for v in brep.vertices_of(&[f]) {
+        if vert_idx[v.idx()].is_none() {
+            vert_idx[v.idx()] = Some(positions.len() as u32);
+            positions.push(brep.vertices[v.idx()].point);
+        }
+    }
+    let (polys, _) = face_polygons(brep, f, &edge_pts, &vert_idx, &mut positions, opts)?;
+    let s = brep.face_surface(f);
+    Ok(FaceDomain {
+        loops: polys.into_iter().map(|p| p.into_iter().map(|q| q.uv).collect()).collect(),
+        periods: [s.u_period(), s.v_period()],
+    })
+}
+
 /// Points strictly inside an edge (its vertices excluded), spaced by the tolerances.
 pub fn discretize_edge(c: &Curve, t0: f64, t1: f64, opts: &MeshOptions) -> Vec<P3> {
+    let opts = &MeshOptions { chord_tol: opts.edge_chord_tol.unwrap_or(opts.chord_tol), ..*opts };
     let n0 = match c {
         Curve::Line { .. } => 1,
         Curve::Polyline(p) => p.len().saturating_sub(1).max(1),
@@ -273,6 +366,22 @@ fn mesh_face(
     positions: &mut Vec<P3>,
     opts: &MeshOptions,
 ) -> Result<FaceTriangulation, MeshError> {
+    let (polys, edge_of) = face_polygons(brep, f, edge_pts, vert_idx, positions, opts)?;
+    let sense = if brep.face(f).same_sense { 1.0 } else { -1.0 };
+    triangulate(brep, f, brep.face_surface(f), polys, &edge_of, positions, opts, sense)
+}
+
+/// The closed polygons bounding a face in its parameter domain, with, for each boundary
+/// point, the B-rep edges it lies on.
+#[allow(clippy::type_complexity)]
+fn face_polygons(
+    brep: &Brep,
+    f: FaceId,
+    edge_pts: &HashMap<EdgeId, Vec<u32>>,
+    vert_idx: &[Option<u32>],
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Result<(Vec<Vec<Pt>>, HashMap<u32, Vec<u32>>), MeshError> {
     let face = brep.face(f);
     let s = brep.face_surface(f);
     let periods = [s.u_period(), s.v_period()];
@@ -356,23 +465,6 @@ fn mesh_face(
                     pts[k].uv[axis] = val;
                 }
             }
-            if std::env::var_os("BREP_DEBUG_FACE")
-                .is_some_and(|v| v.to_string_lossy() == face.step_id.to_string())
-            {
-                let e = brep.edge(ce.edge);
-                eprintln!(
-                    "coedge #{} edge #{} fwd={} curve={} t=[{:.4},{:.4}] n={} first={:?} last={:?}",
-                    ce.step_id,
-                    e.step_id,
-                    ce.forward,
-                    brep.edge_curve(ce.edge).kind(),
-                    e.t_start,
-                    e.t_end,
-                    pts.len(),
-                    pts.first().map(|p| p.uv),
-                    pts.last().map(|p| p.uv)
-                );
-            }
             coedges.push(pts);
         }
         // Chain coedges: drop each coedge's last point unless it sits on a singular line (then
@@ -390,19 +482,7 @@ fn mesh_face(
         if chain.len() < 2 {
             continue;
         }
-        let (pts, w) = unwrap_loop(chain, periods);
-        if std::env::var_os("BREP_DEBUG_FACE")
-            .is_some_and(|v| v.to_string_lossy() == face.step_id.to_string())
-        {
-            eprintln!("loop wrap={w:?} n={}", pts.len());
-            for p in &pts {
-                eprintln!(
-                    "  {:.4} {:.4} sing={} idx={}",
-                    p.uv[0], p.uv[1], p.sing, p.idx
-                );
-            }
-        }
-        loops.push((pts, w));
+        loops.push(unwrap_loop(chain, periods));
     }
 
     // 2. Pair or close loops that wrap around a periodic direction.
@@ -506,7 +586,7 @@ fn mesh_face(
         }
     }
 
-    triangulate(brep, f, s, polys, &edge_of, positions, opts, sense)
+    Ok((polys, edge_of))
 }
 
 /// Unwraps a closed chain of points: periodic coordinates are made continuous, runs between
@@ -836,7 +916,16 @@ fn triangulate(
     }
 
     // Interior grid points.
-    let (du, dv) = grid_steps(s, ub, vb, opts);
+    let (mut du, mut dv) = grid_steps(s, ub, vb, opts);
+    // A straight direction (cylinder and cone generators) still gets rows, at most `ASPECT`
+    // times the curved direction's spacing on the surface, so holes do not fan out into
+    // triangles spanning a wide arc.
+    const ASPECT: f64 = 6.0;
+    if du.is_finite() && !dv.is_finite() {
+        dv = du * su / sv * ASPECT;
+    } else if dv.is_finite() && !du.is_finite() {
+        du = dv * sv / su * ASPECT;
+    }
     let nu = if du.is_finite() {
         ((ub.1 - ub.0) / du).ceil().clamp(1.0, 400.0) as usize
     } else {
@@ -882,7 +971,11 @@ fn triangulate(
     // A chord between two points of the same B-rep edge could be drawn by the face on the other
     // side of that edge too, giving four triangles on one segment: split such chords with a
     // point of this face's own until none is left.
+    const MAX_ROUNDS: usize = 10;
+    const MAX_ADDED: usize = 200_000;
+    let planar = matches!(s, Surface::Plane { .. });
     let mut rounds = 0;
+    let mut added = 0usize;
     loop {
         let depth = (constraints_failed == 0).then(|| constraint_depth(&cdt));
         let mut triangles = vec![];
@@ -911,7 +1004,26 @@ fn triangulate(
             if !known {
                 continue;
             }
-            if rounds < 4 {
+            if rounds < MAX_ROUNDS {
+                // Chord error: the flat triangle's centroid against the surface's. Stops two
+                // rounds before chord splitting does, so that has the last word.
+                if !planar && rounds + 2 < MAX_ROUNDS {
+                    let c = [
+                        (loc.uv[t[0] as usize][0] + loc.uv[t[1] as usize][0] + loc.uv[t[2] as usize][0]) / 3.0,
+                        (loc.uv[t[0] as usize][1] + loc.uv[t[1] as usize][1] + loc.uv[t[2] as usize][1]) / 3.0,
+                    ];
+                    let flat = (positions[loc.vertex[t[0] as usize] as usize].coords
+                        + positions[loc.vertex[t[1] as usize] as usize].coords
+                        + positions[loc.vertex[t[2] as usize] as usize].coords)
+                        / 3.0;
+                    let xy = [c[0] * su, c[1] * sv];
+                    if (s.eval(c[0], c[1]).coords - flat).norm() > opts.chord_tol
+                        && added < MAX_ADDED
+                        && !bnd.near(xy, 0.25 * min_edge(&loc, t, su, sv))
+                    {
+                        splits.push(xy);
+                    }
+                }
                 for e in face.adjacent_edges() {
                     if e.is_constraint_edge() {
                         continue;
@@ -937,6 +1049,7 @@ fn triangulate(
         if splits.is_empty() {
             return Ok(FaceTriangulation { face: f, uv: loc.uv, vertex: loc.vertex, triangles });
         }
+        added += splits.len();
         for xy in splits {
             let uv = [xy[0] / su, xy[1] / sv];
             let idx = positions.len() as u32;
@@ -945,6 +1058,17 @@ fn triangulate(
         }
         rounds += 1;
     }
+}
+
+/// The shortest edge of a local triangle, in scaled parameters.
+fn min_edge(loc: &Local, t: [u32; 3], su: f64, sv: f64) -> f64 {
+    (0..3)
+        .map(|k| {
+            let a = loc.uv[t[k] as usize];
+            let b = loc.uv[t[(k + 1) % 3] as usize];
+            ((a[0] - b[0]) * su).hypot((a[1] - b[1]) * sv)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Local vertices of one face's triangulation, keyed by spade's vertex handles.

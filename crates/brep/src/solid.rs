@@ -76,29 +76,54 @@ pub struct SolidReport {
 /// Mesh options for mass properties of a solid of bounding-box diagonal `diag`.
 pub fn analysis_options(diag: f64) -> MeshOptions {
     MeshOptions {
-        chord_tol: (diag * 2e-4).max(1e-4),
+        chord_tol: (diag * 2e-3).max(1e-3),
         angle_tol: 10f64.to_radians(),
+        edge_chord_tol: Some((diag * 1e-4).max(1e-4)),
     }
 }
 
-fn vertex_bbox(brep: &Brep, s: SolidId) -> Aabb {
+/// A bounding box good enough to size tolerances: vertices, a few points of every edge, and
+/// samples of faces that have no edge at all (a whole sphere or torus).
+fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
     let mut b = Aabb::empty();
-    for v in brep.vertices_of(&brep.solid_faces(s)) {
+    let faces = brep.solid_faces(s);
+    for v in brep.vertices_of(&faces) {
         b.add(&brep.vertices[v.idx()].point);
+    }
+    for e in brep.edges_of(&faces) {
+        let edge = brep.edge(e);
+        let c = brep.edge_curve(e);
+        for k in 1..8 {
+            b.add(&c.eval(edge.t_start + (edge.t_end - edge.t_start) * k as f64 / 8.0));
+        }
+    }
+    for f in faces {
+        let face = brep.face(f);
+        if face.loops.iter().all(|l| brep.loops[l.idx()].coedges.is_empty()) {
+            let srf = brep.face_surface(f);
+            let (bu, bv) = srf.bounds();
+            let ur = srf.u_period().map(|p| (0.0, p)).or(bu).unwrap_or((0.0, 1.0));
+            let vr = srf.v_period().map(|p| (0.0, p)).or(bv).unwrap_or((0.0, 1.0));
+            for i in 0..=8 {
+                for j in 0..=8 {
+                    b.add(&srf.eval(ur.0 + (ur.1 - ur.0) * i as f64 / 8.0, vr.0 + (vr.1 - vr.0) * j as f64 / 8.0));
+                }
+            }
+        }
     }
     b
 }
 
 /// Meshes one solid (all its shells) at `opts`, or at analysis precision when `None`.
 pub fn mesh_solid(brep: &Brep, s: SolidId, opts: Option<MeshOptions>) -> Result<Mesh, MeshError> {
-    let opts = opts.unwrap_or_else(|| analysis_options(vertex_bbox(brep, s).diagonal().max(1e-3)));
+    let opts = opts.unwrap_or_else(|| analysis_options(rough_bbox(brep, s).diagonal().max(1e-3)));
     mesh_faces(brep, &brep.solid_faces(s), &opts)
 }
 
 /// Measures and checks one solid.
 pub fn report_solid(brep: &Brep, s: SolidId) -> Result<SolidReport, MeshError> {
     let solid = &brep.solids[s.idx()];
-    let opts = analysis_options(vertex_bbox(brep, s).diagonal().max(1e-3));
+    let opts = analysis_options(rough_bbox(brep, s).diagonal().max(1e-3));
     let mut findings = vec![];
     let mut volume = 0.0;
     let mut area = 0.0;

@@ -175,6 +175,25 @@ impl Brep {
     pub fn face_surface(&self, id: FaceId) -> &Surface {
         &self.surfaces[self.faces[id.idx()].surface.idx()]
     }
+    /// The point of a face's surface at `(u, v)`.
+    pub fn face_point(&self, id: FaceId, u: f64, v: f64) -> P3 {
+        self.face_surface(id).eval(u, v)
+    }
+    /// The first derivatives `(S_u, S_v)` of a face's surface at `(u, v)`.
+    pub fn face_derivs(&self, id: FaceId, u: f64, v: f64) -> (crate::math::V3, crate::math::V3) {
+        self.face_surface(id).derivs(u, v)
+    }
+    /// The unit normal pointing out of the solid at `(u, v)` of a face (its surface's natural
+    /// normal, reversed where the face runs against its surface).
+    pub fn face_normal(&self, id: FaceId, u: f64, v: f64) -> Option<crate::math::V3> {
+        let n = self.face_surface(id).normal(u, v)?;
+        Some(if self.faces[id.idx()].same_sense { n } else { -n })
+    }
+    /// The parameters of the point of a face's surface nearest to `p` (in any period; use
+    /// [`crate::mesh::face_domain`] to ask whether it lies inside the face's trim).
+    pub fn face_project(&self, id: FaceId, p: &P3) -> (f64, f64) {
+        self.face_surface(id).project(p, None)
+    }
     /// The edge.
     pub fn edge(&self, id: EdgeId) -> &Edge {
         &self.edges[id.idx()]
