@@ -59,6 +59,7 @@ fn fixtures_match_reference_figures() {
             continue;
         }
         let mut got_vols = vec![];
+        let mut bbox = brep::math::Aabb::empty();
         let mut area = 0.0;
         let mut faces = 0;
         let mut kinds = std::collections::BTreeMap::<String, usize>::new();
@@ -71,6 +72,8 @@ fn fixtures_match_reference_figures() {
                 }
             };
             got_vols.push(rep.volume);
+            bbox.add(&rep.bbox.min);
+            bbox.add(&rep.bbox.max);
             area += rep.area;
             faces += rep.faces;
             for (k, n) in &rep.surfaces {
@@ -101,6 +104,13 @@ fn fixtures_match_reference_figures() {
         for (g, w) in got_vols.iter().zip(&want_vols) {
             if rel(*g, *w) > 1e-3 {
                 failures.push(format!("{name}: volume {g:.4} vs reference {w:.4} ({:+.4} %)", 100.0 * (g - w) / w));
+            }
+        }
+        let bb = &r["bbox_mm"];
+        for k in 0..3 {
+            let (lo, hi) = (bb[0][k].as_f64().unwrap(), bb[1][k].as_f64().unwrap());
+            if (bbox.min[k] - lo).abs() > 1e-3 || (bbox.max[k] - hi).abs() > 1e-3 {
+                failures.push(format!("{name}: bbox axis {k} [{:.4}, {:.4}] vs reference [{lo}, {hi}]", bbox.min[k], bbox.max[k]));
             }
         }
         let want_area = r["area_mm2"].as_f64().unwrap();
