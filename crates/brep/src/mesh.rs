@@ -11,7 +11,7 @@
 use crate::curve::Curve;
 use crate::math::{Aabb, P3};
 use crate::surface::Surface;
-use crate::topology::{Brep, EdgeId, FaceId};
+use crate::topology::{Brep, EdgeId, FaceId, LoopId};
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use std::collections::HashMap;
 
@@ -74,6 +74,8 @@ pub struct Mesh {
     pub positions: Vec<P3>,
     /// Per-face triangulations.
     pub faces: Vec<FaceTriangulation>,
+    /// The vertex indices along each B-rep edge, from its start vertex to its end vertex.
+    pub edge_points: HashMap<EdgeId, Vec<u32>>,
 }
 
 impl Mesh {
@@ -194,6 +196,7 @@ pub fn mesh_faces(brep: &Brep, faces: &[FaceId], opts: &MeshOptions) -> Result<M
         let ft = mesh_face(brep, f, &edge_pts, &vert_idx, &mut m.positions, opts)?;
         m.faces.push(ft);
     }
+    m.edge_points = edge_pts;
     Ok(m)
 }
 
@@ -236,8 +239,13 @@ impl FaceDomain {
     }
 }
 
-/// The trimmed parameter domain of one face.
-pub fn face_domain(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<FaceDomain, MeshError> {
+/// Vertex positions, vertex indices and edge point indices for one face's boundary.
+#[allow(clippy::type_complexity)]
+fn face_edge_points(
+    brep: &Brep,
+    f: FaceId,
+    opts: &MeshOptions,
+) -> (Vec<P3>, Vec<Option<u32>>, HashMap<EdgeId, Vec<u32>>) {
     let mut positions: Vec<P3> = vec![];
     let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
     let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
@@ -264,6 +272,66 @@ pub fn face_domain(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<FaceDom
             positions.push(brep.vertices[v.idx()].point);
         }
     }
+    (positions, vert_idx, edge_pts)
+}
+
+/// What a loop is to its face.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopRole {
+    /// The boundary enclosing the face.
+    Outer,
+    /// A hole inside the face.
+    Inner,
+    /// A loop winding around a periodic surface (one rim of a band on a cylinder).
+    Wrapping,
+    /// A single vertex (a pole or apex).
+    Vertex,
+}
+
+/// The role of each of a face's loops, found in its parameter domain: loops winding around the
+/// surface are `Wrapping`; of the others, the one enclosing the largest area is `Outer` unless
+/// a wrapping loop or a pole bounds the face, and the rest are `Inner`.
+pub fn loop_roles(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<Vec<(LoopId, LoopRole)>, MeshError> {
+    let (positions, vert_idx, edge_pts) = face_edge_points(brep, f, opts);
+    let (chains, _) = loop_chains(brep, f, &edge_pts, &vert_idx, &positions)?;
+    let face = brep.face(f);
+    let mut out: Vec<(LoopId, LoopRole)> = face
+        .loops
+        .iter()
+        .filter(|l| brep.loops[l.idx()].coedges.is_empty())
+        .map(|&l| (l, LoopRole::Vertex))
+        .collect();
+    let wraps = chains.iter().any(|(_, _, w)| *w != [0, 0]);
+    // A loop with a pole bridge closes through the pole: it is the face's outer boundary.
+    let bridged = |pts: &[Pt]| {
+        let n = pts.len();
+        (0..n).any(|k| pts[k].sing != 0 && pts[k].sing == pts[(k + 1) % n].sing)
+    };
+    let has_vertex_loop = out.iter().any(|(_, r)| *r == LoopRole::Vertex);
+    let mut outer = None;
+    if !wraps && !has_vertex_loop {
+        outer = chains
+            .iter()
+            .filter(|(_, _, w)| *w == [0, 0])
+            .max_by(|a, b| signed_area(&a.1).abs().total_cmp(&signed_area(&b.1).abs()))
+            .map(|(l, _, _)| *l);
+    }
+    for (l, pts, w) in &chains {
+        let role = if *w != [0, 0] {
+            LoopRole::Wrapping
+        } else if Some(*l) == outer || bridged(pts) {
+            LoopRole::Outer
+        } else {
+            LoopRole::Inner
+        };
+        out.push((*l, role));
+    }
+    Ok(out)
+}
+
+/// The trimmed parameter domain of one face.
+pub fn face_domain(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<FaceDomain, MeshError> {
+    let (mut positions, vert_idx, edge_pts) = face_edge_points(brep, f, opts);
     let (polys, _) = face_polygons(brep, f, &edge_pts, &vert_idx, &mut positions, opts)?;
     let s = brep.face_surface(f);
     Ok(FaceDomain {
@@ -371,37 +439,20 @@ fn mesh_face(
     triangulate(brep, f, brep.face_surface(f), polys, &edge_of, positions, opts, sense)
 }
 
-/// The closed polygons bounding a face in its parameter domain, with, for each boundary
-/// point, the B-rep edges it lies on.
+/// Each edge loop of a face taken into the parameter domain and unwrapped, with how many
+/// periods it winds; and the mesh vertices of the face's vertex loops (poles).
 #[allow(clippy::type_complexity)]
-fn face_polygons(
+fn loop_chains(
     brep: &Brep,
     f: FaceId,
     edge_pts: &HashMap<EdgeId, Vec<u32>>,
     vert_idx: &[Option<u32>],
-    positions: &mut Vec<P3>,
-    opts: &MeshOptions,
-) -> Result<(Vec<Vec<Pt>>, HashMap<u32, Vec<u32>>), MeshError> {
+    positions: &[P3],
+) -> Result<(Vec<(LoopId, Vec<Pt>, [i64; 2])>, Vec<u32>), MeshError> {
     let face = brep.face(f);
     let s = brep.face_surface(f);
     let periods = [s.u_period(), s.v_period()];
-    let sense = if face.same_sense { 1.0 } else { -1.0 };
-    // Which B-rep edges each boundary point lies on (vertices: all their edges in this face).
-    let mut edge_of: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &l in &face.loops {
-        for &c in &brep.loops[l.idx()].coedges {
-            let e = brep.coedges[c.idx()].edge;
-            for &i in edge_pts.get(&e).into_iter().flatten() {
-                let v = edge_of.entry(i).or_default();
-                if !v.contains(&e.0) {
-                    v.push(e.0);
-                }
-            }
-        }
-    }
-
-    // 1. Each loop into the parameter domain.
-    let mut loops: Vec<(Vec<Pt>, [i64; 2])> = vec![];
+    let mut loops: Vec<(LoopId, Vec<Pt>, [i64; 2])> = vec![];
     let mut pole_vertices: Vec<u32> = vec![];
     let mut hint: Option<(f64, f64)> = None;
     for &l in &face.loops {
@@ -482,8 +533,45 @@ fn face_polygons(
         if chain.len() < 2 {
             continue;
         }
-        loops.push(unwrap_loop(chain, periods));
+        let (pts, w) = unwrap_loop(chain, periods);
+        loops.push((l, pts, w));
     }
+
+    Ok((loops, pole_vertices))
+}
+
+/// The closed polygons bounding a face in its parameter domain, with, for each boundary
+/// point, the B-rep edges it lies on.
+#[allow(clippy::type_complexity)]
+fn face_polygons(
+    brep: &Brep,
+    f: FaceId,
+    edge_pts: &HashMap<EdgeId, Vec<u32>>,
+    vert_idx: &[Option<u32>],
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Result<(Vec<Vec<Pt>>, HashMap<u32, Vec<u32>>), MeshError> {
+    let face = brep.face(f);
+    let s = brep.face_surface(f);
+    let periods = [s.u_period(), s.v_period()];
+    let sense = if face.same_sense { 1.0 } else { -1.0 };
+    // Which B-rep edges each boundary point lies on (vertices: all their edges in this face).
+    let mut edge_of: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &l in &face.loops {
+        for &c in &brep.loops[l.idx()].coedges {
+            let e = brep.coedges[c.idx()].edge;
+            for &i in edge_pts.get(&e).into_iter().flatten() {
+                let v = edge_of.entry(i).or_default();
+                if !v.contains(&e.0) {
+                    v.push(e.0);
+                }
+            }
+        }
+    }
+
+    // 1. Each loop into the parameter domain.
+    let (chains, pole_vertices) = loop_chains(brep, f, edge_pts, vert_idx, positions)?;
+    let loops: Vec<(Vec<Pt>, [i64; 2])> = chains.into_iter().map(|(_, p, w)| (p, w)).collect();
 
     // 2. Pair or close loops that wrap around a periodic direction.
     let mut polys: Vec<Vec<Pt>> = vec![];
