@@ -130,7 +130,7 @@ impl Curve {
             Curve::Hyperbola { frame, a, b } => frame.at(a * t.cosh(), b * t.sinh(), 0.0),
             Curve::Parabola { frame, focal } => frame.at(focal * t * t, 2.0 * focal * t, 0.0),
             Curve::Nurbs(n) => {
-                let [p, _, _] = n.local.ders(t.clamp(n.t0, n.t1));
+                let [p, _, _] = n.local.ders_upto(t.clamp(n.t0, n.t1), 0);
                 P3::new(p[0], p[1], p[2])
             }
             Curve::Polyline(pts) => {
@@ -150,7 +150,7 @@ impl Curve {
             Curve::Hyperbola { frame, a, b } => frame.vec(a * t.sinh(), b * t.cosh(), 0.0),
             Curve::Parabola { frame, focal } => frame.vec(2.0 * focal * t, 2.0 * focal, 0.0),
             Curve::Nurbs(n) => {
-                let [_, d, _] = n.local.ders(t.clamp(n.t0, n.t1));
+                let [_, d, _] = n.local.ders_upto(t.clamp(n.t0, n.t1), 1);
                 V3::new(d[0], d[1], d[2])
             }
             Curve::Polyline(pts) => {

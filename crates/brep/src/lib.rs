@@ -23,6 +23,7 @@ pub mod step;
 pub mod surface;
 pub mod topology;
 pub mod validate;
+pub mod write;
 
 pub use error::ReadError;
 pub use solid::{read_step, read_step_bytes, SolidReport, StepPart};

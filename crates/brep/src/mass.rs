@@ -72,6 +72,37 @@ const GAUSS7: [([f64; 3], f64); 7] = [
     ),
 ];
 
+/// Each face's share of the divergence integrals about `origin`: `(face, signed volume, area)`.
+/// Shares about one origin add up, so the volume of any closed set of faces is the sum of its
+/// faces' shares, however the faces were meshed.
+pub fn face_shares(brep: &Brep, mesh: &Mesh, origin: &P3) -> Vec<(crate::topology::FaceId, f64, f64)> {
+    let mut out = vec![];
+    for ft in &mesh.faces {
+        let s = brep.face_surface(ft.face);
+        let (mut vol, mut area) = (0.0, 0.0);
+        for t in &ft.triangles {
+            let a = ft.uv[t[0] as usize];
+            let b = ft.uv[t[1] as usize];
+            let d = ft.uv[t[2] as usize];
+            let det = 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]));
+            if det == 0.0 {
+                continue;
+            }
+            for (w, wt) in GAUSS7.iter() {
+                let u = w[0] * a[0] + w[1] * b[0] + w[2] * d[0];
+                let v = w[0] * a[1] + w[1] * b[1] + w[2] * d[1];
+                let p = s.eval(u, v) - origin;
+                let (su, sv) = s.derivs(u, v);
+                let n = su.cross(&sv);
+                vol += wt * det * p.dot(&n) / 3.0;
+                area += wt * det.abs() * n.norm();
+            }
+        }
+        out.push((ft.face, vol, area));
+    }
+    out
+}
+
 /// Integrates the faces of `mesh` (all of them) over their exact surfaces.
 pub fn mass_properties(brep: &Brep, mesh: &Mesh) -> MassProperties {
     let bbox = exact_bbox(brep, mesh);

@@ -130,14 +130,19 @@ pub struct LocalCurve {
 impl LocalCurve {
     /// Point and first two derivatives at `t`.
     pub fn ders(&self, t: f64) -> [[f64; 3]; 3] {
+        self.ders_upto(t, 2)
+    }
+
+    /// Point and derivatives up to order `nd` (≤ 2) at `t`; higher orders come back zero.
+    pub fn ders_upto(&self, t: f64, nd: usize) -> [[f64; 3]; 3] {
         let p = self.degree;
         let n = self.cps.len();
         let span = find_span(&self.knots, p, n, t);
-        let b = basis_ders(&self.knots, span, t, p, 2);
+        let b = basis_ders(&self.knots, span, t, p, nd);
         let mut h = [[0.0f64; 4]; 3];
         for j in 0..=p {
             let c = &self.cps[span - p + j];
-            for k in 0..3 {
+            for k in 0..=nd.min(2) {
                 for (d, hk) in h[k].iter_mut().enumerate() {
                     *hk += b[k][j] * c[d];
                 }

@@ -84,7 +84,7 @@ pub fn analysis_options(diag: f64) -> MeshOptions {
 
 /// A bounding box good enough to size tolerances: vertices, a few points of every edge, and
 /// samples of faces that have no edge at all (a whole sphere or torus).
-fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
+pub fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
     let mut b = Aabb::empty();
     let faces = brep.solid_faces(s);
     for v in brep.vertices_of(&faces) {

@@ -3,6 +3,7 @@
 //! Every failure is reported as exactly one line on stderr, `features: <path>: <cause>`, with
 //! exit code 2. A panic (a bug) is caught and reported the same way with exit code 3.
 
+mod extract;
 mod inspect;
 mod mesh;
 
@@ -18,7 +19,8 @@ use std::process::ExitCode;
     name = "features",
     version,
     after_help = "Examples:\n  features inspect part.step\n  features inspect part.step --json\n  \
-                  features mesh part.step -o part.stl --tolerance 0.02\n\n\
+                  features mesh part.step -o part.stl --tolerance 0.02\n  \
+                  features extract part.step --json --export features/\n\n\
                   Errors are one line on stderr, `features: <file>: <cause>`, exit code 2."
 )]
 struct Cli {
@@ -32,6 +34,25 @@ enum Command {
     Inspect(InspectArgs),
     /// Triangulate every solid of a STEP file into one STL or OBJ file.
     Mesh(MeshArgs),
+    /// Recognise the AM features a part is built from: concave loops, splitting, dependency order.
+    Extract(ExtractArgs),
+}
+
+/// Arguments of `features extract`.
+#[derive(Debug, Args)]
+pub struct ExtractArgs {
+    /// STEP file to read.
+    #[arg(value_name = "PART.step")]
+    pub part: PathBuf,
+    /// Print the feature tree as one JSON object (schema `features.extract/1`) [default: text].
+    #[arg(long)]
+    pub json: bool,
+    /// Write each feature as its own closed solid, `feature_<id>.step` and `.stl`, into DIR
+    ///
+    /// The directory is created if missing. Each file is written under a temporary name and
+    /// renamed on success.
+    #[arg(long, value_name = "DIR")]
+    pub export: Option<PathBuf>,
 }
 
 /// Arguments of `features inspect`.
@@ -130,6 +151,7 @@ fn run(cmd: &Command) -> Result<(), Failure> {
     match cmd {
         Command::Inspect(a) => inspect::run(a),
         Command::Mesh(a) => mesh::run(a),
+        Command::Extract(a) => extract::run(a),
     }
 }
 
@@ -148,6 +170,7 @@ fn main() -> ExitCode {
     let path = match &cli.command {
         Command::Inspect(a) => a.part.display().to_string(),
         Command::Mesh(a) => a.part.display().to_string(),
+        Command::Extract(a) => a.part.display().to_string(),
     };
     // The panic is reported below, on one line; the default hook would add a second.
     panic::set_hook(Box::new(|_| {}));

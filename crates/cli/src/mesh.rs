@@ -27,14 +27,14 @@ impl Format {
 }
 
 /// One solid's triangles over its own compact vertex list (only vertices that triangles use).
-struct SolidMesh {
+pub(crate) struct SolidMesh {
     step_id: u64,
     positions: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
+    pub(crate) triangles: Vec<[u32; 3]>,
     watertight: bool,
 }
 
-fn solid_mesh(step_id: u64, mesh: &brep::mesh::Mesh) -> SolidMesh {
+pub(crate) fn solid_mesh(step_id: u64, mesh: &brep::mesh::Mesh) -> SolidMesh {
     let (open, bad) = mesh.open_edges();
     let mut remap = vec![u32::MAX; mesh.positions.len()];
     let mut positions = vec![];
@@ -62,13 +62,13 @@ fn solid_mesh(step_id: u64, mesh: &brep::mesh::Mesh) -> SolidMesh {
 
 /// A file being written under a temporary name beside its destination. Removed when dropped
 /// (failure or panic) unless [`TempFile::persist`] renamed it into place.
-struct TempFile {
+pub(crate) struct TempFile {
     tmp: PathBuf,
     done: bool,
 }
 
 impl TempFile {
-    fn create(dest: &Path) -> std::io::Result<(TempFile, File)> {
+    pub(crate) fn create(dest: &Path) -> std::io::Result<(TempFile, File)> {
         let name = dest
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -81,7 +81,7 @@ impl TempFile {
         Ok((TempFile { tmp, done: false }, file))
     }
 
-    fn persist(mut self, dest: &Path) -> std::io::Result<()> {
+    pub(crate) fn persist(mut self, dest: &Path) -> std::io::Result<()> {
         std::fs::rename(&self.tmp, dest)?;
         self.done = true;
         Ok(())
@@ -153,7 +153,7 @@ pub fn run(args: &MeshArgs) -> Result<(), Failure> {
 
 /// Binary STL: 80-byte header naming the source, triangle count, then per triangle the unit
 /// normal (from the vertices, right-handed) and the three vertices as little-endian `f32`.
-fn write_stl(
+pub(crate) fn write_stl(
     w: &mut impl Write,
     source: &str,
     solids: &[SolidMesh],

@@ -1,0 +1,169 @@
+//! `features extract`: the AM feature tree of every solid in a file.
+
+use crate::mesh::{solid_mesh, write_stl, TempFile};
+use crate::{emit, ExtractArgs, Failure};
+use features::{extract, ExtractOptions, FeatureTree};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+/// One solid's tree with the id offset of its features in the file-wide numbering.
+struct Solid {
+    tree: FeatureTree,
+    offset: usize,
+}
+
+/// Runs the command.
+pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
+    let path = &args.part;
+    let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    let mut solids = vec![];
+    let mut offset = 0;
+    for s in part.brep.solid_ids() {
+        let tree = extract(&part.brep, s, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
+        let n = tree.features.len();
+        solids.push(Solid { tree, offset });
+        offset += n;
+    }
+    if let Some(dir) = &args.export {
+        export(dir, &solids).map_err(|e| Failure::new(dir, e))?;
+    }
+    let source = path.display().to_string();
+    let text = if args.json {
+        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids)).map_err(|e| Failure::new(path, e))?;
+        t.push('\n');
+        t
+    } else {
+        to_text(&source, &solids)
+    };
+    emit(&text)
+}
+
+fn round(x: f64, scale: f64) -> f64 {
+    (x * scale).round() / scale + 0.0
+}
+
+fn to_json(source: &str, solids: &[Solid]) -> Value {
+    let volume: f64 = solids.iter().map(|s| s.tree.part_volume).sum();
+    let area: f64 = solids.iter().map(|s| s.tree.part_area).sum();
+    let faces: usize = solids.iter().map(|s| s.tree.part_faces).sum();
+    let genus: Option<i64> = solids.iter().map(|s| s.tree.genus).sum();
+    let mut features = vec![];
+    let mut order = vec![];
+    let mut warnings = vec![];
+    for s in solids {
+        let t = &s.tree;
+        for f in &t.features {
+            let r = &f.reference;
+            features.push(json!({
+                "id": s.offset + f.id,
+                "kind": f.kind.as_str(),
+                "subtype": f.subtype,
+                "reference": {
+                    "surface": r.surface,
+                    "step_face": r.step_face,
+                    "normal": r.normal.map(|n| n.map(|x| round(x, 1e6))),
+                },
+                "parents": f.parents.iter().map(|p| s.offset + p).collect::<Vec<_>>(),
+                "volume_mm3": round(f.volume, 1e3),
+                "faces": f.step_faces(&t.brep),
+                "root_loops": f.root_loops,
+            }));
+        }
+        order.extend(t.build_order.iter().map(|k| s.offset + k));
+        let prefix = if solids.len() > 1 { format!("solid #{}: ", t.brep.solids[t.solid.idx()].step_id) } else { String::new() };
+        warnings.extend(t.warnings.iter().map(|w| format!("{prefix}{w}")));
+    }
+    json!({
+        "schema": "features.extract/1",
+        "source": source,
+        "units": "mm",
+        "part": {"volume_mm3": round(volume, 1e3), "area_mm2": round(area, 1e3), "faces": faces, "genus": genus},
+        "features": features,
+        "build_order": order,
+        "depth": solids.iter().map(|s| s.tree.depth).max().unwrap_or(0),
+        "warnings": warnings,
+    })
+}
+
+fn to_text(source: &str, solids: &[Solid]) -> String {
+    let mut out = String::new();
+    for s in solids {
+        let t = &s.tree;
+        let _ = writeln!(
+            out,
+            "{source}{}: {} feature(s), depth {}, part {:.3} mm^3",
+            if solids.len() > 1 { format!(" solid #{}", t.brep.solids[t.solid.idx()].step_id) } else { String::new() },
+            t.features.len(),
+            t.depth,
+            t.part_volume
+        );
+        // Children under their parents, in build order.
+        fn walk(out: &mut String, t: &FeatureTree, offset: usize, k: usize, indent: usize) {
+            let f = &t.features[k];
+            let r = &f.reference;
+            let on = match (r.surface.as_str(), r.step_face) {
+                ("build_plate", Some(id)) => format!("on the build plate (face #{id})"),
+                ("build_plate", None) => "on the build plate".to_string(),
+                (kind, Some(id)) => format!("on {kind} face #{id}"),
+                (kind, None) => format!("on {kind}"),
+            };
+            let _ = writeln!(
+                out,
+                "{}{}feature {}  {} {}  {}  {:.3} mm^3{}",
+                "   ".repeat(indent.saturating_sub(1)),
+                if indent > 0 { "└─ " } else { "" },
+                offset + f.id,
+                f.kind.as_str(),
+                f.subtype,
+                on,
+                f.volume,
+                if f.root_loops > 1 { format!("  ({} root loops)", f.root_loops) } else { String::new() }
+            );
+            for c in t.build_order.iter().filter(|&&c| t.features[c].parents.first() == Some(&k)) {
+                walk(out, t, offset, *c, indent + 1);
+            }
+        }
+        for &k in t.build_order.iter().filter(|&&k| t.features[k].parents.is_empty()) {
+            walk(&mut out, t, s.offset, k, 0);
+        }
+        for w in &t.warnings {
+            let _ = writeln!(out, "warning: {w}");
+        }
+    }
+    out
+}
+
+fn export(dir: &Path, solids: &[Solid]) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    for s in solids {
+        let t = &s.tree;
+        for f in &t.features {
+            let id = s.offset + f.id;
+            let name = format!("feature_{id}");
+            let step = brep::write::write_step_shells(&t.brep, &[(f.faces.clone(), f.voids.clone())], &name);
+            write_atomic(&dir.join(format!("{name}.step")), |w| w.write_all(step.as_bytes()))?;
+            let mut faces = f.faces.clone();
+            for v in &f.voids {
+                faces.extend(v.iter().copied());
+            }
+            let mesh = brep::mesh::mesh_faces(&t.brep, &faces, &brep::mesh::MeshOptions::default())
+                .map_err(|e| std::io::Error::other(e.to_string()))?;
+            let sm = solid_mesh(0, &mesh);
+            let n = sm.triangles.len() as u32;
+            write_atomic(&dir.join(format!("{name}.stl")), |w| write_stl(w, &name, std::slice::from_ref(&sm), n))?;
+        }
+    }
+    Ok(())
+}
+
+fn write_atomic(dest: &Path, body: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>) -> std::io::Result<()> {
+    let (tmp, file) = TempFile::create(dest)?;
+    let mut w = std::io::BufWriter::new(file);
+    body(&mut w)?;
+    w.flush()?;
+    w.get_ref().sync_all()?;
+    drop(w);
+    tmp.persist(dest)
+}
