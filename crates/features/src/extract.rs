@@ -325,7 +325,8 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
         });
     }
 
-    // Order and depth.
+    // Order and depth: parents first, and among features ready together the lowest id first
+    // (Kahn's algorithm), so the order reads like the tree.
     let mut g = DiGraph::<usize, ()>::new();
     let nodes: Vec<_> = (0..features.len()).map(|k| g.add_node(k)).collect();
     for f in &features {
@@ -333,13 +334,24 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
             g.add_edge(nodes[p], nodes[f.id], ());
         }
     }
-    let build_order: Vec<usize> = match petgraph::algo::toposort(&g, None) {
-        Ok(o) => o.into_iter().map(|n| g[n]).collect(),
-        Err(_) => {
-            warnings.push("feature dependencies form a cycle; listed in extraction order".into());
-            (0..features.len()).collect()
+    let mut indegree: Vec<usize> = nodes.iter().map(|&n| g.neighbors_directed(n, petgraph::Direction::Incoming).count()).collect();
+    let mut ready: std::collections::BinaryHeap<std::cmp::Reverse<usize>> =
+        (0..features.len()).filter(|&k| indegree[k] == 0).map(std::cmp::Reverse).collect();
+    let mut build_order = vec![];
+    while let Some(std::cmp::Reverse(k)) = ready.pop() {
+        build_order.push(k);
+        for c in g.neighbors_directed(nodes[k], petgraph::Direction::Outgoing) {
+            let c = g[c];
+            indegree[c] -= 1;
+            if indegree[c] == 0 {
+                ready.push(std::cmp::Reverse(c));
+            }
         }
-    };
+    }
+    if build_order.len() != features.len() {
+        warnings.push("feature dependencies form a cycle; listed in extraction order".into());
+        build_order = (0..features.len()).collect();
+    }
     for &k in &build_order {
         let d = features[k].parents.iter().map(|&p| features[p].depth + 1).max().unwrap_or(0);
         features[k].depth = d;
