@@ -89,7 +89,7 @@ impl NurbsData {
         let degree = curve.degree();
         let n = kv.len();
         let t0 = kv[degree.min(n - 1)];
-        let t1 = kv[(n - 1 - degree.min(n - 1)).max(0)];
+        let t1 = kv[n - 1 - degree.min(n - 1)];
         let mut spans = 0;
         for i in degree..n.saturating_sub(degree + 1) {
             if kv[i + 1] > kv[i] {

@@ -10,6 +10,9 @@
 //! }
 //! ```
 #![warn(missing_docs)]
+// Numerical kernels (basis functions, grids) index several arrays in lockstep; index loops
+// read more plainly there than zipped iterators.
+#![allow(clippy::needless_range_loop)]
 
 pub mod curve;
 pub mod error;

@@ -918,6 +918,7 @@ fn grid_steps(s: &Surface, ub: (f64, f64), vb: (f64, f64), opts: &MeshOptions) -
     (du, dv)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn triangulate(
     brep: &Brep,
     f: FaceId,

@@ -944,7 +944,7 @@ impl<'a> Translator<'a> {
             .iter()
             .map(|p| as_real(p).ok_or_else(|| self.bad(id, "knot is not a number")))
             .collect::<R<_>>()?;
-        if mults.len() != knots.len() || mults.iter().any(|&m| m < 1 || m > 64) {
+        if mults.len() != knots.len() || mults.iter().any(|&m| !(1..=64).contains(&m)) {
             return Err(self.bad(
                 id,
                 format!(
@@ -958,7 +958,7 @@ impl<'a> Translator<'a> {
         if total as usize != n_ctrl + degree + 1 {
             return Err(self.bad(id, format!("knot multiplicities sum to {total}, expected {} control points + degree {} + 1", n_ctrl, degree)));
         }
-        if knots.windows(2).any(|w| !(w[0] < w[1])) || knots.iter().any(|k| !k.is_finite()) {
+        if knots.windows(2).any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less)) || knots.iter().any(|k| !k.is_finite()) {
             return Err(self.bad(id, "knots are not strictly increasing"));
         }
         tg::KnotVec::from_single_multi(knots, mults.iter().map(|&m| m as usize).collect())
@@ -1074,9 +1074,9 @@ impl<'a> Translator<'a> {
             let frame = self.placement(self.reference(id, r, 1)?, id)?;
             let radius = self.real(id, r, 2)? * self.mm;
             let semi_angle = self.real(id, r, 3)? * self.rad;
-            if !(radius.is_finite() && radius >= 0.0)
-                || !(semi_angle.abs() < std::f64::consts::FRAC_PI_2 && semi_angle != 0.0)
-            {
+            let radius_ok = radius.is_finite() && radius >= 0.0;
+            let angle_ok = semi_angle.abs() < std::f64::consts::FRAC_PI_2 && semi_angle != 0.0;
+            if !radius_ok || !angle_ok {
                 return Err(self.bad(
                     id,
                     format!("cone radius {radius} / semi-angle {semi_angle} rad out of range"),

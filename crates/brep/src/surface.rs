@@ -6,6 +6,9 @@ use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
 use truck_geometry::prelude as tg;
 
+/// A closed parameter interval `(first, last)`.
+pub type Range = (f64, f64);
+
 /// A rational B-spline surface (truck's homogeneous representation).
 pub type NurbsSurface = tg::NurbsSurface<tg::Vector4>;
 
@@ -427,7 +430,7 @@ impl Surface {
 
     /// The finite parameter bounds of the surface, per direction (`None` where unbounded or
     /// periodic).
-    pub fn bounds(&self) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+    pub fn bounds(&self) -> (Option<Range>, Option<Range>) {
         match self {
             Surface::Sphere { .. } => (None, Some((-FRAC_PI_2, FRAC_PI_2))),
             Surface::Revolution(r) => {
@@ -729,7 +732,6 @@ impl Surface {
 mod tests {
     use super::*;
     use crate::curve::{p3, v3};
-    use truck_geometry::prelude::ParametricSurface;
 
     #[test]
     fn local_evaluation_agrees_with_truck() {
