@@ -710,6 +710,16 @@ impl<'a> Translator<'a> {
         let off = (cv.eval(t_start) - ps)
             .norm()
             .max((cv.eval(t_end) - pe).norm());
+        // Far off (not modelling tolerance but a broken edge, e.g. a circle whose radius does
+        // not match its vertices): refuse rather than mesh a curve that is not the edge.
+        let limit = 1.0 + 1e-6 * ps.coords.norm().max(pe.coords.norm());
+        if !(off <= limit) {
+            return Err(ReadError::Entity {
+                id,
+                entity: "EDGE_CURVE".into(),
+                msg: format!("its vertices lie {off:.3} mm off its curve #{g}"),
+            });
+        }
         if off > 1e-2 {
             self.off_curve.0 += 1;
             if off > self.off_curve.1 {
