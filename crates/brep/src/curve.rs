@@ -100,7 +100,11 @@ impl NurbsData {
             local: crate::nurbs::LocalCurve {
                 knots: curve.knot_vec().to_vec(),
                 degree,
-                cps: curve.control_points().iter().map(|c| [c.x, c.y, c.z, c.w]).collect(),
+                cps: curve
+                    .control_points()
+                    .iter()
+                    .map(|c| [c.x, c.y, c.z, c.w])
+                    .collect(),
             },
             curve,
             t0,

@@ -72,35 +72,50 @@ const GAUSS7: [([f64; 3], f64); 7] = [
     ),
 ];
 
+/// The divergence integrals of one face about `origin`: signed volume share, area, and the
+/// first-moment share `∫ x_i² n_i / 2` (7-point Gauss rule on each parameter triangle, the
+/// exact surface and its natural normal; the signed triangle area carries the face's sense).
+fn face_integrals(brep: &Brep, ft: &crate::mesh::FaceTriangulation, origin: &P3) -> (f64, f64, V3) {
+    let s = brep.face_surface(ft.face);
+    let (mut vol, mut area, mut first) = (0.0, 0.0, V3::zeros());
+    for t in &ft.triangles {
+        let a = ft.uv[t[0] as usize];
+        let b = ft.uv[t[1] as usize];
+        let d = ft.uv[t[2] as usize];
+        // Signed parameter-space area: negative where the face runs against the surface.
+        let det = 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]));
+        if det == 0.0 {
+            continue;
+        }
+        for (w, wt) in GAUSS7.iter() {
+            let u = w[0] * a[0] + w[1] * b[0] + w[2] * d[0];
+            let v = w[0] * a[1] + w[1] * b[1] + w[2] * d[1];
+            let p = s.eval(u, v) - origin;
+            let (su, sv) = s.derivs(u, v);
+            let n = su.cross(&sv);
+            vol += wt * det * p.dot(&n) / 3.0;
+            area += wt * det.abs() * n.norm();
+            first += wt * det * V3::new(p.x * p.x * n.x, p.y * p.y * n.y, p.z * p.z * n.z) * 0.5;
+        }
+    }
+    (vol, area, first)
+}
+
 /// Each face's share of the divergence integrals about `origin`: `(face, signed volume, area)`.
 /// Shares about one origin add up, so the volume of any closed set of faces is the sum of its
 /// faces' shares, however the faces were meshed.
-pub fn face_shares(brep: &Brep, mesh: &Mesh, origin: &P3) -> Vec<(crate::topology::FaceId, f64, f64)> {
-    let mut out = vec![];
-    for ft in &mesh.faces {
-        let s = brep.face_surface(ft.face);
-        let (mut vol, mut area) = (0.0, 0.0);
-        for t in &ft.triangles {
-            let a = ft.uv[t[0] as usize];
-            let b = ft.uv[t[1] as usize];
-            let d = ft.uv[t[2] as usize];
-            let det = 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]));
-            if det == 0.0 {
-                continue;
-            }
-            for (w, wt) in GAUSS7.iter() {
-                let u = w[0] * a[0] + w[1] * b[0] + w[2] * d[0];
-                let v = w[0] * a[1] + w[1] * b[1] + w[2] * d[1];
-                let p = s.eval(u, v) - origin;
-                let (su, sv) = s.derivs(u, v);
-                let n = su.cross(&sv);
-                vol += wt * det * p.dot(&n) / 3.0;
-                area += wt * det.abs() * n.norm();
-            }
-        }
-        out.push((ft.face, vol, area));
-    }
-    out
+pub fn face_shares(
+    brep: &Brep,
+    mesh: &Mesh,
+    origin: &P3,
+) -> Vec<(crate::topology::FaceId, f64, f64)> {
+    mesh.faces
+        .iter()
+        .map(|ft| {
+            let (v, a, _) = face_integrals(brep, ft, origin);
+            (ft.face, v, a)
+        })
+        .collect()
 }
 
 /// Integrates the faces of `mesh` (all of them) over their exact surfaces.
@@ -111,32 +126,12 @@ pub fn mass_properties(brep: &Brep, mesh: &Mesh) -> MassProperties {
     } else {
         nalgebra::center(&bbox.min, &bbox.max)
     };
-    let mut vol = 0.0;
-    let mut area = 0.0;
-    let mut first = V3::zeros();
+    let (mut vol, mut area, mut first) = (0.0, 0.0, V3::zeros());
     for ft in &mesh.faces {
-        let s = brep.face_surface(ft.face);
-        for t in &ft.triangles {
-            let a = ft.uv[t[0] as usize];
-            let b = ft.uv[t[1] as usize];
-            let d = ft.uv[t[2] as usize];
-            // Signed parameter-space area: negative where the face runs against the surface.
-            let det = 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]));
-            if det == 0.0 {
-                continue;
-            }
-            for (w, wt) in GAUSS7.iter() {
-                let u = w[0] * a[0] + w[1] * b[0] + w[2] * d[0];
-                let v = w[0] * a[1] + w[1] * b[1] + w[2] * d[1];
-                let p = s.eval(u, v) - c;
-                let (su, sv) = s.derivs(u, v);
-                let n = su.cross(&sv);
-                vol += wt * det * p.dot(&n) / 3.0;
-                area += wt * det.abs() * n.norm();
-                first +=
-                    wt * det * V3::new(p.x * p.x * n.x, p.y * p.y * n.y, p.z * p.z * n.z) * 0.5;
-            }
-        }
+        let (v, a, m) = face_integrals(brep, ft, &c);
+        vol += v;
+        area += a;
+        first += m;
     }
     let centroid = if vol.abs() > 0.0 { c + first / vol } else { c };
     MassProperties {
@@ -155,7 +150,8 @@ pub fn exact_bbox(brep: &Brep, mesh: &Mesh) -> Aabb {
     if bbox.is_empty() {
         return bbox;
     }
-    let near = |p: &P3, b: &Aabb, tol: f64| (0..3).any(|k| p[k] - b.min[k] < tol || b.max[k] - p[k] < tol);
+    let near =
+        |p: &P3, b: &Aabb, tol: f64| (0..3).any(|k| p[k] - b.min[k] < tol || b.max[k] - p[k] < tol);
     // Candidate parameter triangles, refined level by level.
     let mut tol = 1e-3 * bbox.diagonal();
     let mut cands: Vec<(usize, [[f64; 2]; 3])> = vec![];
@@ -175,7 +171,10 @@ pub fn exact_bbox(brep: &Brep, mesh: &Mesh) -> Aabb {
             let at = |a: usize, b: usize| {
                 let (fa, fb) = (a as f64 / n as f64, b as f64 / n as f64);
                 let fc = 1.0 - fa - fb;
-                [fc * tri[0][0] + fa * tri[1][0] + fb * tri[2][0], fc * tri[0][1] + fa * tri[1][1] + fb * tri[2][1]]
+                [
+                    fc * tri[0][0] + fa * tri[1][0] + fb * tri[2][0],
+                    fc * tri[0][1] + fa * tri[1][1] + fb * tri[2][1],
+                ]
             };
             for a in 0..=n {
                 for b in 0..=(n - a) {

@@ -30,7 +30,11 @@ pub struct MeshOptions {
 impl MeshOptions {
     /// A chord tolerance with a 15° angular limit.
     pub fn with_tolerance(chord_tol: f64) -> Self {
-        MeshOptions { chord_tol, angle_tol: 15f64.to_radians(), edge_chord_tol: None }
+        MeshOptions {
+            chord_tol,
+            angle_tol: 15f64.to_radians(),
+            edge_chord_tol: None,
+        }
     }
 }
 
@@ -163,35 +167,11 @@ struct Pt {
 
 /// Meshes the given faces. Faces sharing an edge share its vertices.
 pub fn mesh_faces(brep: &Brep, faces: &[FaceId], opts: &MeshOptions) -> Result<Mesh, MeshError> {
-    let mut m = Mesh::default();
-    let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
-    let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
-    for e in brep.edges_of(faces) {
-        let edge = brep.edge(e);
-        let mut ids = vec![];
-        for v in [edge.start, edge.end] {
-            if vert_idx[v.idx()].is_none() {
-                vert_idx[v.idx()] = Some(m.positions.len() as u32);
-                m.positions.push(brep.vertices[v.idx()].point);
-            }
-        }
-        let (Some(s), Some(t)) = (vert_idx[edge.start.idx()], vert_idx[edge.end.idx()]) else {
-            continue;
-        };
-        ids.push(s);
-        for p in discretize_edge(brep.edge_curve(e), edge.t_start, edge.t_end, opts) {
-            ids.push(m.positions.len() as u32);
-            m.positions.push(p);
-        }
-        ids.push(t);
-        edge_pts.insert(e, ids);
-    }
-    for v in brep.vertices_of(faces) {
-        if vert_idx[v.idx()].is_none() {
-            vert_idx[v.idx()] = Some(m.positions.len() as u32);
-            m.positions.push(brep.vertices[v.idx()].point);
-        }
-    }
+    let (positions, vert_idx, edge_pts) = face_edge_points(brep, faces, opts);
+    let mut m = Mesh {
+        positions,
+        ..Default::default()
+    };
     for &f in faces {
         let ft = mesh_face(brep, f, &edge_pts, &vert_idx, &mut m.positions, opts)?;
         m.faces.push(ft);
@@ -213,10 +193,19 @@ pub struct FaceDomain {
 impl FaceDomain {
     /// Whether `(u, v)` (in any period) lies in the face.
     pub fn contains(&self, uv: [f64; 2]) -> bool {
-        let ks = |p: Option<f64>| if p.is_some() { vec![0.0, -1.0, 1.0, -2.0, 2.0] } else { vec![0.0] };
+        let ks = |p: Option<f64>| {
+            if p.is_some() {
+                vec![0.0, -1.0, 1.0, -2.0, 2.0]
+            } else {
+                vec![0.0]
+            }
+        };
         for a in ks(self.periods[0]) {
             for b in ks(self.periods[1]) {
-                let q = [uv[0] + a * self.periods[0].unwrap_or(0.0), uv[1] + b * self.periods[1].unwrap_or(0.0)];
+                let q = [
+                    uv[0] + a * self.periods[0].unwrap_or(0.0),
+                    uv[1] + b * self.periods[1].unwrap_or(0.0),
+                ];
                 let mut inside = false;
                 for l in &self.loops {
                     let n = l.len();
@@ -243,13 +232,13 @@ impl FaceDomain {
 #[allow(clippy::type_complexity)]
 fn face_edge_points(
     brep: &Brep,
-    f: FaceId,
+    faces: &[FaceId],
     opts: &MeshOptions,
 ) -> (Vec<P3>, Vec<Option<u32>>, HashMap<EdgeId, Vec<u32>>) {
     let mut positions: Vec<P3> = vec![];
     let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
     let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
-    for e in brep.edges_of(&[f]) {
+    for e in brep.edges_of(faces) {
         let edge = brep.edge(e);
         for v in [edge.start, edge.end] {
             if vert_idx[v.idx()].is_none() {
@@ -257,7 +246,9 @@ fn face_edge_points(
                 positions.push(brep.vertices[v.idx()].point);
             }
         }
-        let (Some(s), Some(t)) = (vert_idx[edge.start.idx()], vert_idx[edge.end.idx()]) else { continue };
+        let (Some(s), Some(t)) = (vert_idx[edge.start.idx()], vert_idx[edge.end.idx()]) else {
+            continue;
+        };
         let mut ids = vec![s];
         for p in discretize_edge(brep.edge_curve(e), edge.t_start, edge.t_end, opts) {
             ids.push(positions.len() as u32);
@@ -266,7 +257,7 @@ fn face_edge_points(
         ids.push(t);
         edge_pts.insert(e, ids);
     }
-    for v in brep.vertices_of(&[f]) {
+    for v in brep.vertices_of(faces) {
         if vert_idx[v.idx()].is_none() {
             vert_idx[v.idx()] = Some(positions.len() as u32);
             positions.push(brep.vertices[v.idx()].point);
@@ -291,8 +282,12 @@ pub enum LoopRole {
 /// The role of each of a face's loops, found in its parameter domain: loops winding around the
 /// surface are `Wrapping`; of the others, the one enclosing the largest area is `Outer` unless
 /// a wrapping loop or a pole bounds the face, and the rest are `Inner`.
-pub fn loop_roles(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<Vec<(LoopId, LoopRole)>, MeshError> {
-    let (positions, vert_idx, edge_pts) = face_edge_points(brep, f, opts);
+pub fn loop_roles(
+    brep: &Brep,
+    f: FaceId,
+    opts: &MeshOptions,
+) -> Result<Vec<(LoopId, LoopRole)>, MeshError> {
+    let (positions, vert_idx, edge_pts) = face_edge_points(brep, &[f], opts);
     let (chains, _) = loop_chains(brep, f, &edge_pts, &vert_idx, &positions)?;
     let face = brep.face(f);
     let mut out: Vec<(LoopId, LoopRole)> = face
@@ -331,18 +326,24 @@ pub fn loop_roles(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<Vec<(Loo
 
 /// The trimmed parameter domain of one face.
 pub fn face_domain(brep: &Brep, f: FaceId, opts: &MeshOptions) -> Result<FaceDomain, MeshError> {
-    let (mut positions, vert_idx, edge_pts) = face_edge_points(brep, f, opts);
+    let (mut positions, vert_idx, edge_pts) = face_edge_points(brep, &[f], opts);
     let (polys, _) = face_polygons(brep, f, &edge_pts, &vert_idx, &mut positions, opts)?;
     let s = brep.face_surface(f);
     Ok(FaceDomain {
-        loops: polys.into_iter().map(|p| p.into_iter().map(|q| q.uv).collect()).collect(),
+        loops: polys
+            .into_iter()
+            .map(|p| p.into_iter().map(|q| q.uv).collect())
+            .collect(),
         periods: [s.u_period(), s.v_period()],
     })
 }
 
 /// Points strictly inside an edge (its vertices excluded), spaced by the tolerances.
 pub fn discretize_edge(c: &Curve, t0: f64, t1: f64, opts: &MeshOptions) -> Vec<P3> {
-    let opts = &MeshOptions { chord_tol: opts.edge_chord_tol.unwrap_or(opts.chord_tol), ..*opts };
+    let opts = &MeshOptions {
+        chord_tol: opts.edge_chord_tol.unwrap_or(opts.chord_tol),
+        ..*opts
+    };
     let n0 = match c {
         Curve::Line { .. } => 1,
         Curve::Polyline(p) => p.len().saturating_sub(1).max(1),
@@ -436,7 +437,16 @@ fn mesh_face(
 ) -> Result<FaceTriangulation, MeshError> {
     let (polys, edge_of) = face_polygons(brep, f, edge_pts, vert_idx, positions, opts)?;
     let sense = if brep.face(f).same_sense { 1.0 } else { -1.0 };
-    triangulate(brep, f, brep.face_surface(f), polys, &edge_of, positions, opts, sense)
+    triangulate(
+        brep,
+        f,
+        brep.face_surface(f),
+        polys,
+        &edge_of,
+        positions,
+        opts,
+        sense,
+    )
 }
 
 /// Each edge loop of a face taken into the parameter domain and unwrapped, with how many
@@ -669,7 +679,11 @@ fn face_polygons(
         match full_domain(s, &pole_vertices, positions, opts) {
             Some(poly) => polys.push(poly),
             None => {
-                return Err(face_err(brep, f, "no boundary loop makes a region on the surface"));
+                return Err(face_err(
+                    brep,
+                    f,
+                    "no boundary loop makes a region on the surface",
+                ));
             }
         }
     }
@@ -959,9 +973,11 @@ fn triangulate(
     let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
         ConstrainedDelaunayTriangulation::new();
     let mut loc = Local::default();
-    let insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>, loc: &mut Local, xy: [f64; 2], uv: [f64; 2], idx: u32| {
-        loc.insert(cdt, xy, uv, idx)
-    };
+    let insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+                  loc: &mut Local,
+                  xy: [f64; 2],
+                  uv: [f64; 2],
+                  idx: u32| { loc.insert(cdt, xy, uv, idx) };
 
     // Boundary points, with pole bridges subdivided so the fan at a pole is well shaped.
     let mut constraints_failed = 0usize;
@@ -971,7 +987,13 @@ fn triangulate(
         for k in 0..m {
             let p = poly[k];
             let q = poly[(k + 1) % m];
-            let Some((h, _)) = insert(&mut cdt, &mut loc, [p.uv[0] * su, p.uv[1] * sv], p.uv, p.idx) else {
+            let Some((h, _)) = insert(
+                &mut cdt,
+                &mut loc,
+                [p.uv[0] * su, p.uv[1] * sv],
+                p.uv,
+                p.idx,
+            ) else {
                 return Err(face_err(
                     brep,
                     f,
@@ -989,7 +1011,9 @@ fn triangulate(
                         p.uv[0] + t * (q.uv[0] - p.uv[0]),
                         p.uv[1] + t * (q.uv[1] - p.uv[1]),
                     ];
-                    if let Some((h, _)) = insert(&mut cdt, &mut loc, [uv[0] * su, uv[1] * sv], uv, p.idx) {
+                    if let Some((h, _)) =
+                        insert(&mut cdt, &mut loc, [uv[0] * su, uv[1] * sv], uv, p.idx)
+                    {
                         handles.push(h);
                     }
                 }
@@ -1098,8 +1122,14 @@ fn triangulate(
                 // rounds before chord splitting does, so that has the last word.
                 if !planar && rounds + 2 < MAX_ROUNDS {
                     let c = [
-                        (loc.uv[t[0] as usize][0] + loc.uv[t[1] as usize][0] + loc.uv[t[2] as usize][0]) / 3.0,
-                        (loc.uv[t[0] as usize][1] + loc.uv[t[1] as usize][1] + loc.uv[t[2] as usize][1]) / 3.0,
+                        (loc.uv[t[0] as usize][0]
+                            + loc.uv[t[1] as usize][0]
+                            + loc.uv[t[2] as usize][0])
+                            / 3.0,
+                        (loc.uv[t[0] as usize][1]
+                            + loc.uv[t[1] as usize][1]
+                            + loc.uv[t[2] as usize][1])
+                            / 3.0,
                     ];
                     let flat = (positions[loc.vertex[t[0] as usize] as usize].coords
                         + positions[loc.vertex[t[1] as usize] as usize].coords
@@ -1118,7 +1148,11 @@ fn triangulate(
                         continue;
                     }
                     let (ha, hb) = (e.from().fix().index(), e.to().fix().index());
-                    let (Some(&la), Some(&lb)) = (loc.handle_local.get(&ha), loc.handle_local.get(&hb)) else { continue };
+                    let (Some(&la), Some(&lb)) =
+                        (loc.handle_local.get(&ha), loc.handle_local.get(&hb))
+                    else {
+                        continue;
+                    };
                     let (ga, gb) = (loc.vertex[la], loc.vertex[lb]);
                     let shared = match (edge_of.get(&ga), edge_of.get(&gb)) {
                         (Some(ea), Some(eb)) => ea.iter().any(|x| eb.contains(x)),
@@ -1136,7 +1170,12 @@ fn triangulate(
             triangles.push(t);
         }
         if splits.is_empty() {
-            return Ok(FaceTriangulation { face: f, uv: loc.uv, vertex: loc.vertex, triangles });
+            return Ok(FaceTriangulation {
+                face: f,
+                uv: loc.uv,
+                vertex: loc.vertex,
+                triangles,
+            });
         }
         added += splits.len();
         for xy in splits {
@@ -1231,34 +1270,64 @@ fn constraint_depth(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<
 /// surface (both directions periodic, or periodic one way and collapsing to poles the other).
 /// Seam sides share their vertices with the opposite side and pole sides collapse to one
 /// vertex, so the result is watertight.
-fn full_domain(s: &Surface, pole_vertices: &[u32], positions: &mut Vec<P3>, opts: &MeshOptions) -> Option<Vec<Pt>> {
+fn full_domain(
+    s: &Surface,
+    pole_vertices: &[u32],
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Option<Vec<Pt>> {
     let (bu, bv) = s.bounds();
     let (pu, pv) = (s.u_period(), s.v_period());
     let ur = pu.map(|p| (0.0, p)).or(bu)?;
     let vr = pv.map(|p| (0.0, p)).or(bv)?;
     let (du, dv) = grid_steps(s, ur, vr, opts);
-    let nu = if du.is_finite() { ((ur.1 - ur.0) / du).ceil().clamp(4.0, 400.0) as usize } else { 4 };
-    let nv = if dv.is_finite() { ((vr.1 - vr.0) / dv).ceil().clamp(4.0, 400.0) as usize } else { 4 };
+    let nu = if du.is_finite() {
+        ((ur.1 - ur.0) / du).ceil().clamp(4.0, 400.0) as usize
+    } else {
+        4
+    };
+    let nv = if dv.is_finite() {
+        ((vr.1 - vr.0) / dv).ceil().clamp(4.0, 400.0) as usize
+    } else {
+        4
+    };
     let size = {
         let mut b = Aabb::empty();
         for i in 0..=4 {
             for j in 0..=4 {
-                b.add(&s.eval(ur.0 + (ur.1 - ur.0) * i as f64 / 4.0, vr.0 + (vr.1 - vr.0) * j as f64 / 4.0));
+                b.add(&s.eval(
+                    ur.0 + (ur.1 - ur.0) * i as f64 / 4.0,
+                    vr.0 + (vr.1 - vr.0) * j as f64 / 4.0,
+                ));
             }
         }
         b.diagonal()
     };
     let new_vertex = |p: P3, positions: &mut Vec<P3>| -> u32 {
-        if let Some(&i) = pole_vertices.iter().find(|&&i| (positions[i as usize] - p).norm() <= 1e-7 * size.max(1e-9)) {
+        if let Some(&i) = pole_vertices
+            .iter()
+            .find(|&&i| (positions[i as usize] - p).norm() <= 1e-7 * size.max(1e-9))
+        {
             return i;
         }
         positions.push(p);
         (positions.len() - 1) as u32
     };
     // A side collapses when all its points coincide.
-    let collapsed = |pts: &[P3]| pts.iter().all(|p| (p - pts[0]).norm() <= 1e-7 * size.max(1e-9));
-    let side_u = |v: f64| -> Vec<P3> { (0..=nu).map(|i| s.eval(ur.0 + (ur.1 - ur.0) * i as f64 / nu as f64, v)).collect() };
-    let side_v = |u: f64| -> Vec<P3> { (0..=nv).map(|j| s.eval(u, vr.0 + (vr.1 - vr.0) * j as f64 / nv as f64)).collect() };
+    let collapsed = |pts: &[P3]| {
+        pts.iter()
+            .all(|p| (p - pts[0]).norm() <= 1e-7 * size.max(1e-9))
+    };
+    let side_u = |v: f64| -> Vec<P3> {
+        (0..=nu)
+            .map(|i| s.eval(ur.0 + (ur.1 - ur.0) * i as f64 / nu as f64, v))
+            .collect()
+    };
+    let side_v = |u: f64| -> Vec<P3> {
+        (0..=nv)
+            .map(|j| s.eval(u, vr.0 + (vr.1 - vr.0) * j as f64 / nv as f64))
+            .collect()
+    };
     let (bottom, top) = (side_u(vr.0), side_u(vr.1));
     let (left, _right) = (side_v(ur.0), side_v(ur.1));
     let bottom_pole = collapsed(&bottom);
@@ -1285,21 +1354,45 @@ fn full_domain(s: &Surface, pole_vertices: &[u32], positions: &mut Vec<P3>, opts
     for j in 1..nv {
         left_idx[j] = new_vertex(left[j], positions);
     }
-    let right_idx = |j: usize| if j == 0 { bottom_idx[nu] } else if j == nv { top_idx[nu] } else { left_idx[j] };
+    let right_idx = |j: usize| {
+        if j == 0 {
+            bottom_idx[nu]
+        } else if j == nv {
+            top_idx[nu]
+        } else {
+            left_idx[j]
+        }
+    };
     let u_at = |i: usize| ur.0 + (ur.1 - ur.0) * i as f64 / nu as f64;
     let v_at = |j: usize| vr.0 + (vr.1 - vr.0) * j as f64 / nv as f64;
     let mut poly = vec![];
     for i in 0..nu {
-        poly.push(Pt { uv: [u_at(i), vr.0], idx: bottom_idx[i], sing: if bottom_pole { 1 } else { 0 } });
+        poly.push(Pt {
+            uv: [u_at(i), vr.0],
+            idx: bottom_idx[i],
+            sing: if bottom_pole { 1 } else { 0 },
+        });
     }
     for j in 0..nv {
-        poly.push(Pt { uv: [ur.1, v_at(j)], idx: right_idx(j), sing: 0 });
+        poly.push(Pt {
+            uv: [ur.1, v_at(j)],
+            idx: right_idx(j),
+            sing: 0,
+        });
     }
     for i in (1..=nu).rev() {
-        poly.push(Pt { uv: [u_at(i), vr.1], idx: top_idx[i], sing: if top_pole { 1 } else { 0 } });
+        poly.push(Pt {
+            uv: [u_at(i), vr.1],
+            idx: top_idx[i],
+            sing: if top_pole { 1 } else { 0 },
+        });
     }
     for j in (1..=nv).rev() {
-        poly.push(Pt { uv: [ur.0, v_at(j)], idx: left_idx[j], sing: 0 });
+        poly.push(Pt {
+            uv: [ur.0, v_at(j)],
+            idx: left_idx[j],
+            sing: 0,
+        });
     }
     Some(poly)
 }
@@ -1308,7 +1401,11 @@ fn full_domain(s: &Surface, pole_vertices: &[u32], positions: &mut Vec<P3>, opts
 /// inside the outer loop.
 fn align_loops(polys: &mut [Vec<Pt>], periods: [Option<f64>; 2]) {
     let outer = (0..polys.len())
-        .max_by(|&a, &b| signed_area(&polys[a]).abs().total_cmp(&signed_area(&polys[b]).abs()))
+        .max_by(|&a, &b| {
+            signed_area(&polys[a])
+                .abs()
+                .total_cmp(&signed_area(&polys[b]).abs())
+        })
         .unwrap_or(0);
     let outer_pts: Vec<[f64; 2]> = polys[outer].iter().map(|p| p.uv).collect();
     let inside = |q: [f64; 2]| {
@@ -1327,7 +1424,9 @@ fn align_loops(polys: &mut [Vec<Pt>], periods: [Option<f64>; 2]) {
     };
     let centre = |pts: &[Pt]| {
         let n = pts.len().max(1) as f64;
-        let s = pts.iter().fold([0.0, 0.0], |acc, p| [acc[0] + p.uv[0], acc[1] + p.uv[1]]);
+        let s = pts
+            .iter()
+            .fold([0.0, 0.0], |acc, p| [acc[0] + p.uv[0], acc[1] + p.uv[1]]);
         [s[0] / n, s[1] / n]
     };
     let oc = centre(&polys[outer]);
@@ -1337,15 +1436,26 @@ fn align_loops(polys: &mut [Vec<Pt>], periods: [Option<f64>; 2]) {
         }
         let pu = periods[0].unwrap_or(0.0);
         let pv = periods[1].unwrap_or(0.0);
-        let ku: &[f64] = if periods[0].is_some() { &[0.0, -1.0, 1.0, -2.0, 2.0] } else { &[0.0] };
-        let kv: &[f64] = if periods[1].is_some() { &[0.0, -1.0, 1.0, -2.0, 2.0] } else { &[0.0] };
+        let ku: &[f64] = if periods[0].is_some() {
+            &[0.0, -1.0, 1.0, -2.0, 2.0]
+        } else {
+            &[0.0]
+        };
+        let kv: &[f64] = if periods[1].is_some() {
+            &[0.0, -1.0, 1.0, -2.0, 2.0]
+        } else {
+            &[0.0]
+        };
         let c = centre(poly);
         // Prefer a shift that puts the loop's points inside the outer loop; else the nearest.
         let mut best = (usize::MAX, f64::INFINITY, 0.0, 0.0);
         for &a in ku {
             for &b in kv {
                 let (du, dv) = (a * pu, b * pv);
-                let outside = poly.iter().filter(|p| !inside([p.uv[0] + du, p.uv[1] + dv])).count();
+                let outside = poly
+                    .iter()
+                    .filter(|p| !inside([p.uv[0] + du, p.uv[1] + dv]))
+                    .count();
                 let dist = (c[0] + du - oc[0]).hypot(c[1] + dv - oc[1]);
                 if (outside, dist) < (best.0, best.1) {
                     best = (outside, dist, du, dv);

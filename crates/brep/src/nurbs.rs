@@ -55,7 +55,13 @@ pub fn basis_ders(knots: &[f64], span: usize, t: f64, p: usize, nd: usize) -> [[
     basis_ders_n::<M>(knots, span, t, p, nd)
 }
 
-fn basis_ders_n<const N: usize>(knots: &[f64], span: usize, t: f64, p: usize, nd: usize) -> [[f64; N]; 3] {
+fn basis_ders_n<const N: usize>(
+    knots: &[f64],
+    span: usize,
+    t: f64,
+    p: usize,
+    nd: usize,
+) -> [[f64; N]; 3] {
     let mut ndu = [[0.0f64; N]; N];
     let mut left = [0.0f64; N];
     let mut right = [0.0f64; N];
@@ -66,7 +72,11 @@ fn basis_ders_n<const N: usize>(knots: &[f64], span: usize, t: f64, p: usize, nd
         let mut saved = 0.0;
         for r in 0..j {
             ndu[j][r] = right[r + 1] + left[j - r];
-            let temp = if ndu[j][r] != 0.0 { ndu[r][j - 1] / ndu[j][r] } else { 0.0 };
+            let temp = if ndu[j][r] != 0.0 {
+                ndu[r][j - 1] / ndu[j][r]
+            } else {
+                0.0
+            };
             ndu[r][j] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
         }
@@ -91,10 +101,18 @@ fn basis_ders_n<const N: usize>(knots: &[f64], span: usize, t: f64, p: usize, nd
                 d = a[s2][0] * ndu[rk as usize][pk];
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-            let j2 = if r as isize - 1 <= pk as isize { k - 1 } else { p - r };
+            let j2 = if r as isize - 1 <= pk as isize {
+                k - 1
+            } else {
+                p - r
+            };
             for j in j1..=j2 {
                 let den = ndu[pk + 1][(rk + j as isize) as usize];
-                a[s2][j] = if den != 0.0 { (a[s1][j] - a[s1][j - 1]) / den } else { 0.0 };
+                a[s2][j] = if den != 0.0 {
+                    (a[s1][j] - a[s1][j - 1]) / den
+                } else {
+                    0.0
+                };
                 d += a[s2][j] * ndu[(rk + j as isize) as usize][pk];
             }
             if r <= pk {
@@ -234,8 +252,15 @@ mod tests {
             let t = i as f64 / 50.0;
             let s = find_span(&knots, p, n, t);
             let d = basis_ders(&knots, s, t, p, 2);
-            let (s0, s1, s2): (f64, f64, f64) = (d[0][..=p].iter().sum(), d[1][..=p].iter().sum(), d[2][..=p].iter().sum());
-            assert!((s0 - 1.0).abs() < 1e-12 && s1.abs() < 1e-9 && s2.abs() < 1e-7, "t={t}: {s0} {s1} {s2}");
+            let (s0, s1, s2): (f64, f64, f64) = (
+                d[0][..=p].iter().sum(),
+                d[1][..=p].iter().sum(),
+                d[2][..=p].iter().sum(),
+            );
+            assert!(
+                (s0 - 1.0).abs() < 1e-12 && s1.abs() < 1e-9 && s2.abs() < 1e-7,
+                "t={t}: {s0} {s1} {s2}"
+            );
         }
     }
 }

@@ -34,11 +34,19 @@ impl Plane {
             .find(|a| a.norm() > 1e-3)
             .map(|a| a.normalize())
             .unwrap_or_else(|| any_perpendicular(&n));
-        Plane { origin, normal: n, u, v: n.cross(&u) }
+        Plane {
+            origin,
+            normal: n,
+            u,
+            v: n.cross(&u),
+        }
     }
     /// The same frame moved along the normal by `d`.
     pub fn offset(&self, d: f64) -> Plane {
-        Plane { origin: self.origin + self.normal * d, ..*self }
+        Plane {
+            origin: self.origin + self.normal * d,
+            ..*self
+        }
     }
     /// Signed distance of `p` above the plane.
     pub fn height(&self, p: &P3) -> f64 {
@@ -63,7 +71,11 @@ pub fn section(mesh: &Mesh, plane: &Plane) -> Vec<Vec<P3>> {
     let cross = |a: u32, b: u32| -> P3 {
         let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
         let (da, db) = (d[a as usize], d[b as usize]);
-        let t = if (da - db).abs() > 0.0 { da / (da - db) } else { 0.5 };
+        let t = if (da - db).abs() > 0.0 {
+            da / (da - db)
+        } else {
+            0.5
+        };
         pa + (pb - pa) * t.clamp(0.0, 1.0)
     };
     // Segment from the crossing on one edge to the crossing on another, keyed by edges.
@@ -77,7 +89,9 @@ pub fn section(mesh: &Mesh, plane: &Plane) -> Vec<Vec<P3>> {
             continue;
         }
         // The lone vertex on its side, then the other two in triangle order.
-        let lone = (0..3).find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3]).unwrap_or(0);
+        let lone = (0..3)
+            .find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3])
+            .unwrap_or(0);
         let (a, b, c) = (t[lone], t[(lone + 1) % 3], t[(lone + 2) % 3]);
         let (e1, e2) = (key(a, b), key(a, c));
         let (p1, p2) = (cross(a, b), cross(a, c));
@@ -123,10 +137,13 @@ pub fn section(mesh: &Mesh, plane: &Plane) -> Vec<Vec<P3>> {
 /// Signed area of a closed 2-D polygon (positive counter-clockwise).
 pub fn signed_area(poly: &[[f64; 2]]) -> f64 {
     let n = poly.len();
-    (0..n).map(|k| {
-        let (p, q) = (poly[k], poly[(k + 1) % n]);
-        p[0] * q[1] - q[0] * p[1]
-    }).sum::<f64>() * 0.5
+    (0..n)
+        .map(|k| {
+            let (p, q) = (poly[k], poly[(k + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        * 0.5
 }
 
 #[cfg(test)]
@@ -135,7 +152,9 @@ mod tests {
     use crate::mesh::{mesh_faces, MeshOptions};
 
     fn fixture(name: &str) -> crate::StepPart {
-        let p = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
+        let p = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures")
+            .join(name);
         crate::read_step(p).expect("fixture")
     }
 
@@ -143,14 +162,23 @@ mod tests {
     fn box_section_is_one_ccw_rectangle_of_the_right_area() {
         let part = fixture("box.step");
         let b = &part.brep;
-        let m = mesh_faces(b, &b.solid_faces(crate::topology::SolidId(0)), &MeshOptions::default()).expect("mesh");
+        let m = mesh_faces(
+            b,
+            &b.solid_faces(crate::topology::SolidId(0)),
+            &MeshOptions::default(),
+        )
+        .expect("mesh");
         let bb = m.bbox();
         let plane = Plane::new(P3::new(0.0, 0.0, 0.5 * (bb.min.z + bb.max.z)), V3::z());
         let loops = section(&m, &plane);
         assert_eq!(loops.len(), 1);
         let poly: Vec<[f64; 2]> = loops[0].iter().map(|p| plane.to_2d(p)).collect();
         let want = (bb.max.x - bb.min.x) * (bb.max.y - bb.min.y);
-        assert!((signed_area(&poly) - want).abs() < 1e-9 * want, "{} vs {want}", signed_area(&poly));
+        assert!(
+            (signed_area(&poly) - want).abs() < 1e-9 * want,
+            "{} vs {want}",
+            signed_area(&poly)
+        );
     }
 
     #[test]
@@ -159,24 +187,40 @@ mod tests {
         // boundary and a CW hole whose areas add up to the block's cross-section less the hole.
         let part = fixture("inch_block.step");
         let b = &part.brep;
-        let m = mesh_faces(b, &b.solid_faces(crate::topology::SolidId(0)), &MeshOptions::with_tolerance(0.001)).expect("mesh");
+        let m = mesh_faces(
+            b,
+            &b.solid_faces(crate::topology::SolidId(0)),
+            &MeshOptions::with_tolerance(0.001),
+        )
+        .expect("mesh");
         let plane = Plane::new(P3::new(0.0, 0.0, 6.0), V3::z());
         let loops = section(&m, &plane);
-        let areas: Vec<f64> = loops.iter().map(|l| signed_area(&l.iter().map(|p| plane.to_2d(p)).collect::<Vec<_>>())).collect();
+        let areas: Vec<f64> = loops
+            .iter()
+            .map(|l| signed_area(&l.iter().map(|p| plane.to_2d(p)).collect::<Vec<_>>()))
+            .collect();
         assert_eq!(loops.len(), 2, "{areas:?}");
         let outer = areas.iter().cloned().fold(f64::MIN, f64::max);
         let hole = areas.iter().cloned().fold(f64::MAX, f64::min);
         assert!(outer > 0.0 && hole < 0.0);
         let r = 0.375 * 25.4 / 2.0;
         assert!((outer - 50.8 * 38.1).abs() < 1e-6 * outer);
-        assert!((hole + std::f64::consts::PI * r * r).abs() < 1e-3 * (std::f64::consts::PI * r * r), "hole {hole}");
+        assert!(
+            (hole + std::f64::consts::PI * r * r).abs() < 1e-3 * (std::f64::consts::PI * r * r),
+            "hole {hole}"
+        );
     }
 
     #[test]
     fn tilted_plane_through_a_sphere_gives_a_circle() {
         let part = fixture("sphere.step");
         let b = &part.brep;
-        let m = mesh_faces(b, &b.solid_faces(crate::topology::SolidId(0)), &MeshOptions::with_tolerance(0.001)).expect("mesh");
+        let m = mesh_faces(
+            b,
+            &b.solid_faces(crate::topology::SolidId(0)),
+            &MeshOptions::with_tolerance(0.001),
+        )
+        .expect("mesh");
         let n = V3::new(1.0, 2.0, 3.0).normalize();
         let plane = Plane::new(P3::origin() + n * 5.0, n);
         let loops = section(&m, &plane);

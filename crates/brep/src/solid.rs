@@ -99,14 +99,29 @@ pub fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
     }
     for f in faces {
         let face = brep.face(f);
-        if face.loops.iter().all(|l| brep.loops[l.idx()].coedges.is_empty()) {
+        if face
+            .loops
+            .iter()
+            .all(|l| brep.loops[l.idx()].coedges.is_empty())
+        {
             let srf = brep.face_surface(f);
             let (bu, bv) = srf.bounds();
-            let ur = srf.u_period().map(|p| (0.0, p)).or(bu).unwrap_or((0.0, 1.0));
-            let vr = srf.v_period().map(|p| (0.0, p)).or(bv).unwrap_or((0.0, 1.0));
+            let ur = srf
+                .u_period()
+                .map(|p| (0.0, p))
+                .or(bu)
+                .unwrap_or((0.0, 1.0));
+            let vr = srf
+                .v_period()
+                .map(|p| (0.0, p))
+                .or(bv)
+                .unwrap_or((0.0, 1.0));
             for i in 0..=8 {
                 for j in 0..=8 {
-                    b.add(&srf.eval(ur.0 + (ur.1 - ur.0) * i as f64 / 8.0, vr.0 + (vr.1 - vr.0) * j as f64 / 8.0));
+                    b.add(&srf.eval(
+                        ur.0 + (ur.1 - ur.0) * i as f64 / 8.0,
+                        vr.0 + (vr.1 - vr.0) * j as f64 / 8.0,
+                    ));
                 }
             }
         }

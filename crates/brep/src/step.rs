@@ -968,7 +968,11 @@ impl<'a> Translator<'a> {
         if total as usize != n_ctrl + degree + 1 {
             return Err(self.bad(id, format!("knot multiplicities sum to {total}, expected {} control points + degree {} + 1", n_ctrl, degree)));
         }
-        if knots.windows(2).any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less)) || knots.iter().any(|k| !k.is_finite()) {
+        if knots
+            .windows(2)
+            .any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less))
+            || knots.iter().any(|k| !k.is_finite())
+        {
             return Err(self.bad(id, "knots are not strictly increasing"));
         }
         tg::KnotVec::from_single_multi(knots, mults.iter().map(|&m| m as usize).collect())

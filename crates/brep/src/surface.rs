@@ -164,8 +164,16 @@ impl NurbsSurfaceData {
             ku: surface.uknot_vec().to_vec(),
             kv: surface.vknot_vec().to_vec(),
             degree: (du, dv),
-            n: (surface.control_points().len(), surface.control_points().first().map_or(0, |r| r.len())),
-            cps: surface.control_points().iter().flatten().map(|c| [c.x, c.y, c.z, c.w]).collect(),
+            n: (
+                surface.control_points().len(),
+                surface.control_points().first().map_or(0, |r| r.len()),
+            ),
+            cps: surface
+                .control_points()
+                .iter()
+                .flatten()
+                .map(|c| [c.x, c.y, c.z, c.w])
+                .collect(),
         };
         let mut d = NurbsSurfaceData {
             surface,
@@ -607,7 +615,9 @@ impl Surface {
                     Some(h) => {
                         let q = self.polish(p, h);
                         // Points of other writers lie off the surface by their modelling tolerance.
-                        if (self.eval(q.0, q.1) - p).norm() < 1e-4f64.max(1e-6 * (1.0 + p.coords.norm())) {
+                        if (self.eval(q.0, q.1) - p).norm()
+                            < 1e-4f64.max(1e-6 * (1.0 + p.coords.norm()))
+                        {
                             return q;
                         }
                         self.grid_start(p, n)

@@ -187,7 +187,11 @@ impl Brep {
     /// normal, reversed where the face runs against its surface).
     pub fn face_normal(&self, id: FaceId, u: f64, v: f64) -> Option<crate::math::V3> {
         let n = self.face_surface(id).normal(u, v)?;
-        Some(if self.faces[id.idx()].same_sense { n } else { -n })
+        Some(if self.faces[id.idx()].same_sense {
+            n
+        } else {
+            -n
+        })
     }
     /// The parameters of the point of a face's surface nearest to `p` (in any period; use
     /// [`crate::mesh::face_domain`] to ask whether it lies inside the face's trim).

@@ -106,7 +106,8 @@ pub fn check_shell(brep: &Brep, shell: ShellId) -> ShellReport {
             let id = brep.edge(*e).step_id;
             let what = match f + b {
                 1 => "is used by one face only (open edge)".to_string(),
-                2 => "is used twice in the same direction (inconsistent face orientation)".to_string(),
+                2 => "is used twice in the same direction (inconsistent face orientation)"
+                    .to_string(),
                 n => format!("is used {n} times (non-manifold)"),
             };
             edge_ids.push((id, what));

@@ -15,7 +15,9 @@ fn corpus_volumes_match_opencascade() {
         eprintln!("../shared/corpus not found beside the repository; corpus test skipped");
         return;
     };
-    let refs: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("reference.json")).unwrap()).unwrap();
+    let refs: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reference.json")).unwrap())
+            .unwrap();
     let overrides: Value = serde_json::from_str(include_str!("corpus_overrides.json")).unwrap();
     let mut failures = vec![];
     for (file, r) in refs.as_object().unwrap() {
@@ -33,9 +35,18 @@ fn corpus_volumes_match_opencascade() {
         };
         let b = &part.brep;
         let want = overrides.get(file).unwrap_or(r);
-        let mut want_vols: Vec<f64> = want["volumes_mm3"].as_array().unwrap().iter().filter_map(|v| v.as_f64()).collect();
+        let mut want_vols: Vec<f64> = want["volumes_mm3"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .collect();
         if b.solids.len() != want_vols.len() {
-            failures.push(format!("{file}: {} solids, reference {}", b.solids.len(), want_vols.len()));
+            failures.push(format!(
+                "{file}: {} solids, reference {}",
+                b.solids.len(),
+                want_vols.len()
+            ));
             continue;
         }
         let mut got = vec![];
@@ -43,7 +54,10 @@ fn corpus_volumes_match_opencascade() {
             match brep::solid::report_solid(b, s) {
                 Ok(rep) => {
                     if !rep.closed || !rep.watertight {
-                        failures.push(format!("{file}: solid #{} closed={} watertight={}", rep.step_id, rep.closed, rep.watertight));
+                        failures.push(format!(
+                            "{file}: solid #{} closed={} watertight={}",
+                            rep.step_id, rep.closed, rep.watertight
+                        ));
                     }
                     got.push(rep.volume);
                 }
@@ -54,12 +68,20 @@ fn corpus_volumes_match_opencascade() {
         want_vols.sort_by(f64::total_cmp);
         for (g, w) in got.iter().zip(&want_vols) {
             // Tiny solids (a sliver OpenCASCADE gives zero volume) are compared absolutely.
-            let ok = if w.abs() < 1.0 { (g - w).abs() < 0.01 } else { (g - w).abs() / w <= 5e-3 };
+            let ok = if w.abs() < 1.0 {
+                (g - w).abs() < 0.01
+            } else {
+                (g - w).abs() / w <= 5e-3
+            };
             if !ok {
                 failures.push(format!("{file}: volume {g:.4} vs reference {w:.4}"));
             }
         }
         eprintln!("{file}: {got:?} vs {want_vols:?}");
     }
-    assert!(failures.is_empty(), "corpus failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "corpus failures:\n{}",
+        failures.join("\n")
+    );
 }

@@ -10,7 +10,9 @@ use brep::topology::SolidId;
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name);
     std::fs::read_to_string(p).expect("fixture")
 }
 
@@ -42,7 +44,10 @@ fn assert_same_solid(original: &str, changed: &str) {
 fn assert_same_solid_within(original: &str, changed: &str, rel: f64) {
     let (v0, ..) = volume_of(original);
     let (v1, closed, watertight) = volume_of(changed);
-    assert!(closed && watertight, "changed solid closed={closed} watertight={watertight}");
+    assert!(
+        closed && watertight,
+        "changed solid closed={closed} watertight={watertight}"
+    );
     assert!((v1 - v0).abs() <= rel * v0, "volume changed: {v0} -> {v1}");
 }
 
@@ -57,9 +62,15 @@ fn offset_surface_is_its_basis_moved_along_the_normal() {
     );
     assert_same_solid(&box_step, &changed);
     // The wrong distance must show: the face no longer meets its edges, the solid grows.
-    let wrong = changed.replace("OFFSET_SURFACE('',#900001,2.,.F.)", "OFFSET_SURFACE('',#900001,0.,.F.)");
+    let wrong = changed.replace(
+        "OFFSET_SURFACE('',#900001,2.,.F.)",
+        "OFFSET_SURFACE('',#900001,0.,.F.)",
+    );
     let (v, ..) = volume_of(&wrong);
-    assert!((v - 6000.0).abs() > 1.0, "a zero offset should change the volume, got {v}");
+    assert!(
+        (v - 6000.0).abs() > 1.0,
+        "a zero offset should change the volume, got {v}"
+    );
 }
 
 #[test]
@@ -67,7 +78,10 @@ fn rectangular_trimmed_surface_keeps_its_basis_and_sense() {
     let box_step = fixture("box.step");
     let wrapped = rewrite(
         &box_step,
-        &[("#32 = PLANE('',#33);", "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.T.,.T.);")],
+        &[(
+            "#32 = PLANE('',#33);",
+            "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.T.,.T.);",
+        )],
         "#900001 = PLANE('',#33);\n",
     );
     assert_same_solid(&box_step, &wrapped);
@@ -75,8 +89,14 @@ fn rectangular_trimmed_surface_keeps_its_basis_and_sense() {
     let reversed = rewrite(
         &box_step,
         &[
-            ("#32 = PLANE('',#33);", "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.F.,.T.);"),
-            ("#17 = ADVANCED_FACE('',(#18),#32,.F.);", "#17 = ADVANCED_FACE('',(#18),#32,.T.);"),
+            (
+                "#32 = PLANE('',#33);",
+                "#32 = RECTANGULAR_TRIMMED_SURFACE('',#900001,-100.,100.,-100.,100.,.F.,.T.);",
+            ),
+            (
+                "#17 = ADVANCED_FACE('',(#18),#32,.F.);",
+                "#17 = ADVANCED_FACE('',(#18),#32,.T.);",
+            ),
         ],
         "#900001 = PLANE('',#33);\n",
     );
@@ -160,7 +180,10 @@ fn length_units_scale_everything_to_millimetres() {
         assert!((part.brep.units[0].mm_per_unit - scale).abs() < 1e-9 * scale);
         let (v, ..) = volume_of(&changed);
         let want = 6000.0 * scale.powi(3);
-        assert!((v - want).abs() <= 1e-6 * want, "{new}: volume {v}, want {want}");
+        assert!(
+            (v - want).abs() <= 1e-6 * want,
+            "{new}: volume {v}, want {want}"
+        );
     }
 }
 
@@ -177,7 +200,11 @@ fn fuzz_regressions_are_refused_or_read() {
             Err(err) => assert!(!err.to_string().contains('\n'), "{}: {err}", p.display()),
             Ok(part) => {
                 for s in part.brep.solid_ids() {
-                    let _ = brep::solid::mesh_solid(&part.brep, s, Some(brep::mesh::MeshOptions::with_tolerance(0.5)));
+                    let _ = brep::solid::mesh_solid(
+                        &part.brep,
+                        s,
+                        Some(brep::mesh::MeshOptions::with_tolerance(0.5)),
+                    );
                 }
             }
         }
@@ -192,5 +219,8 @@ fn an_edge_far_off_its_curve_is_refused_naming_it() {
     assert_ne!(changed, cyl);
     let err = brep::read_step_bytes(changed.as_bytes()).expect_err("refused");
     let msg = err.to_string();
-    assert!(msg.contains("#21") && msg.contains("off its curve"), "{msg}");
+    assert!(
+        msg.contains("#21") && msg.contains("off its curve"),
+        "{msg}"
+    );
 }

@@ -24,7 +24,8 @@ fn fixture_names() -> Vec<String> {
 }
 
 fn reference(name: &str) -> Value {
-    let text = std::fs::read_to_string(fixtures_dir().join(format!("{name}.json"))).expect("reference json");
+    let text = std::fs::read_to_string(fixtures_dir().join(format!("{name}.json")))
+        .expect("reference json");
     serde_json::from_str(&text).expect("valid json")
 }
 
@@ -35,8 +36,19 @@ fn rel(a: f64, b: f64) -> f64 {
 #[test]
 fn at_least_the_required_fixtures_exist() {
     let names = fixture_names();
-    for required in ["impeller", "capsule", "fan", "plate_boss_boss", "sphere_boss", "inch_block", "arch"] {
-        assert!(names.iter().any(|n| n == required), "fixture {required} missing");
+    for required in [
+        "impeller",
+        "capsule",
+        "fan",
+        "plate_boss_boss",
+        "sphere_boss",
+        "inch_block",
+        "arch",
+    ] {
+        assert!(
+            names.iter().any(|n| n == required),
+            "fixture {required} missing"
+        );
     }
 }
 
@@ -55,7 +67,10 @@ fn fixtures_match_reference_figures() {
         let b = &part.brep;
         let want_solids = r["solids"].as_u64().unwrap_or(0) as usize;
         if b.solids.len() != want_solids {
-            failures.push(format!("{name}: {} solids, reference {want_solids}", b.solids.len()));
+            failures.push(format!(
+                "{name}: {} solids, reference {want_solids}",
+                b.solids.len()
+            ));
             continue;
         }
         let mut got_vols = vec![];
@@ -80,10 +95,16 @@ fn fixtures_match_reference_figures() {
                 *kinds.entry(k.clone()).or_default() += n;
             }
             if !rep.closed {
-                failures.push(format!("{name}: solid #{} not closed: {:?}", rep.step_id, rep.findings));
+                failures.push(format!(
+                    "{name}: solid #{} not closed: {:?}",
+                    rep.step_id, rep.findings
+                ));
             }
             if !rep.watertight {
-                failures.push(format!("{name}: solid #{} analysis mesh not watertight", rep.step_id));
+                failures.push(format!(
+                    "{name}: solid #{} analysis mesh not watertight",
+                    rep.step_id
+                ));
             }
             if want_solids == 1 {
                 if let Some(g) = r["genus"].as_i64() {
@@ -95,41 +116,66 @@ fn fixtures_match_reference_figures() {
             let mesh = mesh_solid(b, s, Some(MeshOptions::default())).expect("display mesh");
             let (open, bad) = mesh.open_edges();
             if open + bad != 0 {
-                failures.push(format!("{name}: display mesh has {open} open and {bad} non-manifold edges"));
+                failures.push(format!(
+                    "{name}: display mesh has {open} open and {bad} non-manifold edges"
+                ));
             }
         }
-        let mut want_vols: Vec<f64> = r["volumes_mm3"].as_array().unwrap().iter().filter_map(|v| v.as_f64()).collect();
+        let mut want_vols: Vec<f64> = r["volumes_mm3"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .collect();
         want_vols.sort_by(f64::total_cmp);
         got_vols.sort_by(f64::total_cmp);
         for (g, w) in got_vols.iter().zip(&want_vols) {
             if rel(*g, *w) > 1e-3 {
-                failures.push(format!("{name}: volume {g:.4} vs reference {w:.4} ({:+.4} %)", 100.0 * (g - w) / w));
+                failures.push(format!(
+                    "{name}: volume {g:.4} vs reference {w:.4} ({:+.4} %)",
+                    100.0 * (g - w) / w
+                ));
             }
         }
         let bb = &r["bbox_mm"];
         for k in 0..3 {
             let (lo, hi) = (bb[0][k].as_f64().unwrap(), bb[1][k].as_f64().unwrap());
             if (bbox.min[k] - lo).abs() > 1e-3 || (bbox.max[k] - hi).abs() > 1e-3 {
-                failures.push(format!("{name}: bbox axis {k} [{:.4}, {:.4}] vs reference [{lo}, {hi}]", bbox.min[k], bbox.max[k]));
+                failures.push(format!(
+                    "{name}: bbox axis {k} [{:.4}, {:.4}] vs reference [{lo}, {hi}]",
+                    bbox.min[k], bbox.max[k]
+                ));
             }
         }
         let want_area = r["area_mm2"].as_f64().unwrap();
         if rel(area, want_area) > 5e-3 {
-            failures.push(format!("{name}: area {area:.4} vs reference {want_area:.4}"));
+            failures.push(format!(
+                "{name}: area {area:.4} vs reference {want_area:.4}"
+            ));
         }
         if faces as u64 != r["faces"].as_u64().unwrap() {
             failures.push(format!("{name}: {faces} faces, reference {}", r["faces"]));
         }
         for (k, n) in r["faces_by_surface"].as_object().unwrap() {
             let n = n.as_u64().unwrap() as usize;
-            let got = if k == "other" { kinds.get("offset").copied().unwrap_or(0) } else { kinds.get(k).copied().unwrap_or(0) };
+            let got = if k == "other" {
+                kinds.get("offset").copied().unwrap_or(0)
+            } else {
+                kinds.get(k).copied().unwrap_or(0)
+            };
             if got != n {
                 failures.push(format!("{name}: {got} {k} faces, reference {n}"));
             }
         }
-        eprintln!("{name}: volumes {got_vols:?} (ref {want_vols:?}), area {area:.3} (ref {want_area:.3})");
+        eprintln!(
+            "{name}: volumes {got_vols:?} (ref {want_vols:?}), area {area:.3} (ref {want_area:.3})"
+        );
     }
-    assert!(failures.is_empty(), "fixture failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "fixture failures:\n{}",
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -143,6 +189,9 @@ fn inch_fixture_is_converted_to_millimetres() {
     for k in 0..3 {
         let lo = bb[0][k].as_f64().unwrap();
         let hi = bb[1][k].as_f64().unwrap();
-        assert!((rep.bbox.min[k] - lo).abs() < 0.05 && (rep.bbox.max[k] - hi).abs() < 0.05, "bbox axis {k}");
+        assert!(
+            (rep.bbox.min[k] - lo).abs() < 0.05 && (rep.bbox.max[k] - hi).abs() < 0.05,
+            "bbox axis {k}"
+        );
     }
 }

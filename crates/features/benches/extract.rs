@@ -11,7 +11,12 @@ fn median(mut v: Vec<Duration>) -> Duration {
 
 fn files(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "step")).collect())
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "step"))
+                .collect()
+        })
         .unwrap_or_default();
     v.sort();
     v
@@ -22,10 +27,18 @@ fn main() {
     let mut all = files(&root.join("fixtures"));
     all.extend(files(&root.join("../shared/corpus")));
     println!("goal: impeller read + extract < 100 ms");
-    println!("{:<40} {:>7} {:>9} {:>11} {:>11}", "file", "solids", "features", "read ms", "extract ms");
+    println!(
+        "{:<40} {:>7} {:>9} {:>11} {:>11}",
+        "file", "solids", "features", "read ms", "extract ms"
+    );
     for path in all {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let Ok(bytes) = std::fs::read(&path) else { continue };
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let Ok(bytes) = std::fs::read(&path) else {
+            continue;
+        };
         let Ok(part) = brep::read_step_bytes(&bytes) else {
             println!("{name:<40} unreadable");
             continue;
@@ -42,7 +55,8 @@ fn main() {
         let n = run();
         let (mut reads, mut extracts) = (vec![], vec![]);
         let start = Instant::now();
-        while reads.len() < 3 || (start.elapsed() < Duration::from_millis(800) && reads.len() < 30) {
+        while reads.len() < 3 || (start.elapsed() < Duration::from_millis(800) && reads.len() < 30)
+        {
             let t = Instant::now();
             let _ = brep::read_step_bytes(&bytes);
             reads.push(t.elapsed());

@@ -14,7 +14,14 @@ fn main() {
                 Err(e) => println!("{path}: {e}"),
                 Ok(t) => {
                     let sum: f64 = t.features.iter().map(|f| f.volume).sum();
-                    println!("{path} solid {}: {} features, part {:.2} sum {:.2} ({:?})", s.0, t.features.len(), t.part_volume, sum, t0.elapsed());
+                    println!(
+                        "{path} solid {}: {} features, part {:.2} sum {:.2} ({:?})",
+                        s.0,
+                        t.features.len(),
+                        t.part_volume,
+                        sum,
+                        t0.elapsed()
+                    );
                     for f in &t.features {
                         println!(
                             "  #{} {} {} ref={} {:?} parents={:?} vol={:.2} loops={} depth={} closed={} faces={}",

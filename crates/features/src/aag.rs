@@ -89,7 +89,10 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
             let g = t.map(|i| ft.vertex[i as usize]);
             for k in 0..3 {
                 let (a, b, c) = (g[k], g[(k + 1) % 3], g[(k + 2) % 3]);
-                third.entry((a.min(b), a.max(b))).or_default().push((ft.face, c));
+                third
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push((ft.face, c));
             }
         }
     }
@@ -99,7 +102,10 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         let mut adj: Vec<FaceId> = vec![];
         for &c in &brep.edge(e).coedges {
             let f = brep.coedge_face(c);
-            if node.contains_key(&f) && !adj.contains(&f) && brep.face(f).loops.contains(&brep.coedges[c.idx()].lp) {
+            if node.contains_key(&f)
+                && !adj.contains(&f)
+                && brep.face(f).loops.contains(&brep.coedges[c.idx()].lp)
+            {
                 adj.push(f);
             }
         }
@@ -107,7 +113,9 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
             continue;
         }
         let (f1, f2) = (adj[0], adj[1]);
-        let Some(pts) = mesh.edge_points.get(&e) else { continue };
+        let Some(pts) = mesh.edge_points.get(&e) else {
+            continue;
+        };
         let segs = pts.len().saturating_sub(1);
         let step = (segs / 12).max(1);
         let (mut concave, mut convex, mut smooth) = (0, 0, 0);
@@ -116,24 +124,36 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         for k in (0..segs).step_by(step) {
             let (a, b) = (pts[k], pts[k + 1]);
             let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-            let Some(users) = third.get(&(a.min(b), a.max(b))) else { continue };
+            let Some(users) = third.get(&(a.min(b), a.max(b))) else {
+                continue;
+            };
             let c1 = users.iter().find(|(f, _)| *f == f1).map(|x| x.1);
             let c2 = users.iter().find(|(f, _)| *f == f2).map(|x| x.1);
-            let (Some(c1), Some(c2)) = (c1, c2) else { continue };
+            let (Some(c1), Some(c2)) = (c1, c2) else {
+                continue;
+            };
             let m = nalgebra::center(&pa, &pb);
             let normal = |f: FaceId| {
                 let (u, v) = brep.face_project(f, &m);
                 brep.face_normal(f, u, v)
             };
-            let (Some(n1), Some(n2)) = (normal(f1), normal(f2)) else { continue };
+            let (Some(n1), Some(n2)) = (normal(f1), normal(f2)) else {
+                continue;
+            };
             let along = pb - pa;
             let into = |c: u32| -> Option<V3> {
                 let w = mesh.positions[c as usize] - pa;
                 let l2 = along.norm_squared();
-                let d = if l2 > 0.0 { w - along * (w.dot(&along) / l2) } else { w };
+                let d = if l2 > 0.0 {
+                    w - along * (w.dot(&along) / l2)
+                } else {
+                    w
+                };
                 d.try_normalize(1e-300)
             };
-            let (Some(d1), Some(d2)) = (into(c1), into(c2)) else { continue };
+            let (Some(d1), Some(d2)) = (into(c1), into(c2)) else {
+                continue;
+            };
             r12 += (mesh.positions[c2 as usize] - pa).dot(&n1);
             r21 += (mesh.positions[c1 as usize] - pa).dot(&n2);
             nr += 1;
@@ -158,9 +178,28 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         };
         convexity.insert(e, c);
         if nr > 0 {
-            rises.insert(e, Rise { faces: [f1, f2], rise: [r12 / nr as f64, r21 / nr as f64] });
+            rises.insert(
+                e,
+                Rise {
+                    faces: [f1, f2],
+                    rise: [r12 / nr as f64, r21 / nr as f64],
+                },
+            );
         }
-        graph.add_edge(node[&f1], node[&f2], EdgeAttr { edge: e, convexity: c, max_angle_deg: max_angle });
+        graph.add_edge(
+            node[&f1],
+            node[&f2],
+            EdgeAttr {
+                edge: e,
+                convexity: c,
+                max_angle_deg: max_angle,
+            },
+        );
     }
-    Aag { graph, node, convexity, rise: rises }
+    Aag {
+        graph,
+        node,
+        convexity,
+        rise: rises,
+    }
 }

@@ -21,7 +21,9 @@ pub struct ExtractOptions {
 
 impl Default for ExtractOptions {
     fn default() -> Self {
-        ExtractOptions { smooth_angle_deg: 3.0 }
+        ExtractOptions {
+            smooth_angle_deg: 3.0,
+        }
     }
 }
 
@@ -101,7 +103,12 @@ pub struct Feature {
 impl Feature {
     /// STEP `#id`s of the part's faces in this feature (healing faces have none).
     pub fn step_faces(&self, brep: &Brep) -> Vec<u64> {
-        let mut ids: Vec<u64> = self.faces.iter().map(|f| brep.face(*f).step_id).filter(|&i| i != 0).collect();
+        let mut ids: Vec<u64> = self
+            .faces
+            .iter()
+            .map(|f| brep.face(*f).step_id)
+            .filter(|&i| i != 0)
+            .collect();
         ids.sort_unstable();
         ids
     }
@@ -139,14 +146,24 @@ struct Draft {
 }
 
 /// Extracts the AM features of one solid.
-pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<FeatureTree, ExtractError> {
+pub fn extract(
+    part: &Brep,
+    solid: SolidId,
+    opts: &ExtractOptions,
+) -> Result<FeatureTree, ExtractError> {
     let mut b = part.clone();
     let mut warnings = vec![];
     let shells = b.solids[solid.idx()].shells.clone();
     let outer: Vec<FaceId> = b.shells[shells[0].idx()].faces.clone();
-    let voids: Vec<Vec<FaceId>> = shells[1..].iter().map(|s| b.shells[s.idx()].faces.clone()).collect();
+    let voids: Vec<Vec<FaceId>> = shells[1..]
+        .iter()
+        .map(|s| b.shells[s.idx()].faces.clone())
+        .collect();
     if !voids.is_empty() {
-        warnings.push(format!("{} void shell(s) kept with the base feature", voids.len()));
+        warnings.push(format!(
+            "{} void shell(s) kept with the base feature",
+            voids.len()
+        ));
     }
 
     // The part as read, meshed once: figures, per-face shares of the volume, adjacency and
@@ -159,12 +176,26 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     let diag = rough.diagonal().max(1e-3);
     let mopts = analysis_options(diag);
     let mesh = mesh_faces(&b, &all_faces, &mopts)?;
-    let origin = if rough.is_empty() { brep::math::P3::origin() } else { nalgebra::center(&rough.min, &rough.max) };
-    let mut shares: HashMap<FaceId, (f64, f64)> =
-        brep::mass::face_shares(&b, &mesh, &origin).into_iter().map(|(f, v, a)| (f, (v, a))).collect();
-    let vol_of = |shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]| fs.iter().map(|f| shares.get(f).map_or(0.0, |s| s.0)).sum::<f64>();
-    let part_volume = vol_of(&shares, &outer).abs() - voids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
-    let part_area: f64 = all_faces.iter().map(|f| shares.get(f).map_or(0.0, |s| s.1)).sum();
+    let origin = if rough.is_empty() {
+        brep::math::P3::origin()
+    } else {
+        nalgebra::center(&rough.min, &rough.max)
+    };
+    let mut shares: HashMap<FaceId, (f64, f64)> = brep::mass::face_shares(&b, &mesh, &origin)
+        .into_iter()
+        .map(|(f, v, a)| (f, (v, a)))
+        .collect();
+    let vol_of = |shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]| {
+        fs.iter()
+            .map(|f| shares.get(f).map_or(0.0, |s| s.0))
+            .sum::<f64>()
+    };
+    let part_volume =
+        vol_of(&shares, &outer).abs() - voids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
+    let part_area: f64 = all_faces
+        .iter()
+        .map(|f| shares.get(f).map_or(0.0, |s| s.1))
+        .sum();
     let genus = brep::validate::check_shell(&b, shells[0]).genus;
     let graph = aag::build(&b, &outer, &mesh, opts.smooth_angle_deg);
 
@@ -176,7 +207,10 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     for &f in &outer {
         let tangent_loop = b.face(f).loops.iter().any(|l| {
             let cs = &b.loops[l.idx()].coedges;
-            !cs.is_empty() && cs.iter().all(|c| graph.convexity.get(&b.coedges[c.idx()].edge) == Some(&Convexity::Smooth))
+            !cs.is_empty()
+                && cs.iter().all(|c| {
+                    graph.convexity.get(&b.coedges[c.idx()].edge) == Some(&Convexity::Smooth)
+                })
         });
         if !tangent_loop {
             continue;
@@ -185,16 +219,29 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
             if role != LoopRole::Inner {
                 continue;
             }
-            let edges: Vec<EdgeId> = b.loops[l.idx()].coedges.iter().map(|c| b.coedges[c.idx()].edge).collect();
-            if edges.iter().all(|e| graph.convexity.get(e) == Some(&Convexity::Smooth)) {
-                if edges.iter().all(|e| graph.rise_from(*e, f).is_some_and(|r| r > 0.0)) {
+            let edges: Vec<EdgeId> = b.loops[l.idx()]
+                .coedges
+                .iter()
+                .map(|c| b.coedges[c.idx()].edge)
+                .collect();
+            if edges
+                .iter()
+                .all(|e| graph.convexity.get(e) == Some(&Convexity::Smooth))
+            {
+                if edges
+                    .iter()
+                    .all(|e| graph.rise_from(*e, f).is_some_and(|r| r > 0.0))
+                {
                     warnings.push(format!(
                         "face #{}: a root blended by a concave fillet; the fillet is built with the feature growing there",
                         b.face(f).step_id
                     ));
                     chains.push(edges);
                 } else {
-                    warnings.push(format!("face #{}: a hole bounded by tangent edges is kept in its parent feature", b.face(f).step_id));
+                    warnings.push(format!(
+                        "face #{}: a hole bounded by tangent edges is kept in its parent feature",
+                        b.face(f).step_id
+                    ));
                 }
             }
         }
@@ -203,7 +250,11 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     // Split, heal, repeat. The parent side of a cut holds the draft's anchor: the build-plate
     // face for the base, the healing faces for a feature split off before.
     let plate = base_reference(&b, &outer, &mut vec![]).face;
-    let mut drafts = vec![Draft { faces: outer.clone(), host: None, heal: vec![] }];
+    let mut drafts = vec![Draft {
+        faces: outer.clone(),
+        host: None,
+        heal: vec![],
+    }];
     let mut done = vec![false; chains.len()];
     let mut unsplit: Vec<usize> = vec![];
     let mut i = 0;
@@ -211,12 +262,21 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
         loop {
             let here: HashSet<FaceId> = drafts[i].faces.iter().copied().collect();
             let live: Vec<usize> = (0..chains.len())
-                .filter(|&k| !done[k] && chains[k].iter().all(|e| edge_faces(&b, *e).iter().any(|f| here.contains(f))))
+                .filter(|&k| {
+                    !done[k]
+                        && chains[k]
+                            .iter()
+                            .all(|e| edge_faces(&b, *e).iter().any(|f| here.contains(f)))
+                })
                 .collect();
             if live.is_empty() {
                 break;
             }
-            let anchor: Vec<FaceId> = if i == 0 { plate.into_iter().collect() } else { drafts[i].heal.clone() };
+            let anchor: Vec<FaceId> = if i == 0 {
+                plate.into_iter().collect()
+            } else {
+                drafts[i].heal.clone()
+            };
             let mut split = false;
             // One chain at a time.
             for &k in &live {
@@ -258,7 +318,11 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     }
 
     if !unsplit.is_empty() {
-        let ids: Vec<String> = unsplit.iter().take(6).map(|&k| format!("#{}", b.edge(chains[k][0]).step_id)).collect();
+        let ids: Vec<String> = unsplit
+            .iter()
+            .take(6)
+            .map(|&k| format!("#{}", b.edge(chains[k][0]).step_id))
+            .collect();
         warnings.push(format!(
             "{} closed concave loop(s) do not bound a feature that can be split off (pocket floors, slots, or roots spread over several faces); kept in their features (through edges {}{})",
             unsplit.len(),
@@ -282,19 +346,30 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     }
 
     // Shells, parents, measures.
-    let owner: HashMap<FaceId, usize> = drafts.iter().enumerate().flat_map(|(k, d)| d.faces.iter().map(move |f| (*f, k))).collect();
+    let owner: HashMap<FaceId, usize> = drafts
+        .iter()
+        .enumerate()
+        .flat_map(|(k, d)| d.faces.iter().map(move |f| (*f, k)))
+        .collect();
     let mut features = vec![];
     for (k, d) in drafts.iter().enumerate() {
         let shell = ShellId(b.shells.len() as u32);
-        b.shells.push(Shell { step_id: 0, faces: d.faces.clone(), void: false });
+        b.shells.push(Shell {
+            step_id: 0,
+            faces: d.faces.clone(),
+            void: false,
+        });
         for f in &d.faces {
             b.faces[f.idx()].shell = shell;
         }
         let fvoids = if k == 0 { voids.clone() } else { vec![] };
-        let volume = vol_of(&shares, &d.faces).abs() - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
+        let volume = vol_of(&shares, &d.faces).abs()
+            - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
         let closed = brep::validate::check_shell(&b, shell).closed;
         if !closed {
-            warnings.push(format!("feature {k}: its shell is not closed after splitting"));
+            warnings.push(format!(
+                "feature {k}: its shell is not closed after splitting"
+            ));
         }
         let (parents, reference) = match &d.host {
             Some((t, _)) => {
@@ -303,7 +378,11 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
             }
             None => (vec![], base_reference(&b, &d.faces, &mut warnings)),
         };
-        let kind = if reference.surface == "plane" || reference.surface == "build_plate" { FeatureKind::Two5d } else { FeatureKind::Freeform };
+        let kind = if reference.surface == "plane" || reference.surface == "build_plate" {
+            FeatureKind::Two5d
+        } else {
+            FeatureKind::Freeform
+        };
         let subtype = match kind {
             FeatureKind::Two5d => two5d_subtype(&b, &d.faces, &reference),
             FeatureKind::Freeform => "brep_freeform".to_string(),
@@ -334,9 +413,17 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
             g.add_edge(nodes[p], nodes[f.id], ());
         }
     }
-    let mut indegree: Vec<usize> = nodes.iter().map(|&n| g.neighbors_directed(n, petgraph::Direction::Incoming).count()).collect();
-    let mut ready: std::collections::BinaryHeap<std::cmp::Reverse<usize>> =
-        (0..features.len()).filter(|&k| indegree[k] == 0).map(std::cmp::Reverse).collect();
+    let mut indegree: Vec<usize> = nodes
+        .iter()
+        .map(|&n| {
+            g.neighbors_directed(n, petgraph::Direction::Incoming)
+                .count()
+        })
+        .collect();
+    let mut ready: std::collections::BinaryHeap<std::cmp::Reverse<usize>> = (0..features.len())
+        .filter(|&k| indegree[k] == 0)
+        .map(std::cmp::Reverse)
+        .collect();
     let mut build_order = vec![];
     while let Some(std::cmp::Reverse(k)) = ready.pop() {
         build_order.push(k);
@@ -353,13 +440,20 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
         build_order = (0..features.len()).collect();
     }
     for &k in &build_order {
-        let d = features[k].parents.iter().map(|&p| features[p].depth + 1).max().unwrap_or(0);
+        let d = features[k]
+            .parents
+            .iter()
+            .map(|&p| features[p].depth + 1)
+            .max()
+            .unwrap_or(0);
         features[k].depth = d;
     }
     let depth = features.iter().map(|f| f.depth).max().unwrap_or(0);
     let sum: f64 = features.iter().map(|f| f.volume).sum();
     if (sum - part_volume).abs() > 5e-3 * part_volume.abs().max(1e-9) {
-        warnings.push(format!("feature volumes add up to {sum:.3} mm^3, the part has {part_volume:.3} mm^3"));
+        warnings.push(format!(
+            "feature volumes add up to {sum:.3} mm^3, the part has {part_volume:.3} mm^3"
+        ));
     }
     Ok(FeatureTree {
         brep: b,
@@ -375,11 +469,14 @@ pub fn extract(part: &Brep, solid: SolidId, opts: &ExtractOptions) -> Result<Fea
     })
 }
 
-
 /// Closed chains of concave edges: connected sets of concave edges in which every vertex joins
 /// exactly two edge ends. Where concave edges branch, each face loop made only of them counts.
 fn concave_chains(b: &Brep, faces: &[FaceId], g: &aag::Aag) -> Vec<Vec<EdgeId>> {
-    let concave: Vec<EdgeId> = b.edges_of(faces).into_iter().filter(|e| g.convexity.get(e) == Some(&Convexity::Concave)).collect();
+    let concave: Vec<EdgeId> = b
+        .edges_of(faces)
+        .into_iter()
+        .filter(|e| g.convexity.get(e) == Some(&Convexity::Concave))
+        .collect();
     let mut at: HashMap<VertexId, Vec<usize>> = HashMap::new();
     for (k, e) in concave.iter().enumerate() {
         let ed = b.edge(*e);
@@ -421,10 +518,18 @@ fn concave_chains(b: &Brep, faces: &[FaceId], g: &aag::Aag) -> Vec<Vec<EdgeId>> 
     if branching {
         for &f in faces {
             for l in &b.face(f).loops {
-                let edges: Vec<EdgeId> = b.loops[l.idx()].coedges.iter().map(|c| b.coedges[c.idx()].edge).collect();
+                let edges: Vec<EdgeId> = b.loops[l.idx()]
+                    .coedges
+                    .iter()
+                    .map(|c| b.coedges[c.idx()].edge)
+                    .collect();
                 if !edges.is_empty()
-                    && edges.iter().all(|e| g.convexity.get(e) == Some(&Convexity::Concave))
-                    && !out.iter().any(|c: &Vec<EdgeId>| c.iter().all(|x| edges.contains(x)) && c.len() == edges.len())
+                    && edges
+                        .iter()
+                        .all(|e| g.convexity.get(e) == Some(&Convexity::Concave))
+                    && !out.iter().any(|c: &Vec<EdgeId>| {
+                        c.iter().all(|x| edges.contains(x)) && c.len() == edges.len()
+                    })
                 {
                     out.push(edges);
                 }
@@ -474,11 +579,15 @@ fn plan_cut(b: &Brep, faces: &[FaceId], anchor: &[FaceId], chains: &[&Vec<EdgeId
     for chain in chains {
         let mut host: Option<FaceId> = None;
         for e in chain.iter() {
-            let fs: Vec<FaceId> = edge_faces(b, *e).into_iter().filter(|f| comps.contains_key(f)).collect();
+            let fs: Vec<FaceId> = edge_faces(b, *e)
+                .into_iter()
+                .filter(|f| comps.contains_key(f))
+                .collect();
             if fs.len() != 2 {
                 return None;
             }
-            let (p, c): (Vec<FaceId>, Vec<FaceId>) = fs.into_iter().partition(|f| comps[f] == parent);
+            let (p, c): (Vec<FaceId>, Vec<FaceId>) =
+                fs.into_iter().partition(|f| comps[f] == parent);
             if p.len() != 1 || c.len() != 1 {
                 return None;
             }
@@ -493,8 +602,15 @@ fn plan_cut(b: &Brep, faces: &[FaceId], anchor: &[FaceId], chains: &[&Vec<EdgeId
     if child.is_empty() || child.contains(&parent) {
         return None;
     }
-    let child_faces: Vec<FaceId> = faces.iter().copied().filter(|f| child.contains(&comps[f])).collect();
-    Some(Cut { child: child_faces, hosts })
+    let child_faces: Vec<FaceId> = faces
+        .iter()
+        .copied()
+        .filter(|f| child.contains(&comps[f]))
+        .collect();
+    Some(Cut {
+        child: child_faces,
+        hosts,
+    })
 }
 
 /// Applies a cut and heals both sides (paper, Fig. 8): each host face drops the chain's edges
@@ -525,17 +641,39 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
         let mut coedges = vec![];
         for (e, fwd) in ordered {
             let nc = CoedgeId(b.coedges.len() as u32);
-            b.coedges.push(Coedge { step_id: 0, edge: e, forward: fwd, lp: nl });
+            b.coedges.push(Coedge {
+                step_id: 0,
+                edge: e,
+                forward: fwd,
+                lp: nl,
+            });
             b.edges[e.idx()].coedges.push(nc);
             coedges.push(nc);
         }
-        b.loops.push(Loop { step_id: 0, face: h, outer: true, coedges, vertex: None });
-        b.faces.push(Face { step_id: 0, surface: host.surface, same_sense: !host.same_sense, loops: vec![nl], shell: host.shell });
+        b.loops.push(Loop {
+            step_id: 0,
+            face: h,
+            outer: true,
+            coedges,
+            vertex: None,
+        });
+        b.faces.push(Face {
+            step_id: 0,
+            surface: host.surface,
+            same_sense: !host.same_sense,
+            loops: vec![nl],
+            shell: host.shell,
+        });
         heal.push(h);
         // The host drops the chain, and seams that now lead nowhere (used twice in a row).
         let mut loops = vec![];
         for l in &host.loops {
-            let mut cs: Vec<CoedgeId> = b.loops[l.idx()].coedges.iter().copied().filter(|c| !chain.contains(&b.coedges[c.idx()].edge)).collect();
+            let mut cs: Vec<CoedgeId> = b.loops[l.idx()]
+                .coedges
+                .iter()
+                .copied()
+                .filter(|c| !chain.contains(&b.coedges[c.idx()].edge))
+                .collect();
             let mut changed = true;
             while changed && cs.len() >= 2 {
                 changed = false;
@@ -552,7 +690,12 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
                     }
                 }
             }
-            if !cs.is_empty() || !b.loops[l.idx()].coedges.iter().any(|c| chain.contains(&b.coedges[c.idx()].edge)) {
+            if !cs.is_empty()
+                || !b.loops[l.idx()]
+                    .coedges
+                    .iter()
+                    .any(|c| chain.contains(&b.coedges[c.idx()].edge))
+            {
                 b.loops[l.idx()].coedges = cs;
                 loops.push(*l);
             }
@@ -560,13 +703,22 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
         b.faces[t.idx()].loops = loops;
     }
     let set: HashSet<FaceId> = cut.child.iter().copied().collect();
-    let parent: Vec<FaceId> = drafts[i].faces.iter().copied().filter(|f| !set.contains(f)).collect();
+    let parent: Vec<FaceId> = drafts[i]
+        .faces
+        .iter()
+        .copied()
+        .filter(|f| !set.contains(f))
+        .collect();
     let mut child = cut.child.clone();
     child.extend(heal.iter().copied());
     // Both sides must close.
     let closed = |b: &mut Brep, faces: &[FaceId]| {
         let s = ShellId(b.shells.len() as u32);
-        b.shells.push(Shell { step_id: 0, faces: faces.to_vec(), void: false });
+        b.shells.push(Shell {
+            step_id: 0,
+            faces: faces.to_vec(),
+            void: false,
+        });
         let ok = brep::validate::check_shell(b, s).closed;
         b.shells.pop();
         ok
@@ -575,7 +727,9 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
     let mut touched: Vec<FaceId> = cut.hosts.iter().map(|(t, _)| *t).collect();
     touched.extend(heal.iter().copied());
     let coarse = brep::mesh::MeshOptions::with_tolerance(0.5);
-    let valid = touched.iter().all(|f| brep::mesh::face_domain(b, *f, &coarse).is_ok_and(|d| !d.loops.is_empty()));
+    let valid = touched
+        .iter()
+        .all(|f| brep::mesh::face_domain(b, *f, &coarse).is_ok_and(|d| !d.loops.is_empty()));
     if !valid || !closed(b, &parent) || !closed(b, &child) {
         *b = saved;
         return false;
@@ -583,7 +737,11 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
     let host = cut.hosts[0].0;
     let loops_n = cut.hosts.len();
     drafts[i].faces = parent;
-    drafts.push(Draft { faces: child, host: Some((host, vec![LoopId(u32::MAX); loops_n])), heal });
+    drafts.push(Draft {
+        faces: child,
+        host: Some((host, vec![LoopId(u32::MAX); loops_n])),
+        heal,
+    });
     true
 }
 
@@ -647,11 +805,11 @@ fn components(b: &Brep, faces: &[FaceId], cut: &HashSet<EdgeId>) -> HashMap<Face
             }
         }
     }
-    faces.iter().map(|f| (*f, find(&mut parent, idx[f]))).collect()
+    faces
+        .iter()
+        .map(|f| (*f, find(&mut parent, idx[f])))
+        .collect()
 }
-
-
-
 
 fn surface_kind(s: &Surface) -> String {
     match s {
@@ -663,7 +821,11 @@ fn surface_kind(s: &Surface) -> String {
 /// A plane's unit normal pointing out of `f` (into whatever grows from it).
 fn plane_normal(b: &Brep, f: FaceId) -> Option<V3> {
     match b.face_surface(f) {
-        Surface::Plane { frame } => Some(if b.face(f).same_sense { frame.z } else { -frame.z }),
+        Surface::Plane { frame } => Some(if b.face(f).same_sense {
+            frame.z
+        } else {
+            -frame.z
+        }),
         _ => None,
     }
 }
@@ -671,18 +833,29 @@ fn plane_normal(b: &Brep, f: FaceId) -> Option<V3> {
 fn host_reference(b: &Brep, t: FaceId) -> Reference {
     let s = b.face_surface(t);
     let normal = plane_normal(b, t).map(|n| [n.x, n.y, n.z]);
-    Reference { surface: surface_kind(s), face: Some(t), step_face: Some(b.face(t).step_id), normal }
+    Reference {
+        surface: surface_kind(s),
+        face: Some(t),
+        step_face: Some(b.face(t).step_id),
+        normal,
+    }
 }
 
 /// The base feature rests on the build plate: its lowest planar face pointing down.
 fn base_reference(b: &Brep, faces: &[FaceId], warnings: &mut Vec<String>) -> Reference {
     let mut best: Option<(f64, FaceId)> = None;
     for &f in faces {
-        let Some(n) = plane_normal(b, f) else { continue };
+        let Some(n) = plane_normal(b, f) else {
+            continue;
+        };
         if n.z > -1.0 + 1e-6 {
             continue;
         }
-        let z = b.vertices_of(&[f]).iter().map(|v| b.vertices[v.idx()].point.z).fold(f64::INFINITY, f64::min);
+        let z = b
+            .vertices_of(&[f])
+            .iter()
+            .map(|v| b.vertices[v.idx()].point.z)
+            .fold(f64::INFINITY, f64::min);
         let z = if z.is_finite() { z } else { 0.0 };
         if best.is_none_or(|(bz, _)| z < bz) {
             best = Some((z, f));
@@ -702,7 +875,9 @@ fn base_reference(b: &Brep, faces: &[FaceId], warnings: &mut Vec<String>) -> Ref
 /// `stretch`: a prism of one planar profile along a direction; `loft`: two planar profiles on
 /// parallel planes joined otherwise; `brep_two5d`: anything else built on a plane.
 fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
-    let Some(n) = r.normal.map(|n| V3::new(n[0], n[1], n[2])) else { return "brep_two5d".into() };
+    let Some(n) = r.normal.map(|n| V3::new(n[0], n[1], n[2])) else {
+        return "brep_two5d".into();
+    };
     let par = |a: &V3, c: &V3| a.cross(c).norm() < 1e-6;
     let mut bottom = vec![];
     let mut top = vec![];
@@ -724,7 +899,8 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
     };
     let coplanar = |fs: &[FaceId]| {
         let l0 = level(fs[0]);
-        fs.iter().all(|&f| (level(f) - l0).abs() <= 1e-6 * (1.0 + l0.abs()))
+        fs.iter()
+            .all(|&f| (level(f) - l0).abs() <= 1e-6 * (1.0 + l0.abs()))
     };
     if !coplanar(&bottom) || !coplanar(&top) {
         return "brep_two5d".into();
@@ -732,9 +908,14 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
     // Every side face runs from the bottom profile to the top one.
     let touches = |f: FaceId, others: &[FaceId]| {
         let mine: HashSet<EdgeId> = b.edges_of(&[f]).into_iter().collect();
-        others.iter().any(|&o| b.edges_of(&[o]).iter().any(|e| mine.contains(e)))
+        others
+            .iter()
+            .any(|&o| b.edges_of(&[o]).iter().any(|e| mine.contains(e)))
     };
-    if !sides.iter().all(|&f| touches(f, &bottom) && touches(f, &top)) {
+    if !sides
+        .iter()
+        .all(|&f| touches(f, &bottom) && touches(f, &top))
+    {
         return "brep_two5d".into();
     }
     // Directions every side face could be swept along.
@@ -761,7 +942,10 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
         Surface::Extrusion { dir, .. } => par(dir, d),
         _ => false,
     };
-    if dirs.iter().any(|d| d.dot(&n).abs() > 1e-6 && sides.iter().all(|&f| contains(f, d))) {
+    if dirs
+        .iter()
+        .any(|d| d.dot(&n).abs() > 1e-6 && sides.iter().all(|&f| contains(f, d)))
+    {
         "stretch".into()
     } else {
         "loft".into()

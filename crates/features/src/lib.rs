@@ -7,4 +7,6 @@
 pub mod aag;
 pub mod extract;
 
-pub use extract::{extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference};
+pub use extract::{
+    extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference,
+};

@@ -11,9 +11,24 @@ fn tree_text(name: &str) -> String {
     let part = brep::read_step(dir.join(format!("{name}.step"))).expect("reads");
     let t = extract(&part.brep, SolidId(0), &ExtractOptions::default()).expect("extracts");
     let mut s = String::new();
-    let _ = writeln!(s, "part volume {:.1} mm^3, genus {:?}, depth {}", t.part_volume, t.genus, t.depth);
+    let _ = writeln!(
+        s,
+        "part volume {:.1} mm^3, genus {:?}, depth {}",
+        t.part_volume, t.genus, t.depth
+    );
     for f in &t.features {
-        let n = f.reference.normal.map(|n| format!(" normal ({:.3}, {:.3}, {:.3})", n[0] + 0.0, n[1] + 0.0, n[2] + 0.0)).unwrap_or_default();
+        let n = f
+            .reference
+            .normal
+            .map(|n| {
+                format!(
+                    " normal ({:.3}, {:.3}, {:.3})",
+                    n[0] + 0.0,
+                    n[1] + 0.0,
+                    n[2] + 0.0
+                )
+            })
+            .unwrap_or_default();
         let _ = writeln!(
             s,
             "feature {}: {} {} on {}{} parents {:?} depth {} root_loops {} volume {:.1}",
@@ -44,7 +59,17 @@ macro_rules! snap {
     )*};
 }
 
-snap!(impeller, capsule, fan, plate_boss_boss, sphere_boss, arch, inch_block, boss_fillet, void_box);
+snap!(
+    impeller,
+    capsule,
+    fan,
+    plate_boss_boss,
+    sphere_boss,
+    arch,
+    inch_block,
+    boss_fillet,
+    void_box
+);
 
 #[test]
 fn box_fixture() {

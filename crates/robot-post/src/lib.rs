@@ -1,1 +1,19 @@
-//! robot-post: placeholder until its issue lands.
+//! robot-post: the programs a machine runs, written from a planned tool path.
+//!
+//! - [`machine`]: machine profiles ([`MachineProfile`]), read from TOML; the built-in ones are
+//!   the files in the repository's `profiles/` folder.
+//! - [`toolpath`]: the planned path the posts consume ([`ToolPath`] of [`PathPoint`]s), from the
+//!   slicer (re-exported).
+//! - [`marlin`](mod@marlin): 3-axis Marlin G-code for paths whose tool axis is +Z throughout.
+//!
+//! Every fallible function returns a [`PostError`] whose message is one line.
+
+pub mod error;
+pub mod machine;
+pub mod marlin;
+pub use slicer::toolpath;
+
+pub use error::PostError;
+pub use machine::{MachineKind, MachineProfile};
+pub use marlin::marlin;
+pub use toolpath::{MoveKind, PathPoint, ToolPath};

@@ -1,1 +1,18 @@
-//! slicer: placeholder until its issue lands.
+//! slicer: layers and tool paths of the feature-based planner (issue "features plan").
+//!
+//! - [`params`]: a feature's layer parameters (the paper's process keys) with defaults,
+//!   validation, per-feature patches and the layer thicknesses they give;
+//! - [`fill`]: filling one planar layer by path mode (raster, zig-zag, contour,
+//!   contour-zig-zag) and ordering the paths for print;
+//! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
+//! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume.
+//!
+//! Polygon offsets and booleans come from the `i_overlay` crate.
+
+pub mod fill;
+pub mod params;
+pub mod planar;
+pub mod toolpath;
+
+pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
+pub use params::{LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

@@ -1,0 +1,311 @@
+//! Machine profiles: what the machine is (nozzle, filament, bead, speeds, temperatures, bed),
+//! read from TOML. The built-in profiles are the commented files in the repository's
+//! `profiles/` folder, compiled in with `include_str!`, so a user can copy one and edit it.
+
+use std::fmt;
+
+use crate::PostError;
+
+/// The bundled `profiles/marlin.toml`: a generic 220x220x250 mm Marlin printer.
+pub const MARLIN_TOML: &str = include_str!("../../../profiles/marlin.toml");
+/// The bundled `profiles/delta5.toml`: a generic 5-axis printer.
+pub const DELTA5_TOML: &str = include_str!("../../../profiles/delta5.toml");
+/// The bundled `profiles/kuka.toml`: a generic KUKA robot deposition cell.
+pub const KUKA_TOML: &str = include_str!("../../../profiles/kuka.toml");
+/// The bundled `profiles/process.toml`: the process file format (`[defaults]` and
+/// `[features.<id>]` tables) with its default values, for the planner and for users to copy.
+pub const PROCESS_TOML: &str = include_str!("../../../profiles/process.toml");
+
+/// Which post writes the program, and so which motions the machine has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MachineKind {
+    /// A 3-axis Marlin printer: tool axis +Z only.
+    Marlin,
+    /// A 5-axis printer (three linear axes and a tilting/rotary table).
+    Delta5,
+    /// A KUKA robot deposition cell.
+    Kuka,
+}
+
+impl MachineKind {
+    /// Every kind, in declaration order.
+    pub const ALL: [MachineKind; 3] = [MachineKind::Marlin, MachineKind::Delta5, MachineKind::Kuka];
+
+    /// The kind's name as written in profiles and on the command line (`marlin`, `delta5`,
+    /// `kuka`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MachineKind::Marlin => "marlin",
+            MachineKind::Delta5 => "delta5",
+            MachineKind::Kuka => "kuka",
+        }
+    }
+
+    /// The kind named `name` (as [`MachineKind::as_str`] writes it), if any.
+    pub fn from_name(name: &str) -> Option<MachineKind> {
+        MachineKind::ALL.into_iter().find(|k| k.as_str() == name)
+    }
+}
+
+impl fmt::Display for MachineKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A machine profile. Lengths in mm, speeds in mm/s, temperatures in °C. The TOML form has
+/// exactly these keys (unknown keys are refused); see `profiles/marlin.toml` for each key's
+/// meaning.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineProfile {
+    /// Human-readable name, written in program headers.
+    pub name: String,
+    /// Which post the profile is for.
+    pub kind: MachineKind,
+    /// Nozzle bore (mm).
+    pub nozzle_diameter: f64,
+    /// Filament diameter D (mm), for the extrusion of Isa & Lazoglu 2019, Eq. 1.
+    pub filament_diameter: f64,
+    /// Bead width w (mm).
+    pub bead_width: f64,
+    /// Printing speed (mm/s).
+    pub print_speed: f64,
+    /// Printing speed of beads resting on the build plate (mm/s).
+    pub first_layer_speed: f64,
+    /// Travel speed (mm/s).
+    pub travel_speed: f64,
+    /// Nozzle temperature (°C).
+    pub nozzle_temperature: f64,
+    /// Bed temperature (°C); 0 for no heated bed.
+    pub bed_temperature: f64,
+    /// Printable size in X, Y and Z (mm).
+    pub bed_size: [f64; 3],
+    /// true: the machine's X0 Y0 is the bed centre (deltas, rotary tables); false: X0 Y0 is a
+    /// bed corner, so the bed spans `0..bed_size` in X and Y. Either way the post places the
+    /// part's XY bounding-box centre on the bed centre.
+    pub bed_origin_centre: bool,
+    /// Filament retracted before a travel that follows printing (mm); 0 for none.
+    pub retraction_length: f64,
+    /// Speed of retraction and un-retraction (mm/s).
+    pub retraction_speed: f64,
+    /// Nozzle lift during travel moves (mm); 0 for none.
+    pub z_hop: f64,
+}
+
+impl MachineProfile {
+    /// The built-in profile of `kind`, parsed from the bundled `profiles/<kind>.toml`.
+    pub fn builtin(kind: MachineKind) -> MachineProfile {
+        let text = match kind {
+            MachineKind::Marlin => MARLIN_TOML,
+            MachineKind::Delta5 => DELTA5_TOML,
+            MachineKind::Kuka => KUKA_TOML,
+        };
+        // The bundled files are checked by the test `builtin_profiles_parse_and_validate`.
+        MachineProfile::from_toml(text).expect("bundled machine profile is valid")
+    }
+
+    /// Reads a profile from TOML text and validates it ([`MachineProfile::validate`]).
+    pub fn from_toml(text: &str) -> Result<Self, PostError> {
+        let profile: MachineProfile = toml::from_str(text).map_err(|e| {
+            let message = one_line(e.message());
+            match e.span().and_then(|s| text.get(..s.start)) {
+                Some(before) => {
+                    let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
+                    PostError::ProfileSyntax(format!("line {line}: {message}"))
+                }
+                None => PostError::ProfileSyntax(message),
+            }
+        })?;
+        profile.validate()?;
+        Ok(profile)
+    }
+
+    /// The profile as TOML text (without the comments of the bundled files).
+    pub fn to_toml(&self) -> String {
+        // Serialising a struct of strings, numbers and an array cannot fail.
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Checks that every figure is finite and in range: diameters, widths, speeds and bed
+    /// sizes positive; temperatures, retraction and z-hop not negative (and temperatures
+    /// below 500 °C); the name not empty.
+    pub fn validate(&self) -> Result<(), PostError> {
+        let bad = |field: &'static str, reason: String| PostError::ProfileValue {
+            name: self.name.clone(),
+            field,
+            reason,
+        };
+        if self.name.trim().is_empty() {
+            return Err(bad("name", "must not be empty".into()));
+        }
+        let positive = [
+            ("nozzle_diameter", self.nozzle_diameter),
+            ("filament_diameter", self.filament_diameter),
+            ("bead_width", self.bead_width),
+            ("print_speed", self.print_speed),
+            ("first_layer_speed", self.first_layer_speed),
+            ("travel_speed", self.travel_speed),
+            ("retraction_speed", self.retraction_speed),
+            ("bed_size", self.bed_size[0]),
+            ("bed_size", self.bed_size[1]),
+            ("bed_size", self.bed_size[2]),
+        ];
+        for (field, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(field, format!("must be a positive number, got {v}")));
+            }
+        }
+        let non_negative = [
+            ("nozzle_temperature", self.nozzle_temperature),
+            ("bed_temperature", self.bed_temperature),
+            ("retraction_length", self.retraction_length),
+            ("z_hop", self.z_hop),
+        ];
+        for (field, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(bad(field, format!("must be zero or positive, got {v}")));
+            }
+        }
+        for (field, v) in [
+            ("nozzle_temperature", self.nozzle_temperature),
+            ("bed_temperature", self.bed_temperature),
+        ] {
+            if v >= 500.0 {
+                return Err(bad(field, format!("must be below 500 °C, got {v}")));
+            }
+        }
+        // Figures past these are typos (mm for µm, mm/min for mm/s), and would make absurd
+        // programs.
+        for (field, v, max) in [
+            ("nozzle_diameter", self.nozzle_diameter, 50.0),
+            ("filament_diameter", self.filament_diameter, 50.0),
+            ("bead_width", self.bead_width, 50.0),
+            ("print_speed", self.print_speed, 10_000.0),
+            ("first_layer_speed", self.first_layer_speed, 10_000.0),
+            ("travel_speed", self.travel_speed, 10_000.0),
+            ("retraction_speed", self.retraction_speed, 10_000.0),
+            ("retraction_length", self.retraction_length, 1_000.0),
+            ("z_hop", self.z_hop, 1_000.0),
+            ("bed_size", self.bed_size[0], 1e6),
+            ("bed_size", self.bed_size[1], 1e6),
+            ("bed_size", self.bed_size[2], 1e6),
+        ] {
+            if v > max {
+                return Err(bad(field, format!("must be at most {max}, got {v}")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Filament length (mm) fed for a bead of width `w`, thickness `dl` and length `len`:
+    /// `4·w·dl·len / (π·D²)` with this profile's filament diameter D (Isa & Lazoglu 2019,
+    /// Eq. 1). For planners; the posts only write the `e` the planner computed.
+    pub fn filament_length(&self, w: f64, dl: f64, len: f64) -> f64 {
+        4.0 * w * dl * len
+            / (std::f64::consts::PI * self.filament_diameter * self.filament_diameter)
+    }
+}
+
+/// `s` on one line: line breaks and runs of spaces become single spaces.
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_profiles_parse_and_validate() {
+        for kind in MachineKind::ALL {
+            let p = MachineProfile::builtin(kind);
+            assert_eq!(p.kind, kind);
+            p.validate().unwrap();
+            assert_eq!(p.nozzle_diameter, 0.4);
+            assert_eq!(p.filament_diameter, 1.75);
+            assert_eq!(p.bead_width, 0.45);
+            assert_eq!(p.print_speed, 40.0);
+            assert_eq!(p.first_layer_speed, 20.0);
+            assert_eq!(p.travel_speed, 120.0);
+            assert_eq!((p.nozzle_temperature, p.bed_temperature), (210.0, 60.0));
+            assert_eq!((p.retraction_length, p.retraction_speed), (0.8, 35.0));
+            assert_eq!(p.z_hop, 0.2);
+            assert_eq!(MachineKind::from_name(kind.as_str()), Some(kind));
+        }
+        let m = MachineProfile::builtin(MachineKind::Marlin);
+        assert_eq!(m.bed_size, [220.0, 220.0, 250.0]);
+        assert!(!m.bed_origin_centre);
+    }
+
+    #[test]
+    fn profile_toml_round_trip() {
+        let m = MachineProfile::builtin(MachineKind::Kuka);
+        assert_eq!(MachineProfile::from_toml(&m.to_toml()).unwrap(), m);
+    }
+
+    #[test]
+    fn profile_errors_are_one_line() {
+        let unknown = MARLIN_TOML.replace("z_hop = 0.2", "z_hop = 0.2\nzhop = 1.0");
+        let missing = MARLIN_TOML.replace("z_hop = 0.2", "");
+        let bad_kind = MARLIN_TOML.replace("kind = \"marlin\"", "kind = \"prusa\"");
+        let negative = MARLIN_TOML.replace("print_speed = 40.0", "print_speed = -40.0");
+        let nan = MARLIN_TOML.replace("bead_width = 0.45", "bead_width = nan");
+        let hot = MARLIN_TOML.replace("nozzle_temperature = 210.0", "nozzle_temperature = 2100.0");
+        for (text, needle) in [
+            (unknown.as_str(), "zhop"),
+            (missing.as_str(), "z_hop"),
+            (bad_kind.as_str(), "prusa"),
+            (negative.as_str(), "print_speed"),
+            (nan.as_str(), "bead_width"),
+            (hot.as_str(), "nozzle_temperature"),
+            ("", "name"),
+            ("\u{0}\u{ff}[[[", "machine profile"),
+        ] {
+            let e = MachineProfile::from_toml(text).unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+        let e = MachineProfile::from_toml(&unknown).unwrap_err().to_string();
+        assert!(e.contains("line "), "{e}");
+    }
+
+    #[test]
+    fn process_file_documents_the_defaults() {
+        let v: toml::Table = toml::from_str(PROCESS_TOML).unwrap();
+        let d = v["defaults"].as_table().unwrap();
+        assert!(d["tolerance"].as_float().unwrap() > 0.0);
+        assert_eq!(d["layer_height_pattern"].as_str(), Some("uniform"));
+        assert_eq!(d["uniform_layer_height"].as_float(), Some(0.2));
+        assert_eq!(d["path_mode"].as_str(), Some("contour_zigzag"));
+        assert_eq!(d["filling_ratio"].as_float(), Some(1.0));
+        assert_eq!(d["perimeters"].as_integer(), Some(2));
+        assert_eq!(d["raster_angle_deg"].as_float(), Some(45.0));
+        // The example override is commented out, and valid once uncommented.
+        assert!(!v.contains_key("features"));
+        let uncommented: String = PROCESS_TOML
+            .lines()
+            .map(|l| {
+                l.strip_prefix("# ")
+                    .filter(|r| r.starts_with("[features.") || r.contains(" = "))
+                    .unwrap_or(l)
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let v: toml::Table = toml::from_str(&uncommented).unwrap();
+        assert!(v["features"]["1"]
+            .as_table()
+            .unwrap()
+            .contains_key("perimeters"));
+    }
+
+    #[test]
+    fn extrusion_follows_isa_lazoglu_eq1() {
+        let m = MachineProfile::builtin(MachineKind::Marlin);
+        // 0.45 x 0.2 bead, 10 mm long, 1.75 mm filament: 0.9 mm³ / 2.405 mm² = 0.37418 mm.
+        let e = m.filament_length(0.45, 0.2, 10.0);
+        assert!((e - 0.9 / (std::f64::consts::PI * 1.75 * 1.75 / 4.0)).abs() < 1e-12);
+        assert!((e - 0.37418).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,494 @@
+//! Layer parameters of a feature (the paper's per-feature process keys) and their defaults.
+//!
+//! A process file gives one [`LayerParams`] for the whole part and, per feature, a
+//! [`LayerParamsPatch`] that overrides some keys ([`LayerParams::patched`]). Both read and write
+//! with serde using the paper's key names (`layer_height_pattern`, `path_mode`, ...); enum values
+//! are snake case (`uniform`, `contour_zigzag`). A misspelled key is an error, not a silent
+//! default.
+
+use serde::{Deserialize, Serialize};
+
+/// The most layers [`LayerParams::layer_heights`] returns; more means the parameters are wrong
+/// (a 1 m part at 1 µm layers), and an empty list is returned instead of exhausting memory.
+pub const MAX_LAYERS: usize = 1_000_000;
+
+/// How a planar layer is filled (the paper's `path_mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PathMode {
+    /// Parallel lines in one direction, each a separate path, all printed the same way.
+    Raster,
+    /// The raster lines joined into continuous paths; the direction turns 90° every layer.
+    Zigzag,
+    /// Successive inward offsets of the boundary until the region is used up.
+    Contour,
+    /// `perimeters` offsets of the boundary, then zig-zag infill inside them.
+    ContourZigzag,
+}
+
+/// How layer thicknesses are chosen (the paper's `layer_height_pattern`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerHeightPattern {
+    /// Every layer `uniform_layer_height` thick (adjusted so the top lands on the top).
+    Uniform,
+    /// Layer `i` is `adaptive_layer_height[i]` thick (the list repeats if it is short).
+    Adaptive,
+}
+
+/// Layer and path parameters of one feature.
+///
+/// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
+/// unknown keys are an error.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LayerParams {
+    /// Geometric tolerance, mm (chords of curved boundaries and offsets). Default 0.05.
+    pub tolerance: f64,
+    /// Uniform or adaptive layer thickness. Default uniform.
+    pub layer_height_pattern: LayerHeightPattern,
+    /// Layer thickness for the uniform pattern, mm. Default 0.2.
+    pub uniform_layer_height: f64,
+    /// Thickness of successive layers for the adaptive pattern, mm. Default empty.
+    pub adaptive_layer_height: Vec<f64>,
+    /// Spacing between neighbouring path centre lines, mm; `None` (the default) means bead width
+    /// divided by `filling_ratio`.
+    pub uniform_offset: Option<f64>,
+    /// Spacing per layer for the adaptive pattern, mm (repeats if short); empty (the default)
+    /// means the uniform spacing on every layer.
+    pub adaptive_offset: Vec<f64>,
+    /// Fill pattern. Default `contour_zigzag`.
+    pub path_mode: PathMode,
+    /// Bead width over path spacing, in (0, 1]. Default 1 (beads touch).
+    pub filling_ratio: f64,
+    /// Number of perimeters for `contour_zigzag`. Default 2.
+    pub perimeters: usize,
+    /// Direction of raster and zig-zag lines, degrees from +x. Default 45; zig-zag adds 90° on
+    /// odd layers.
+    pub raster_angle_deg: f64,
+}
+
+impl Default for LayerParams {
+    fn default() -> Self {
+        LayerParams {
+            tolerance: 0.05,
+            layer_height_pattern: LayerHeightPattern::Uniform,
+            uniform_layer_height: 0.2,
+            adaptive_layer_height: Vec::new(),
+            uniform_offset: None,
+            adaptive_offset: Vec::new(),
+            path_mode: PathMode::ContourZigzag,
+            filling_ratio: 1.0,
+            perimeters: 2,
+            raster_angle_deg: 45.0,
+        }
+    }
+}
+
+impl LayerParams {
+    /// Spacing between neighbouring path centre lines for a bead `bead_width` mm wide:
+    /// `uniform_offset` if given, else `bead_width / filling_ratio`.
+    ///
+    /// Meaningful only for parameters that pass [`LayerParams::validate`].
+    pub fn spacing(&self, bead_width: f64) -> f64 {
+        match self.uniform_offset {
+            Some(s) => s,
+            None => bead_width / self.filling_ratio,
+        }
+    }
+
+    /// Spacing for layer number `layer`: with the adaptive pattern and a non-empty
+    /// `adaptive_offset`, that list's entry for the layer (the list repeats); otherwise
+    /// [`LayerParams::spacing`].
+    pub fn spacing_for_layer(&self, bead_width: f64, layer: usize) -> f64 {
+        match self.layer_height_pattern {
+            LayerHeightPattern::Adaptive if !self.adaptive_offset.is_empty() => {
+                self.adaptive_offset[layer % self.adaptive_offset.len()]
+            }
+            _ => self.spacing(bead_width),
+        }
+    }
+
+    /// Thicknesses of successive layers stacking up to `extent` mm.
+    ///
+    /// - uniform: `n = ceil(extent / h - 1e-9)` layers of `extent / n` each, so the top of the
+    ///   last layer lands on the top;
+    /// - adaptive: the `adaptive_layer_height` list, repeated or cut short to cover `extent`,
+    ///   the last layer trimmed to end on the top (a remainder under 1e-9 mm is merged into the
+    ///   layer below rather than kept as a sliver).
+    ///
+    /// Empty when `extent` is not positive and finite, when the parameters fail
+    /// [`LayerParams::validate`] for the heights, or when more than [`MAX_LAYERS`] layers would
+    /// be needed.
+    pub fn layer_heights(&self, extent: f64) -> Vec<f64> {
+        if !(extent.is_finite() && extent > 0.0) {
+            return Vec::new();
+        }
+        match self.layer_height_pattern {
+            LayerHeightPattern::Uniform => {
+                let h = self.uniform_layer_height;
+                if !(h.is_finite() && h > 0.0) {
+                    return Vec::new();
+                }
+                let n = (extent / h - 1e-9).ceil().max(1.0);
+                if !n.is_finite() || n > MAX_LAYERS as f64 {
+                    return Vec::new();
+                }
+                let n = n as usize;
+                vec![extent / n as f64; n]
+            }
+            LayerHeightPattern::Adaptive => {
+                let list = &self.adaptive_layer_height;
+                if list.is_empty() || list.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
+                    return Vec::new();
+                }
+                let eps = 1e-9;
+                let mut out = Vec::new();
+                let mut z = 0.0;
+                for &h in list.iter().cycle() {
+                    let remaining = extent - z;
+                    if remaining <= eps {
+                        break;
+                    }
+                    if out.len() >= MAX_LAYERS {
+                        return Vec::new();
+                    }
+                    let dl = h.min(remaining);
+                    out.push(dl);
+                    z += dl;
+                }
+                // Land exactly on the top: a sub-eps remainder goes into the last layer.
+                if let Some(last) = out.last_mut() {
+                    *last += extent - z;
+                }
+                out
+            }
+        }
+    }
+
+    /// Checks the parameters; the error is one line naming the offending key.
+    pub fn validate(&self) -> Result<(), String> {
+        fn positive(key: &str, v: f64) -> Result<(), String> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{key} must be a positive number of mm, got {v}"))
+            }
+        }
+        positive("tolerance", self.tolerance)?;
+        positive("uniform_layer_height", self.uniform_layer_height)?;
+        for (i, &h) in self.adaptive_layer_height.iter().enumerate() {
+            positive(&format!("adaptive_layer_height[{i}]"), h)?;
+        }
+        if self.layer_height_pattern == LayerHeightPattern::Adaptive
+            && self.adaptive_layer_height.is_empty()
+        {
+            return Err(
+                "adaptive_layer_height must list at least one height when layer_height_pattern is adaptive"
+                    .to_string(),
+            );
+        }
+        if let Some(s) = self.uniform_offset {
+            positive("uniform_offset", s)?;
+        }
+        for (i, &s) in self.adaptive_offset.iter().enumerate() {
+            positive(&format!("adaptive_offset[{i}]"), s)?;
+        }
+        let r = self.filling_ratio;
+        if !(r.is_finite() && r > 0.0 && r <= 1.0) {
+            return Err(format!("filling_ratio must be in (0, 1], got {r}"));
+        }
+        if !self.raster_angle_deg.is_finite() {
+            return Err(format!(
+                "raster_angle_deg must be a finite number of degrees, got {}",
+                self.raster_angle_deg
+            ));
+        }
+        Ok(())
+    }
+
+    /// These parameters with every key the patch sets replaced by the patch's value.
+    pub fn patched(&self, p: &LayerParamsPatch) -> LayerParams {
+        let mut out = self.clone();
+        if let Some(v) = p.tolerance {
+            out.tolerance = v;
+        }
+        if let Some(v) = p.layer_height_pattern {
+            out.layer_height_pattern = v;
+        }
+        if let Some(v) = p.uniform_layer_height {
+            out.uniform_layer_height = v;
+        }
+        if let Some(v) = &p.adaptive_layer_height {
+            out.adaptive_layer_height = v.clone();
+        }
+        if let Some(v) = p.uniform_offset {
+            out.uniform_offset = Some(v);
+        }
+        if let Some(v) = &p.adaptive_offset {
+            out.adaptive_offset = v.clone();
+        }
+        if let Some(v) = p.path_mode {
+            out.path_mode = v;
+        }
+        if let Some(v) = p.filling_ratio {
+            out.filling_ratio = v;
+        }
+        if let Some(v) = p.perimeters {
+            out.perimeters = v;
+        }
+        if let Some(v) = p.raster_angle_deg {
+            out.raster_angle_deg = v;
+        }
+        out
+    }
+}
+
+/// Per-feature overrides of [`LayerParams`]: every key optional, unknown keys an error.
+///
+/// `uniform_offset` here sets a spacing; a patch cannot reset it to "bead width / filling ratio".
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LayerParamsPatch {
+    /// Overrides [`LayerParams::tolerance`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Overrides [`LayerParams::layer_height_pattern`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layer_height_pattern: Option<LayerHeightPattern>,
+    /// Overrides [`LayerParams::uniform_layer_height`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uniform_layer_height: Option<f64>,
+    /// Overrides [`LayerParams::adaptive_layer_height`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive_layer_height: Option<Vec<f64>>,
+    /// Overrides [`LayerParams::uniform_offset`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uniform_offset: Option<f64>,
+    /// Overrides [`LayerParams::adaptive_offset`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive_offset: Option<Vec<f64>>,
+    /// Overrides [`LayerParams::path_mode`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path_mode: Option<PathMode>,
+    /// Overrides [`LayerParams::filling_ratio`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub filling_ratio: Option<f64>,
+    /// Overrides [`LayerParams::perimeters`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub perimeters: Option<usize>,
+    /// Overrides [`LayerParams::raster_angle_deg`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub raster_angle_deg: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_match_the_issue() {
+        let p = LayerParams::default();
+        assert_eq!(p.tolerance, 0.05);
+        assert_eq!(p.layer_height_pattern, LayerHeightPattern::Uniform);
+        assert_eq!(p.uniform_layer_height, 0.2);
+        assert!(p.adaptive_layer_height.is_empty());
+        assert_eq!(p.uniform_offset, None);
+        assert!(p.adaptive_offset.is_empty());
+        assert_eq!(p.path_mode, PathMode::ContourZigzag);
+        assert_eq!(p.filling_ratio, 1.0);
+        assert_eq!(p.perimeters, 2);
+        assert_eq!(p.raster_angle_deg, 45.0);
+        assert_eq!(p.validate(), Ok(()));
+    }
+
+    #[test]
+    fn spacing_is_width_over_filling_ratio_unless_given() {
+        let mut p = LayerParams {
+            filling_ratio: 0.8,
+            ..LayerParams::default()
+        };
+        assert!((p.spacing(0.4) - 0.5).abs() < 1e-12);
+        p.uniform_offset = Some(0.45);
+        assert_eq!(p.spacing(0.4), 0.45);
+        assert_eq!(p.spacing_for_layer(0.4, 3), 0.45);
+        p.layer_height_pattern = LayerHeightPattern::Adaptive;
+        p.adaptive_layer_height = vec![0.2];
+        p.adaptive_offset = vec![0.4, 0.5];
+        assert_eq!(p.spacing_for_layer(0.4, 0), 0.4);
+        assert_eq!(p.spacing_for_layer(0.4, 3), 0.5);
+    }
+
+    #[test]
+    fn uniform_heights_land_on_the_top() {
+        let p = LayerParams::default();
+        let h = p.layer_heights(10.0);
+        assert_eq!(h.len(), 50);
+        assert!((h.iter().sum::<f64>() - 10.0).abs() < 1e-9);
+        // 1.05 / 0.2 = 5.25 -> 6 layers of 0.175.
+        let h = p.layer_heights(1.05);
+        assert_eq!(h.len(), 6);
+        assert!(h.iter().all(|&t| (t - 0.175).abs() < 1e-12));
+        // Thinner than a layer: one layer of the whole extent.
+        assert_eq!(p.layer_heights(0.05), vec![0.05]);
+        assert!(p.layer_heights(0.0).is_empty());
+        assert!(p.layer_heights(-1.0).is_empty());
+        assert!(p.layer_heights(f64::NAN).is_empty());
+        assert!(p.layer_heights(f64::INFINITY).is_empty());
+    }
+
+    #[test]
+    fn adaptive_heights_cycle_and_trim() {
+        let p = LayerParams {
+            layer_height_pattern: LayerHeightPattern::Adaptive,
+            adaptive_layer_height: vec![0.1, 0.2, 0.3],
+            ..LayerParams::default()
+        };
+        let h = p.layer_heights(1.0);
+        // 0.1 0.2 0.3 0.1 0.2 | 0.1 trimmed from 0.3
+        assert_eq!(h.len(), 6);
+        for (a, b) in h.iter().zip([0.1, 0.2, 0.3, 0.1, 0.2, 0.1]) {
+            assert!((a - b).abs() < 1e-9, "{h:?}");
+        }
+        assert!((h.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        // Shorter than the list: truncated.
+        let h = p.layer_heights(0.25);
+        assert_eq!(h.len(), 2);
+        assert!((h[1] - 0.15).abs() < 1e-12);
+        // An exact multiple leaves no sliver.
+        let h = p.layer_heights(0.6);
+        assert_eq!(h.len(), 3);
+        // Empty list: nothing (validate says why).
+        let q = LayerParams {
+            adaptive_layer_height: vec![],
+            ..p.clone()
+        };
+        assert!(q.layer_heights(1.0).is_empty());
+        assert!(q.validate().unwrap_err().contains("adaptive_layer_height"));
+    }
+
+    #[test]
+    fn absurd_layer_counts_give_nothing() {
+        let p = LayerParams {
+            uniform_layer_height: 1e-9,
+            ..LayerParams::default()
+        };
+        assert!(p.layer_heights(1000.0).is_empty());
+        let p = LayerParams {
+            layer_height_pattern: LayerHeightPattern::Adaptive,
+            adaptive_layer_height: vec![1e-9],
+            ..LayerParams::default()
+        };
+        assert!(p.layer_heights(1000.0).is_empty());
+    }
+
+    #[test]
+    fn validate_names_the_key() {
+        let bad = |f: fn(&mut LayerParams), key: &str| {
+            let mut p = LayerParams::default();
+            f(&mut p);
+            let e = p.validate().unwrap_err();
+            assert!(e.contains(key), "{e}");
+            assert!(!e.contains('\n'));
+        };
+        bad(|p| p.tolerance = 0.0, "tolerance");
+        bad(|p| p.uniform_layer_height = -0.2, "uniform_layer_height");
+        bad(
+            |p| p.uniform_layer_height = f64::NAN,
+            "uniform_layer_height",
+        );
+        bad(
+            |p| p.adaptive_layer_height = vec![0.2, 0.0],
+            "adaptive_layer_height[1]",
+        );
+        bad(|p| p.uniform_offset = Some(0.0), "uniform_offset");
+        bad(
+            |p| p.adaptive_offset = vec![f64::INFINITY],
+            "adaptive_offset[0]",
+        );
+        bad(|p| p.filling_ratio = 0.0, "filling_ratio");
+        bad(|p| p.filling_ratio = 1.01, "filling_ratio");
+        bad(|p| p.raster_angle_deg = f64::NAN, "raster_angle_deg");
+        let p = LayerParams {
+            filling_ratio: 1.0,
+            ..LayerParams::default()
+        };
+        assert_eq!(p.validate(), Ok(()));
+    }
+
+    #[test]
+    fn serde_uses_the_paper_keys() {
+        let p: LayerParams = serde_json::from_str(
+            r#"{"layer_height_pattern":"adaptive","adaptive_layer_height":[0.1,0.2],
+                "path_mode":"contour_zigzag","filling_ratio":0.9}"#,
+        )
+        .unwrap();
+        assert_eq!(p.layer_height_pattern, LayerHeightPattern::Adaptive);
+        assert_eq!(p.adaptive_layer_height, vec![0.1, 0.2]);
+        assert_eq!(p.filling_ratio, 0.9);
+        assert_eq!(p.tolerance, 0.05);
+        let p: LayerParams = serde_json::from_str("{}").unwrap();
+        assert_eq!(p, LayerParams::default());
+        let json = serde_json::to_string(&LayerParams::default()).unwrap();
+        assert!(json.contains(r#""path_mode":"contour_zigzag""#), "{json}");
+        assert!(
+            json.contains(r#""layer_height_pattern":"uniform""#),
+            "{json}"
+        );
+        let back: LayerParams = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, LayerParams::default());
+        for (s, m) in [
+            ("raster", PathMode::Raster),
+            ("zigzag", PathMode::Zigzag),
+            ("contour", PathMode::Contour),
+            ("contour_zigzag", PathMode::ContourZigzag),
+        ] {
+            assert_eq!(
+                serde_json::from_str::<PathMode>(&format!("\"{s}\"")).unwrap(),
+                m
+            );
+        }
+        assert!(serde_json::from_str::<LayerParams>(r#"{"layer_hieght":0.2}"#).is_err());
+        assert!(serde_json::from_str::<LayerParams>(r#"{"path_mode":"spiral"}"#).is_err());
+    }
+
+    #[test]
+    fn patch_overrides_only_what_it_sets() {
+        let base = LayerParams::default();
+        let patch: LayerParamsPatch =
+            serde_json::from_str(r#"{"path_mode":"raster","uniform_offset":0.5,"perimeters":3}"#)
+                .unwrap();
+        let p = base.patched(&patch);
+        assert_eq!(p.path_mode, PathMode::Raster);
+        assert_eq!(p.uniform_offset, Some(0.5));
+        assert_eq!(p.perimeters, 3);
+        assert_eq!(p.tolerance, base.tolerance);
+        assert_eq!(p.raster_angle_deg, base.raster_angle_deg);
+        assert_eq!(base.patched(&LayerParamsPatch::default()), base);
+        let all: LayerParamsPatch = serde_json::from_str(
+            r#"{"tolerance":0.01,"layer_height_pattern":"adaptive","uniform_layer_height":0.3,
+                "adaptive_layer_height":[0.1],"uniform_offset":0.4,"adaptive_offset":[0.4],
+                "path_mode":"zigzag","filling_ratio":0.5,"perimeters":1,"raster_angle_deg":0}"#,
+        )
+        .unwrap();
+        let p = base.patched(&all);
+        assert_eq!(p.tolerance, 0.01);
+        assert_eq!(p.layer_height_pattern, LayerHeightPattern::Adaptive);
+        assert_eq!(p.uniform_layer_height, 0.3);
+        assert_eq!(p.adaptive_layer_height, vec![0.1]);
+        assert_eq!(p.adaptive_offset, vec![0.4]);
+        assert_eq!(p.path_mode, PathMode::Zigzag);
+        assert_eq!(p.filling_ratio, 0.5);
+        assert_eq!(p.perimeters, 1);
+        assert_eq!(p.raster_angle_deg, 0.0);
+        // A misspelled key is an error, naming the key.
+        let e = serde_json::from_str::<LayerParamsPatch>(r#"{"filing_ratio":0.5}"#).unwrap_err();
+        assert!(e.to_string().contains("filing_ratio"), "{e}");
+        // Serialises only what it sets.
+        let json = serde_json::to_string(&patch).unwrap();
+        assert_eq!(
+            json,
+            r#"{"uniform_offset":0.5,"path_mode":"raster","perimeters":3}"#
+        );
+    }
+}

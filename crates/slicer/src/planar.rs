@@ -1,0 +1,169 @@
+//! Planar layers for `two5d` features (feature-based AM paper: "the slicing plane is parallel
+//! to the reference plane, ... the tool direction is vertical to them").
+//!
+//! Each feature is cut at the middle of every layer by a plane parallel to its reference plane;
+//! the cross-section's loops are grouped into regions and filled by the feature's path mode; the
+//! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
+//! tool axis, and each segment gets its filament length from Eq. 1.
+
+use crate::fill::{fill_layer, order_paths, regions_from_loops, PathKind};
+use crate::params::LayerParams;
+use crate::toolpath::{MoveKind, PathPoint};
+use brep::math::{P3, V3};
+use brep::mesh::{mesh_faces, MeshOptions};
+use brep::section::{section, Plane};
+use features::{Feature, FeatureKind, FeatureTree};
+
+/// What the planner needs to know about the machine's bead.
+#[derive(Debug, Clone, Copy)]
+pub struct Bead {
+    /// Bead width `w`, mm.
+    pub width: f64,
+    /// Filament diameter `D`, mm.
+    pub filament_diameter: f64,
+}
+
+/// Why a feature could not be planned.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// The feature is not planar.
+    #[error("feature {0} is freeform: its curved layers are not available yet")]
+    Freeform(usize),
+    /// The feature has no reference plane.
+    #[error("feature {0} has no reference plane")]
+    NoPlane(usize),
+    /// Meshing the feature failed.
+    #[error("feature {id}: {msg}")]
+    Mesh {
+        /// Feature id.
+        id: usize,
+        /// Cause.
+        msg: String,
+    },
+    /// Bad layer parameters.
+    #[error("feature {id}: {msg}")]
+    Params {
+        /// Feature id.
+        id: usize,
+        /// Cause.
+        msg: String,
+    },
+}
+
+/// Eq. 1 (Isa & Lazoglu 2019): filament length fed for a bead of width `w`, layer thickness
+/// `dl` and length `l`, from filament of diameter `d`: `4·w·Δl·L / (π·D²)`.
+pub fn filament_length(w: f64, dl: f64, l: f64, d: f64) -> f64 {
+    4.0 * w * dl * l / (std::f64::consts::PI * d * d)
+}
+
+/// Figures of one planned feature.
+#[derive(Debug, Clone, Default)]
+pub struct FeatureFigures {
+    /// Layers planned.
+    pub layers: usize,
+    /// Path points written.
+    pub points: usize,
+    /// Printed length, mm.
+    pub print_length: f64,
+    /// Travel length, mm.
+    pub travel_length: f64,
+    /// Filament fed, mm.
+    pub filament: f64,
+    /// Thinnest, mean and thickest layer, mm.
+    pub thickness: (f64, f64, f64),
+    /// Things to know.
+    pub warnings: Vec<String>,
+}
+
+/// The reference plane of a two5d feature: through its healing faces (or build-plate face),
+/// normal pointing into the feature.
+pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
+    let n = f.reference.normal.map(|n| V3::new(n[0], n[1], n[2]))?;
+    let b = &tree.brep;
+    // A point of the reference: a vertex of the reference face; else the feature's lowest point.
+    let face = f.heal_faces.first().copied().or(f.reference.face);
+    let p = face
+        .and_then(|fc| b.vertices_of(&[fc]).first().map(|v| b.vertices[v.idx()].point))
+        .or_else(|| {
+            b.vertices_of(&f.faces)
+                .iter()
+                .map(|v| b.vertices[v.idx()].point)
+                .min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
+        })?;
+    Some(Plane::new(p, n))
+}
+
+/// Plans one two5d feature, appending its points to `out` (travel from `cursor`, which is left at
+/// the last point).
+pub fn plan_two5d(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+    out: &mut Vec<PathPoint>,
+    cursor: &mut Option<P3>,
+) -> Result<FeatureFigures, PlanError> {
+    if f.kind != FeatureKind::Two5d {
+        return Err(PlanError::Freeform(f.id));
+    }
+    params.validate().map_err(|msg| PlanError::Params { id: f.id, msg })?;
+    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+    let b = &tree.brep;
+    let mut faces = f.faces.clone();
+    for v in &f.voids {
+        faces.extend(v.iter().copied());
+    }
+    // A mesh much finer than a layer: its chords are what the sections see.
+    let tol = (params.tolerance * 0.25).min(0.25 * params.uniform_layer_height).max(1e-3);
+    let mesh = mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh { id: f.id, msg: e.to_string() })?;
+    let top = mesh.positions.iter().map(|p| plane.height(p)).fold(0.0f64, f64::max);
+    let heights = params.layer_heights(top);
+    let spacing = params.spacing(bead.width);
+    let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
+    let mut fig = FeatureFigures::default();
+    let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
+    let mut z = 0.0;
+    for (layer, &dl) in heights.iter().enumerate() {
+        let mid = z + 0.5 * dl;
+        z += dl;
+        let cut = plane.offset(mid);
+        let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut).iter().map(|l| l.iter().map(|p| cut.to_2d(p)).collect()).collect();
+        let regions = regions_from_loops(&loops);
+        if regions.is_empty() {
+            continue;
+        }
+        let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
+        let paths = order_paths(fill_layer(&regions, params, layer, bead.width, spacing), start);
+        if paths.is_empty() {
+            continue;
+        }
+        fig.layers += 1;
+        tmin = tmin.min(dl);
+        tmax = tmax.max(dl);
+        tsum += dl;
+        for path in paths {
+            let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
+            let Some(first) = pts.first() else { continue };
+            // Travel to the start of the path.
+            if let Some(c) = *cursor {
+                fig.travel_length += (first - c).norm();
+            }
+            out.push(PathPoint { feature: f.id, layer, kind: MoveKind::Travel, p: [first.x, first.y, first.z], axis, e: 0.0, thickness: dl, width: bead.width });
+            for w in pts.windows(2) {
+                let l = (w[1] - w[0]).norm();
+                let e = filament_length(bead.width, dl, l, bead.filament_diameter);
+                fig.print_length += l;
+                fig.filament += e;
+                out.push(PathPoint { feature: f.id, layer, kind: MoveKind::Print, p: [w[1].x, w[1].y, w[1].z], axis, e, thickness: dl, width: bead.width });
+            }
+            let _ = path.kind == PathKind::Perimeter;
+            *cursor = pts.last().copied();
+        }
+    }
+    fig.points = out.iter().filter(|p| p.feature == f.id).count();
+    fig.thickness = if fig.layers > 0 { (tmin, tsum / fig.layers as f64, tmax) } else { (0.0, 0.0, 0.0) };
+    if fig.layers == 0 {
+        fig.warnings.push(format!("feature {} has no printable layer (thinner than a bead?)", f.id));
+    }
+    Ok(fig)
+}

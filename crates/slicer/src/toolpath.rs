@@ -1,0 +1,312 @@
+//! The planned tool path the posts consume (the planner fills it), and its `toolpath.csv` form.
+
+/// Why a tool path could not be read or used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ToolPathError {
+    /// A `toolpath.csv` line could not be read.
+    #[error("tool path CSV line {line}: {reason}")]
+    Csv {
+        /// One-based line number.
+        line: usize,
+        /// What is wrong with the line.
+        reason: String,
+    },
+    /// A path point holds a NaN or infinite number.
+    #[error("tool path point {index} (feature {feature}, layer {layer}): {field} is not a finite number")]
+    NonFinite {
+        /// Zero-based index of the point in the path.
+        index: usize,
+        /// The point's feature.
+        feature: usize,
+        /// The point's layer.
+        layer: usize,
+        /// The field that is not finite.
+        field: &'static str,
+    },
+}
+
+/// `x` in fixed-point with `decimals` places: never exponent notation, never `-0`.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.decimals$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => s,
+    }
+}
+
+#[cfg(test)]
+mod fixed_tests {
+    use super::fixed;
+
+    #[test]
+    fn fixed_point_without_negative_zero_or_exponent() {
+        assert_eq!(fixed(-0.0, 3), "0.000");
+        assert_eq!(fixed(-0.0004, 3), "0.000");
+        assert_eq!(fixed(-0.0005001, 3), "-0.001");
+        assert_eq!(fixed(1e-12, 5), "0.00000");
+        assert_eq!(fixed(1.5e21, 1), "1500000000000000000000.0");
+        assert_eq!(fixed(2100.4, 0), "2100");
+        assert_eq!(fixed(-0.4, 0), "0");
+        assert_eq!(fixed(12.3456789, 6), "12.345679");
+    }
+}
+
+/// Whether the nozzle deposits on the segment ending at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MoveKind {
+    /// Depositing: the segment from the previous point to this one lays a bead.
+    Print,
+    /// Moving without depositing.
+    Travel,
+}
+
+impl MoveKind {
+    /// `print` or `travel`, as in `toolpath.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MoveKind::Print => "print",
+            MoveKind::Travel => "travel",
+        }
+    }
+}
+
+/// One point of the path: where the segment ending here goes, and what it deposits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    /// Id of the feature this point belongs to.
+    pub feature: usize,
+    /// Layer index within the path (the `;LAYER:` number of G-code viewers).
+    pub layer: usize,
+    /// Print or travel.
+    pub kind: MoveKind,
+    /// Nozzle tip position in part coordinates (mm).
+    pub p: [f64; 3],
+    /// Unit tool axis, from the deposit towards the nozzle (+Z for a 3-axis printer).
+    pub axis: [f64; 3],
+    /// Filament length (mm) fed on the segment ending here; 0 on travel.
+    pub e: f64,
+    /// Layer (bead) thickness Δl at this point (mm).
+    pub thickness: f64,
+    /// Bead width w at this point (mm).
+    pub width: f64,
+}
+
+/// A planned path: points in the order the machine visits them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ToolPath {
+    /// The points, in machine order.
+    pub points: Vec<PathPoint>,
+}
+
+/// The header line of `toolpath.csv`.
+pub const CSV_HEADER: &str = "feature,layer,move,x,y,z,i,j,k,e,thickness,width";
+
+impl ToolPath {
+    /// The path as CSV: the header exactly [`CSV_HEADER`]
+    /// (`feature,layer,move,x,y,z,i,j,k,e,thickness,width`), then one line per point; `move`
+    /// is `print` or `travel`; coordinates, axis and `e` with 6 decimals, thickness and width
+    /// with 4, fixed-point (never exponent notation, no `-0`). Lines end with `\n`.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::with_capacity(64 * (self.points.len() + 1));
+        out.push_str(CSV_HEADER);
+        out.push('\n');
+        for q in &self.points {
+            let fields = [
+                q.feature.to_string(),
+                q.layer.to_string(),
+                q.kind.as_str().to_string(),
+                fixed(q.p[0], 6),
+                fixed(q.p[1], 6),
+                fixed(q.p[2], 6),
+                fixed(q.axis[0], 6),
+                fixed(q.axis[1], 6),
+                fixed(q.axis[2], 6),
+                fixed(q.e, 6),
+                fixed(q.thickness, 4),
+                fixed(q.width, 4),
+            ];
+            out.push_str(&fields.join(","));
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Reads CSV written by [`ToolPath::to_csv`]. The first line must be the header exactly;
+    /// blank lines are skipped and `\r\n` line ends accepted. Numbers must be finite. The
+    /// error names the line and field.
+    pub fn from_csv(text: &str) -> Result<ToolPath, ToolPathError> {
+        let mut lines = text.lines().enumerate();
+        let header = lines.next().map(|(_, l)| l.trim()).unwrap_or("");
+        let header = header.strip_prefix('\u{feff}').unwrap_or(header);
+        if header != CSV_HEADER {
+            return Err(ToolPathError::Csv {
+                line: 1,
+                reason: format!("the header must be `{CSV_HEADER}`, got `{}`", clip(header)),
+            });
+        }
+        let mut points = Vec::new();
+        for (i, line) in lines {
+            let line_no = i + 1;
+            let line = line.trim();
+            if line.is_empty() {
+                continue;
+            }
+            let err = |reason: String| ToolPathError::Csv {
+                line: line_no,
+                reason,
+            };
+            let f: Vec<&str> = line.split(',').map(str::trim).collect();
+            if f.len() != 12 {
+                return Err(err(format!("expected 12 fields, got {}", f.len())));
+            }
+            let int = |k: usize, name: &str| {
+                f[k].parse::<usize>()
+                    .map_err(|_| err(format!("{name} `{}` is not a whole number", clip(f[k]))))
+            };
+            let num = |k: usize, name: &str| match f[k].parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(err(format!(
+                    "{name} `{}` is not a finite number",
+                    clip(f[k])
+                ))),
+            };
+            let kind = match f[2] {
+                "print" => MoveKind::Print,
+                "travel" => MoveKind::Travel,
+                other => {
+                    return Err(err(format!(
+                        "move `{}` is neither `print` nor `travel`",
+                        clip(other)
+                    )))
+                }
+            };
+            points.push(PathPoint {
+                feature: int(0, "feature")?,
+                layer: int(1, "layer")?,
+                kind,
+                p: [num(3, "x")?, num(4, "y")?, num(5, "z")?],
+                axis: [num(6, "i")?, num(7, "j")?, num(8, "k")?],
+                e: num(9, "e")?,
+                thickness: num(10, "thickness")?,
+                width: num(11, "width")?,
+            });
+        }
+        Ok(ToolPath { points })
+    }
+
+    /// The first point holding a NaN or infinite number, as an error.
+    pub fn check_finite(&self) -> Result<(), ToolPathError> {
+        for (index, q) in self.points.iter().enumerate() {
+            let fields = [
+                ("x", q.p[0]),
+                ("y", q.p[1]),
+                ("z", q.p[2]),
+                ("i", q.axis[0]),
+                ("j", q.axis[1]),
+                ("k", q.axis[2]),
+                ("e", q.e),
+                ("thickness", q.thickness),
+                ("width", q.width),
+            ];
+            if let Some((field, _)) = fields.iter().find(|(_, v)| !v.is_finite()) {
+                return Err(ToolPathError::NonFinite {
+                    index,
+                    feature: q.feature,
+                    layer: q.layer,
+                    field,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `s` cut to 40 characters for an error message, with control characters replaced.
+fn clip(s: &str) -> String {
+    let mut out: String = s
+        .chars()
+        .take(40)
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    if s.chars().count() > 40 {
+        out.push('…');
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> ToolPath {
+        let pt = |kind, p: [f64; 3], e| PathPoint {
+            feature: 3,
+            layer: 1,
+            kind,
+            p,
+            axis: [0.0, -0.6, 0.8],
+            e,
+            thickness: 0.2,
+            width: 0.45,
+        };
+        ToolPath {
+            points: vec![
+                pt(MoveKind::Travel, [-1.0, 2.5, 0.4], 0.0),
+                pt(MoveKind::Print, [1e-9, -1e-12, 123456.123456789], 0.0374177),
+                pt(MoveKind::Print, [-0.0, 1e15, 0.4], 1e-7),
+            ],
+        }
+    }
+
+    #[test]
+    fn csv_round_trip_and_exact_header() {
+        let p = sample();
+        let csv = p.to_csv();
+        assert_eq!(
+            csv.lines().next(),
+            Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width")
+        );
+        assert!(!csv.contains("e-") && !csv.contains("e+") && !csv.contains("-0.000000,"));
+        let back = ToolPath::from_csv(&csv).unwrap();
+        assert_eq!(back.points.len(), p.points.len());
+        for (a, b) in p.points.iter().zip(&back.points) {
+            assert_eq!((a.feature, a.layer, a.kind), (b.feature, b.layer, b.kind));
+            for k in 0..3 {
+                assert!((a.p[k] - b.p[k]).abs() <= 5e-7);
+                assert!((a.axis[k] - b.axis[k]).abs() <= 5e-7);
+            }
+            assert!((a.e - b.e).abs() <= 5e-7);
+            assert!((a.thickness - b.thickness).abs() <= 5e-5);
+            assert!((a.width - b.width).abs() <= 5e-5);
+        }
+        // Written again, the text is identical.
+        assert_eq!(back.to_csv(), csv);
+        assert_eq!(
+            ToolPath::from_csv(&csv.replace('\n', "\r\n")).unwrap(),
+            back
+        );
+    }
+
+    #[test]
+    fn csv_errors_name_the_line() {
+        let good = sample().to_csv();
+        let cases = [
+            (String::new(), 1, "header"),
+            ("x,y\n".to_string(), 1, "header"),
+            (good.replace("travel", "jump"), 2, "move"),
+            (good.replacen(",0.2000,", ",NaN,", 1), 2, "thickness"),
+            (good.replacen("3,1,print", "-3,1,print", 1), 3, "feature"),
+            (format!("{good}1,2,print\n"), 5, "12 fields"),
+        ];
+        for (text, line, needle) in cases {
+            match ToolPath::from_csv(&text) {
+                Err(ToolPathError::Csv { line: l, reason }) => {
+                    assert_eq!(l, line, "{reason}");
+                    assert!(reason.contains(needle), "{reason}");
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+        assert_eq!(ToolPath::from_csv(CSV_HEADER).unwrap(), ToolPath::default());
+    }
+}
