@@ -713,7 +713,7 @@ impl<'a> Translator<'a> {
         // Far off (not modelling tolerance but a broken edge, e.g. a circle whose radius does
         // not match its vertices): refuse rather than mesh a curve that is not the edge.
         let limit = 1.0 + 1e-6 * ps.coords.norm().max(pe.coords.norm());
-        if !(off <= limit) {
+        if off.is_nan() || off > limit {
             return Err(ReadError::Entity {
                 id,
                 entity: "EDGE_CURVE".into(),
