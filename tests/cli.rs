@@ -616,7 +616,10 @@ fn help_mentions_the_verbs() {
     let out = Command::new(BIN).arg("--help").output().unwrap();
     assert_eq!(out.status.code(), Some(0));
     let text = stdout(&out);
-    assert!(text.contains("inspect") && text.contains("mesh") && text.contains("extract"), "{text}");
+    assert!(
+        text.contains("inspect") && text.contains("mesh") && text.contains("extract"),
+        "{text}"
+    );
     for verb in ["inspect", "mesh", "extract"] {
         let out = Command::new(BIN).args([verb, "--help"]).output().unwrap();
         assert_eq!(out.status.code(), Some(0), "{verb} --help");
@@ -653,7 +656,13 @@ fn extract_bad_inputs_fail_with_one_line_and_export_nothing() {
     let dir = TempDir::new("extract_bad_inputs");
     for (what, path) in bad_inputs(&dir) {
         let export = dir.path(&format!("out-{what}").replace(' ', "_"));
-        let out = run(&["extract".as_ref(), path.as_os_str(), "--json".as_ref(), "--export".as_ref(), export.as_os_str()]);
+        let out = run(&[
+            "extract".as_ref(),
+            path.as_os_str(),
+            "--json".as_ref(),
+            "--export".as_ref(),
+            export.as_os_str(),
+        ]);
         assert_one_line_failure(&out, &path, what);
         assert!(out.stdout.is_empty(), "{what}: wrote to stdout");
         assert!(!export.exists(), "{what}: created the export directory");
@@ -662,20 +671,51 @@ fn extract_bad_inputs_fail_with_one_line_and_export_nothing() {
 
 #[test]
 fn extract_json_plate_boss_boss_has_the_exact_shape() {
-    let out = run(&["extract".as_ref(), fixture("plate_boss_boss.step").as_os_str(), "--json".as_ref()]);
+    let out = run(&[
+        "extract".as_ref(),
+        fixture("plate_boss_boss.step").as_os_str(),
+        "--json".as_ref(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let v: Value = serde_json::from_str(&stdout(&out)).expect("JSON");
-    assert_eq!(keys(&v), ["schema", "source", "units", "part", "features", "build_order", "depth", "warnings"]);
+    assert_eq!(
+        keys(&v),
+        [
+            "schema",
+            "source",
+            "units",
+            "part",
+            "features",
+            "build_order",
+            "depth",
+            "warnings"
+        ]
+    );
     assert_eq!(v["schema"], "features.extract/1");
     assert_eq!(v["units"], "mm");
-    assert_eq!(keys(&v["part"]), ["volume_mm3", "area_mm2", "faces", "genus"]);
+    assert_eq!(
+        keys(&v["part"]),
+        ["volume_mm3", "area_mm2", "faces", "genus"]
+    );
     let reference = fixture_json("plate_boss_boss.json");
     let want = reference["volumes_mm3"][0].as_f64().unwrap();
     assert!(rel_err(v["part"]["volume_mm3"].as_f64().unwrap(), want) < 1e-3);
     let feats = v["features"].as_array().unwrap();
     assert_eq!(feats.len(), 3);
     for (k, f) in feats.iter().enumerate() {
-        assert_eq!(keys(f), ["id", "kind", "subtype", "reference", "parents", "volume_mm3", "faces", "root_loops"]);
+        assert_eq!(
+            keys(f),
+            [
+                "id",
+                "kind",
+                "subtype",
+                "reference",
+                "parents",
+                "volume_mm3",
+                "faces",
+                "root_loops"
+            ]
+        );
         assert_eq!(keys(&f["reference"]), ["surface", "step_face", "normal"]);
         assert_eq!(f["id"], k);
         assert_eq!(f["kind"], "two5d");
@@ -686,13 +726,25 @@ fn extract_json_plate_boss_boss_has_the_exact_shape() {
     assert_eq!(v["build_order"], serde_json::json!([0, 1, 2]));
     assert_eq!(v["depth"], 2);
     // Every part face is in exactly one feature.
-    let mut faces: Vec<u64> = feats.iter().flat_map(|f| f["faces"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap())).collect();
+    let mut faces: Vec<u64> = feats
+        .iter()
+        .flat_map(|f| {
+            f["faces"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_u64().unwrap())
+        })
+        .collect();
     let n = faces.len();
     faces.sort_unstable();
     faces.dedup();
     assert_eq!(faces.len(), n);
     assert_eq!(n as u64, v["part"]["faces"].as_u64().unwrap());
-    let sum: f64 = feats.iter().map(|f| f["volume_mm3"].as_f64().unwrap()).sum();
+    let sum: f64 = feats
+        .iter()
+        .map(|f| f["volume_mm3"].as_f64().unwrap())
+        .sum();
     assert!(rel_err(sum, want) < 5e-3, "features add up to {sum}");
 }
 
@@ -700,7 +752,13 @@ fn extract_json_plate_boss_boss_has_the_exact_shape() {
 fn extract_export_writes_closed_solids_that_read_back() {
     let dir = TempDir::new("extract_export");
     let export = dir.path("capsule");
-    let out = run(&["extract".as_ref(), fixture("capsule.step").as_os_str(), "--json".as_ref(), "--export".as_ref(), export.as_os_str()]);
+    let out = run(&[
+        "extract".as_ref(),
+        fixture("capsule.step").as_os_str(),
+        "--json".as_ref(),
+        "--export".as_ref(),
+        export.as_os_str(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let v: Value = serde_json::from_str(&stdout(&out)).expect("JSON");
     let feats = v["features"].as_array().unwrap();
@@ -717,21 +775,37 @@ fn extract_export_writes_closed_solids_that_read_back() {
         assert_eq!(s["closed"], true);
         assert_eq!(s["watertight"], true);
         let vol = s["volume_mm3"].as_f64().unwrap();
-        assert!(rel_err(vol, f["volume_mm3"].as_f64().unwrap()) < 5e-3, "feature {id}: {vol}");
+        assert!(
+            rel_err(vol, f["volume_mm3"].as_f64().unwrap()) < 5e-3,
+            "feature {id}: {vol}"
+        );
         let soup = read_stl(&std::fs::read(&stl).unwrap());
         let stl_vol = check_closed_and_volume(&soup, "exported stl");
-        assert!(rel_err(stl_vol, vol) < 0.02, "feature {id}: stl {stl_vol} vs {vol}");
+        assert!(
+            rel_err(stl_vol, vol) < 0.02,
+            "feature {id}: stl {stl_vol} vs {vol}"
+        );
     }
     // No temporary files left behind.
-    assert!(std::fs::read_dir(&export).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().ends_with(".tmp")));
+    assert!(std::fs::read_dir(&export).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .ends_with(".tmp")));
 }
 
 #[test]
 fn extract_text_tree_shows_the_chain() {
-    let out = run(&["extract".as_ref(), fixture("plate_boss_boss.step").as_os_str()]);
+    let out = run(&[
+        "extract".as_ref(),
+        fixture("plate_boss_boss.step").as_os_str(),
+    ]);
     assert!(out.status.success());
     let text = stdout(&out);
-    assert!(text.contains("feature 0  two5d stretch  on the build plate"), "{text}");
+    assert!(
+        text.contains("feature 0  two5d stretch  on the build plate"),
+        "{text}"
+    );
     assert!(text.contains("└─ feature 1"), "{text}");
     assert!(text.contains("   └─ feature 2"), "{text}");
 }

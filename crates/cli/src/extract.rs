@@ -21,7 +21,8 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     let mut solids = vec![];
     let mut offset = 0;
     for s in part.brep.solid_ids() {
-        let tree = extract(&part.brep, s, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
+        let tree = extract(&part.brep, s, &ExtractOptions::default())
+            .map_err(|e| Failure::new(path, e))?;
         let n = tree.features.len();
         solids.push(Solid { tree, offset });
         offset += n;
@@ -31,7 +32,8 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     }
     let source = path.display().to_string();
     let text = if args.json {
-        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids)).map_err(|e| Failure::new(path, e))?;
+        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids))
+            .map_err(|e| Failure::new(path, e))?;
         t.push('\n');
         t
     } else {
@@ -55,24 +57,14 @@ fn to_json(source: &str, solids: &[Solid]) -> Value {
     for s in solids {
         let t = &s.tree;
         for f in &t.features {
-            let r = &f.reference;
-            features.push(json!({
-                "id": s.offset + f.id,
-                "kind": f.kind.as_str(),
-                "subtype": f.subtype,
-                "reference": {
-                    "surface": r.surface,
-                    "step_face": r.step_face,
-                    "normal": r.normal.map(|n| n.map(|x| round(x, 1e6))),
-                },
-                "parents": f.parents.iter().map(|p| s.offset + p).collect::<Vec<_>>(),
-                "volume_mm3": round(f.volume, 1e3),
-                "faces": f.step_faces(&t.brep),
-                "root_loops": f.root_loops,
-            }));
+            features.push(feature_json_fields(t, f, s.offset));
         }
         order.extend(t.build_order.iter().map(|k| s.offset + k));
-        let prefix = if solids.len() > 1 { format!("solid #{}: ", t.brep.solids[t.solid.idx()].step_id) } else { String::new() };
+        let prefix = if solids.len() > 1 {
+            format!("solid #{}: ", t.brep.solids[t.solid.idx()].step_id)
+        } else {
+            String::new()
+        };
         warnings.extend(t.warnings.iter().map(|w| format!("{prefix}{w}")));
     }
     json!({
@@ -87,6 +79,25 @@ fn to_json(source: &str, solids: &[Solid]) -> Value {
     })
 }
 
+/// The `extract` fields of one feature, numbered from `offset` (the features of earlier solids).
+pub fn feature_json_fields(t: &FeatureTree, f: &features::Feature, offset: usize) -> Value {
+    let r = &f.reference;
+    json!({
+        "id": offset + f.id,
+        "kind": f.kind.as_str(),
+        "subtype": f.subtype,
+        "reference": {
+            "surface": r.surface,
+            "step_face": r.step_face,
+            "normal": r.normal.map(|n| n.map(|x| round(x, 1e6))),
+        },
+        "parents": f.parents.iter().map(|p| offset + p).collect::<Vec<_>>(),
+        "volume_mm3": round(f.volume, 1e3),
+        "faces": f.step_faces(&t.brep),
+        "root_loops": f.root_loops,
+    })
+}
+
 fn to_text(source: &str, solids: &[Solid]) -> String {
     let mut out = String::new();
     for s in solids {
@@ -94,7 +105,11 @@ fn to_text(source: &str, solids: &[Solid]) -> String {
         let _ = writeln!(
             out,
             "{source}{}: {} feature(s), depth {}, part {:.3} mm^3",
-            if solids.len() > 1 { format!(" solid #{}", t.brep.solids[t.solid.idx()].step_id) } else { String::new() },
+            if solids.len() > 1 {
+                format!(" solid #{}", t.brep.solids[t.solid.idx()].step_id)
+            } else {
+                String::new()
+            },
             t.features.len(),
             t.depth,
             t.part_volume
@@ -119,13 +134,25 @@ fn to_text(source: &str, solids: &[Solid]) -> String {
                 f.subtype,
                 on,
                 f.volume,
-                if f.root_loops > 1 { format!("  ({} root loops)", f.root_loops) } else { String::new() }
+                if f.root_loops > 1 {
+                    format!("  ({} root loops)", f.root_loops)
+                } else {
+                    String::new()
+                }
             );
-            for c in t.build_order.iter().filter(|&&c| t.features[c].parents.first() == Some(&k)) {
+            for c in t
+                .build_order
+                .iter()
+                .filter(|&&c| t.features[c].parents.first() == Some(&k))
+            {
                 walk(out, t, offset, *c, indent + 1);
             }
         }
-        for &k in t.build_order.iter().filter(|&&k| t.features[k].parents.is_empty()) {
+        for &k in t
+            .build_order
+            .iter()
+            .filter(|&&k| t.features[k].parents.is_empty())
+        {
             walk(&mut out, t, s.offset, k, 0);
         }
         for w in &t.warnings {
@@ -142,8 +169,14 @@ fn export(dir: &Path, solids: &[Solid]) -> std::io::Result<()> {
         for f in &t.features {
             let id = s.offset + f.id;
             let name = format!("feature_{id}");
-            let step = brep::write::write_step_shells(&t.brep, &[(f.faces.clone(), f.voids.clone())], &name);
-            write_atomic(&dir.join(format!("{name}.step")), |w| w.write_all(step.as_bytes()))?;
+            let step = brep::write::write_step_shells(
+                &t.brep,
+                &[(f.faces.clone(), f.voids.clone())],
+                &name,
+            );
+            write_atomic(&dir.join(format!("{name}.step")), |w| {
+                w.write_all(step.as_bytes())
+            })?;
             let mut faces = f.faces.clone();
             for v in &f.voids {
                 faces.extend(v.iter().copied());
@@ -152,13 +185,18 @@ fn export(dir: &Path, solids: &[Solid]) -> std::io::Result<()> {
                 .map_err(|e| std::io::Error::other(e.to_string()))?;
             let sm = solid_mesh(0, &mesh);
             let n = sm.triangles.len() as u32;
-            write_atomic(&dir.join(format!("{name}.stl")), |w| write_stl(w, &name, std::slice::from_ref(&sm), n))?;
+            write_atomic(&dir.join(format!("{name}.stl")), |w| {
+                write_stl(w, &name, std::slice::from_ref(&sm), n)
+            })?;
         }
     }
     Ok(())
 }
 
-fn write_atomic(dest: &Path, body: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>) -> std::io::Result<()> {
+fn write_atomic(
+    dest: &Path,
+    body: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let (tmp, file) = TempFile::create(dest)?;
     let mut w = std::io::BufWriter::new(file);
     body(&mut w)?;

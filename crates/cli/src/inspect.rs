@@ -185,12 +185,21 @@ fn to_text(ins: &Inspection) -> String {
             // Rounded first, so a coordinate a hair below zero does not print as -0.0000.
             let f = |x: f64| {
                 let r = (x * 1e4).round() / 1e4;
-                if r == 0.0 { 0.0 } else { r }
+                if r == 0.0 {
+                    0.0
+                } else {
+                    r
+                }
             };
             let _ = writeln!(
                 s,
                 "  bbox:        ({:.4}, {:.4}, {:.4}) .. ({:.4}, {:.4}, {:.4}) mm",
-                f(a.x), f(a.y), f(a.z), f(b.x), f(b.y), f(b.z)
+                f(a.x),
+                f(a.y),
+                f(a.z),
+                f(b.x),
+                f(b.y),
+                f(b.z)
             );
             let _ = writeln!(
                 s,

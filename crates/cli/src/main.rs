@@ -6,6 +6,7 @@
 mod extract;
 mod inspect;
 mod mesh;
+mod plan;
 
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;
@@ -36,6 +37,29 @@ enum Command {
     Mesh(MeshArgs),
     /// Recognise the AM features a part is built from: concave loops, splitting, dependency order.
     Extract(ExtractArgs),
+    /// Plan layers and paths for every feature and write the machine program.
+    Plan(PlanArgs),
+}
+
+/// Arguments of `features plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// STEP file to read.
+    #[arg(value_name = "PART.step")]
+    pub part: PathBuf,
+    /// Process file (TOML): `[defaults]` layer parameters and `[features.<id>]` overrides
+    /// [default: 0.2 mm layers, contour_zigzag, 2 perimeters, solid fill; see profiles/process.toml]
+    #[arg(long, value_name = "FILE")]
+    pub process: Option<PathBuf>,
+    /// Built-in machine: marlin, delta5 or kuka [default: marlin]
+    #[arg(long, value_name = "NAME", conflicts_with = "machine_profile")]
+    pub machine: Option<String>,
+    /// Machine profile (TOML) instead of a built-in one (see profiles/*.toml)
+    #[arg(long, value_name = "FILE")]
+    pub machine_profile: Option<PathBuf>,
+    /// Output directory for toolpath.csv, plan.json and the machine program [required]
+    #[arg(short, long, value_name = "DIR")]
+    pub output: PathBuf,
 }
 
 /// Arguments of `features extract`.
@@ -152,6 +176,7 @@ fn run(cmd: &Command) -> Result<(), Failure> {
         Command::Inspect(a) => inspect::run(a),
         Command::Mesh(a) => mesh::run(a),
         Command::Extract(a) => extract::run(a),
+        Command::Plan(a) => plan::run(a),
     }
 }
 
@@ -171,6 +196,7 @@ fn main() -> ExitCode {
         Command::Inspect(a) => a.part.display().to_string(),
         Command::Mesh(a) => a.part.display().to_string(),
         Command::Extract(a) => a.part.display().to_string(),
+        Command::Plan(a) => a.part.display().to_string(),
     };
     // The panic is reported below, on one line; the default hook would add a second.
     panic::set_hook(Box::new(|_| {}));

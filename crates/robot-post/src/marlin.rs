@@ -4,8 +4,8 @@
 //! comments, relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
 //! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
 
-use slicer::toolpath::fixed;
 use crate::{MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
+use slicer::toolpath::fixed;
 
 /// Largest deviation of a tool axis component from +Z (0, 0, 1) that Marlin accepts.
 pub const AXIS_TOLERANCE: f64 = 1e-6;

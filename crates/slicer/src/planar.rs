@@ -83,7 +83,11 @@ pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
     // A point of the reference: a vertex of the reference face; else the feature's lowest point.
     let face = f.heal_faces.first().copied().or(f.reference.face);
     let p = face
-        .and_then(|fc| b.vertices_of(&[fc]).first().map(|v| b.vertices[v.idx()].point))
+        .and_then(|fc| {
+            b.vertices_of(&[fc])
+                .first()
+                .map(|v| b.vertices[v.idx()].point)
+        })
         .or_else(|| {
             b.vertices_of(&f.faces)
                 .iter()
@@ -106,7 +110,9 @@ pub fn plan_two5d(
     if f.kind != FeatureKind::Two5d {
         return Err(PlanError::Freeform(f.id));
     }
-    params.validate().map_err(|msg| PlanError::Params { id: f.id, msg })?;
+    params
+        .validate()
+        .map_err(|msg| PlanError::Params { id: f.id, msg })?;
     let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
     let b = &tree.brep;
     let mut faces = f.faces.clone();
@@ -114,9 +120,19 @@ pub fn plan_two5d(
         faces.extend(v.iter().copied());
     }
     // A mesh much finer than a layer: its chords are what the sections see.
-    let tol = (params.tolerance * 0.25).min(0.25 * params.uniform_layer_height).max(1e-3);
-    let mesh = mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh { id: f.id, msg: e.to_string() })?;
-    let top = mesh.positions.iter().map(|p| plane.height(p)).fold(0.0f64, f64::max);
+    let tol = (params.tolerance * 0.25)
+        .min(0.25 * params.uniform_layer_height)
+        .max(1e-3);
+    let mesh =
+        mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
+            id: f.id,
+            msg: e.to_string(),
+        })?;
+    let top = mesh
+        .positions
+        .iter()
+        .map(|p| plane.height(p))
+        .fold(0.0f64, f64::max);
     let heights = params.layer_heights(top);
     let spacing = params.spacing(bead.width);
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
@@ -127,13 +143,19 @@ pub fn plan_two5d(
         let mid = z + 0.5 * dl;
         z += dl;
         let cut = plane.offset(mid);
-        let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut).iter().map(|l| l.iter().map(|p| cut.to_2d(p)).collect()).collect();
+        let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
+            .iter()
+            .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
+            .collect();
         let regions = regions_from_loops(&loops);
         if regions.is_empty() {
             continue;
         }
         let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-        let paths = order_paths(fill_layer(&regions, params, layer, bead.width, spacing), start);
+        let paths = order_paths(
+            fill_layer(&regions, params, layer, bead.width, spacing),
+            start,
+        );
         if paths.is_empty() {
             continue;
         }
@@ -148,22 +170,47 @@ pub fn plan_two5d(
             if let Some(c) = *cursor {
                 fig.travel_length += (first - c).norm();
             }
-            out.push(PathPoint { feature: f.id, layer, kind: MoveKind::Travel, p: [first.x, first.y, first.z], axis, e: 0.0, thickness: dl, width: bead.width });
+            out.push(PathPoint {
+                feature: f.id,
+                layer,
+                kind: MoveKind::Travel,
+                p: [first.x, first.y, first.z],
+                axis,
+                e: 0.0,
+                thickness: dl,
+                width: bead.width,
+            });
             for w in pts.windows(2) {
                 let l = (w[1] - w[0]).norm();
                 let e = filament_length(bead.width, dl, l, bead.filament_diameter);
                 fig.print_length += l;
                 fig.filament += e;
-                out.push(PathPoint { feature: f.id, layer, kind: MoveKind::Print, p: [w[1].x, w[1].y, w[1].z], axis, e, thickness: dl, width: bead.width });
+                out.push(PathPoint {
+                    feature: f.id,
+                    layer,
+                    kind: MoveKind::Print,
+                    p: [w[1].x, w[1].y, w[1].z],
+                    axis,
+                    e,
+                    thickness: dl,
+                    width: bead.width,
+                });
             }
             let _ = path.kind == PathKind::Perimeter;
             *cursor = pts.last().copied();
         }
     }
     fig.points = out.iter().filter(|p| p.feature == f.id).count();
-    fig.thickness = if fig.layers > 0 { (tmin, tsum / fig.layers as f64, tmax) } else { (0.0, 0.0, 0.0) };
+    fig.thickness = if fig.layers > 0 {
+        (tmin, tsum / fig.layers as f64, tmax)
+    } else {
+        (0.0, 0.0, 0.0)
+    };
     if fig.layers == 0 {
-        fig.warnings.push(format!("feature {} has no printable layer (thinner than a bead?)", f.id));
+        fig.warnings.push(format!(
+            "feature {} has no printable layer (thinner than a bead?)",
+            f.id
+        ));
     }
     Ok(fig)
 }

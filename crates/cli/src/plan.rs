@@ -1,0 +1,230 @@
+//! `features plan`: layers, paths and a machine program for every feature, in build order.
+
+use crate::extract::feature_json_fields;
+use crate::mesh::TempFile;
+use crate::{emit, Failure, PlanArgs};
+use features::{extract, ExtractOptions};
+use robot_post::machine::{MachineKind, MachineProfile};
+use serde_json::{json, Value};
+use slicer::params::{LayerParams, LayerParamsPatch};
+use slicer::planar::{plan_two5d, Bead};
+use slicer::toolpath::ToolPath;
+use std::collections::HashMap;
+use std::io::Write as _;
+use std::path::Path;
+
+/// A process file: `[defaults]` and `[features.<id>]` overrides.
+#[derive(Debug, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProcessFile {
+    #[serde(default)]
+    defaults: Option<LayerParamsPatch>,
+    #[serde(default)]
+    features: HashMap<String, LayerParamsPatch>,
+}
+
+fn round(x: f64, scale: f64) -> f64 {
+    (x * scale).round() / scale + 0.0
+}
+
+/// Runs the command.
+pub fn run(args: &PlanArgs) -> Result<(), Failure> {
+    let path = &args.part;
+    // Settings first: a bad process or machine file fails before any work.
+    let process: ProcessFile = match &args.process {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .map_err(|e| Failure::new(p, format!("cannot read process file: {e}")))?;
+            toml::from_str(&text).map_err(|e| {
+                let line = e
+                    .span()
+                    .map(|r| text[..r.start.min(text.len())].matches('\n').count() + 1);
+                let at = line.map(|l| format!(" line {l}")).unwrap_or_default();
+                Failure::new(p, format!("process file{at}: {}", e.message().trim()))
+            })?
+        }
+        None => ProcessFile::default(),
+    };
+    let base = match &process.defaults {
+        Some(p) => LayerParams::default().patched(p),
+        None => LayerParams::default(),
+    };
+    base.validate().map_err(|e| {
+        Failure::new(
+            args.process.as_deref().unwrap_or(path),
+            format!("process defaults: {e}"),
+        )
+    })?;
+    let machine = match (&args.machine_profile, args.machine.as_deref()) {
+        (Some(p), _) => {
+            let text = std::fs::read_to_string(p)
+                .map_err(|e| Failure::new(p, format!("cannot read machine profile: {e}")))?;
+            MachineProfile::from_toml(&text).map_err(|e| Failure::new(p, e))?
+        }
+        (None, Some(name)) => {
+            let kind = MachineKind::from_name(name).ok_or_else(|| {
+                Failure::new(
+                    path,
+                    format!("unknown machine `{name}` (marlin, delta5 or kuka)"),
+                )
+            })?;
+            MachineProfile::builtin(kind)
+        }
+        (None, None) => MachineProfile::builtin(MachineKind::Marlin),
+    };
+    if machine.kind != MachineKind::Marlin {
+        return Err(Failure::new(
+            path,
+            format!(
+                "machine `{}`: the {} post is not available yet; use `--machine marlin`",
+                machine.name,
+                machine.kind.as_str()
+            ),
+        ));
+    }
+    let bead = Bead {
+        width: machine.bead_width,
+        filament_diameter: machine.filament_diameter,
+    };
+    let filament_area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
+
+    let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    let mut trees = vec![];
+    for s in part.brep.solid_ids() {
+        trees.push(
+            extract(&part.brep, s, &ExtractOptions::default())
+                .map_err(|e| Failure::new(path, e))?,
+        );
+    }
+    let total: u64 = trees.iter().map(|t| t.features.len() as u64).sum();
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(total),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("planning {bar:30} {pos}/{len} features {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+
+    let mut points = vec![];
+    let mut cursor = None;
+    let mut feature_values = vec![];
+    let mut warnings: Vec<String> = vec![];
+    let mut offset = 0usize;
+    for t in &trees {
+        for &k in &t.build_order {
+            let f = &t.features[k];
+            let id = offset + f.id;
+            bar.set_message(format!("feature {id}"));
+            let params = match process.features.get(&id.to_string()) {
+                Some(p) => base.patched(p),
+                None => base.clone(),
+            };
+            params.validate().map_err(|e| {
+                Failure::new(
+                    args.process.as_deref().unwrap_or(path),
+                    format!("feature {id}: {e}"),
+                )
+            })?;
+            let start = points.len();
+            let fig = plan_two5d(t, f, &params, bead, &mut points, &mut cursor)
+                .map_err(|e| Failure::new(path, e))?;
+            for p in &mut points[start..] {
+                p.feature = id;
+            }
+            let mut v = feature_json_fields(t, f, offset);
+            let o = v.as_object_mut().expect("object");
+            o.insert("layers".into(), json!(fig.layers));
+            o.insert("points".into(), json!(points.len() - start));
+            o.insert(
+                "print_length_mm".into(),
+                json!(round(fig.print_length, 1e3)),
+            );
+            o.insert(
+                "travel_length_mm".into(),
+                json!(round(fig.travel_length, 1e3)),
+            );
+            o.insert(
+                "extruded_volume_mm3".into(),
+                json!(round(fig.filament * filament_area, 1e3)),
+            );
+            o.insert("volume_mm3".into(), json!(round(f.volume, 1e3)));
+            o.insert(
+                "thickness_min_mm".into(),
+                json!(round(fig.thickness.0, 1e6)),
+            );
+            o.insert(
+                "thickness_mean_mm".into(),
+                json!(round(fig.thickness.1, 1e6)),
+            );
+            o.insert(
+                "thickness_max_mm".into(),
+                json!(round(fig.thickness.2, 1e6)),
+            );
+            o.insert("warnings".into(), json!(fig.warnings));
+            feature_values.push(v);
+            bar.inc(1);
+        }
+        warnings.extend(t.warnings.iter().cloned());
+        offset += t.features.len();
+    }
+    bar.finish_and_clear();
+    let toolpath = ToolPath { points };
+    let source = path.display().to_string();
+    let program = robot_post::marlin::marlin(&toolpath, &machine, &source)
+        .map_err(|e| Failure::new(path, e))?;
+    let plan = json!({
+        "schema": "features.plan/1",
+        "source": source,
+        "machine": machine.name,
+        "features": feature_values,
+        "warnings": warnings,
+    });
+    let mut plan_text = serde_json::to_string_pretty(&plan).map_err(|e| Failure::new(path, e))?;
+    plan_text.push('\n');
+    // Everything is ready: write the three files.
+    let dir = &args.output;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
+    for (name, text) in [
+        ("toolpath.csv", toolpath.to_csv()),
+        ("plan.json", plan_text),
+        ("program.gcode", program),
+    ] {
+        write_atomic(&dir.join(name), text.as_bytes())
+            .map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))?;
+    }
+    let print: f64 = feature_values
+        .iter()
+        .filter_map(|v| v["print_length_mm"].as_f64())
+        .sum();
+    let vol: f64 = feature_values
+        .iter()
+        .filter_map(|v| v["extruded_volume_mm3"].as_f64())
+        .sum();
+    emit(&format!(
+        "{}: {} feature(s), {} points, {:.1} mm printed, {:.1} mm^3 extruded -> {}\n",
+        path.display(),
+        feature_values.len(),
+        toolpath.points.len(),
+        print,
+        vol,
+        dir.display()
+    ))
+}
+
+fn write_atomic(dest: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let (tmp, file) = TempFile::create(dest)?;
+    let mut w = std::io::BufWriter::new(file);
+    w.write_all(bytes)?;
+    w.flush()?;
+    w.get_ref().sync_all()?;
+    drop(w);
+    tmp.persist(dest)
+}
+
+#[allow(dead_code)]
+fn _value_type_check(_: Value) {}

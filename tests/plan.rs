@@ -1,0 +1,345 @@
+//! `features plan` end to end on every fixture made only of two5d features: the extruded volume
+//! matches the part's, every print point lies inside the part, every layer lies on its plane,
+//! and the G-code parsed back reproduces `toolpath.csv`.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_features");
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+struct Out(PathBuf);
+impl Drop for Out {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+fn plan(name: &str, extra: &[&str]) -> (Out, Value, String, String) {
+    // One directory per call: tests run in parallel and may plan the same part.
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir =
+        std::env::temp_dir().join(format!("features-plan-{}-{run}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(fixture(&format!("{name}.step")))
+        .args(extra)
+        .arg("-o")
+        .arg(&dir)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let plan: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"))
+            .expect("json");
+    let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("csv");
+    let gcode = std::fs::read_to_string(dir.join("program.gcode")).expect("gcode");
+    (Out(dir), plan, csv, gcode)
+}
+
+#[derive(Debug, Clone)]
+struct Row {
+    feature: usize,
+    layer: usize,
+    print: bool,
+    p: [f64; 3],
+    axis: [f64; 3],
+    e: f64,
+    thickness: f64,
+}
+
+fn rows(csv: &str) -> Vec<Row> {
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width")
+    );
+    lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            let f = |k: usize| c[k].parse::<f64>().expect("number");
+            Row {
+                feature: c[0].parse().expect("feature"),
+                layer: c[1].parse().expect("layer"),
+                print: c[2] == "print",
+                p: [f(3), f(4), f(5)],
+                axis: [f(6), f(7), f(8)],
+                e: f(9),
+                thickness: f(10),
+            }
+        })
+        .collect()
+}
+
+const TWO5D_ONLY: [&str; 9] = [
+    "box",
+    "cylinder",
+    "arch",
+    "inch_block",
+    "plate_boss_boss",
+    "boss_fillet",
+    "two_solids",
+    "void_box",
+    "cone",
+];
+
+#[test]
+fn extruded_volume_matches_the_part_and_points_are_inside() {
+    let mut failures = vec![];
+    for name in TWO5D_ONLY {
+        let (_dir, plan, csv, _) = plan(name, &[]);
+        let reference: Value = serde_json::from_str(
+            &std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        let part_volume: f64 = reference["volumes_mm3"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .sum();
+        let extruded: f64 = plan["features"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["extruded_volume_mm3"].as_f64().unwrap())
+            .sum();
+        if (extruded - part_volume).abs() > 0.01 * part_volume {
+            failures.push(format!(
+                "{name}: extruded {extruded:.2} mm^3 vs part {part_volume:.2}"
+            ));
+        }
+        // Inside: the middle of each bead, by the generalised winding number of the part's mesh.
+        let part = brep::read_step(fixture(&format!("{name}.step"))).unwrap();
+        let meshes: Vec<_> = part
+            .brep
+            .solid_ids()
+            .map(|s| {
+                brep::solid::mesh_solid(
+                    &part.brep,
+                    s,
+                    Some(brep::mesh::MeshOptions::with_tolerance(0.01)),
+                )
+                .unwrap()
+            })
+            .collect();
+        let rs = rows(&csv);
+        let mut outside = 0;
+        for r in rs.iter().filter(|r| r.print).step_by(7) {
+            let q = brep::math::P3::new(
+                r.p[0] - 0.5 * r.thickness * r.axis[0],
+                r.p[1] - 0.5 * r.thickness * r.axis[1],
+                r.p[2] - 0.5 * r.thickness * r.axis[2],
+            );
+            if meshes.iter().all(|m| m.winding_number(&q) < 0.5) {
+                outside += 1;
+            }
+        }
+        if outside > 0 {
+            failures.push(format!(
+                "{name}: {outside} sampled print points outside the part"
+            ));
+        }
+        // Each layer of a feature lies on one plane normal to its tool axis.
+        let mut planes: std::collections::HashMap<(usize, usize), (f64, f64)> =
+            std::collections::HashMap::new();
+        for r in &rs {
+            let h = r.p[0] * r.axis[0] + r.p[1] * r.axis[1] + r.p[2] * r.axis[2];
+            let e = planes.entry((r.feature, r.layer)).or_insert((h, h));
+            e.0 = e.0.min(h);
+            e.1 = e.1.max(h);
+            let n = (r.axis[0].powi(2) + r.axis[1].powi(2) + r.axis[2].powi(2)).sqrt();
+            if (n - 1.0).abs() > 1e-5 {
+                failures.push(format!("{name}: tool axis not unit"));
+                break;
+            }
+        }
+        for ((f, l), (lo, hi)) in planes {
+            if hi - lo > 1e-5 {
+                failures.push(format!(
+                    "{name}: feature {f} layer {l} spans {:.6} mm along its axis",
+                    hi - lo
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+fn literal(v: &gcode::Value) -> f64 {
+    match v {
+        gcode::Value::Literal(x) => *x as f64,
+        other => panic!("not a number: {other:?}"),
+    }
+}
+
+#[test]
+fn gcode_parsed_back_reproduces_the_toolpath() {
+    for name in ["plate_boss_boss", "arch", "void_box"] {
+        let (_dir, _plan, csv, gcode) = plan(name, &[]);
+        let offset_line = gcode
+            .lines()
+            .find(|l| l.starts_with("; offset "))
+            .expect("offset comment");
+        let off: Vec<f64> = offset_line["; offset ".len()..]
+            .split_whitespace()
+            .take(3)
+            .map(|w| w[1..].parse().expect("offset number"))
+            .collect();
+        let mut pos = [0.0f64; 3];
+        let mut prints: Vec<([f64; 3], f64)> = vec![];
+        let program = gcode::parse(&gcode).expect("the gcode crate reads the program");
+        for block in &program.blocks {
+            for code in &block.codes {
+                let gcode::Code::General(g) = code else {
+                    continue;
+                };
+                let major = g.number.major();
+                if major != 0 && major != 1 {
+                    continue;
+                }
+                let (mut e, mut moved) = (None, false);
+                for a in &g.args {
+                    let v = literal(&a.value);
+                    match a.letter.to_ascii_uppercase() {
+                        'X' => (pos[0], moved) = (v, true),
+                        'Y' => (pos[1], moved) = (v, true),
+                        'Z' => (pos[2], moved) = (v, true),
+                        'E' => e = Some(v),
+                        _ => {}
+                    }
+                }
+                if let (1, Some(e), true) = (major, e, moved) {
+                    prints.push(([pos[0] - off[0], pos[1] - off[1], pos[2] - off[2]], e));
+                }
+            }
+        }
+        let want: Vec<Row> = rows(&csv).into_iter().filter(|r| r.print).collect();
+        assert_eq!(prints.len(), want.len(), "{name}: print moves");
+        for (k, (g, r)) in prints.iter().zip(&want).enumerate() {
+            for a in 0..3 {
+                assert!(
+                    (g.0[a] - r.p[a]).abs() < 2e-3,
+                    "{name}: move {k} axis {a}: {} vs {}",
+                    g.0[a],
+                    r.p[a]
+                );
+            }
+            assert!(
+                (g.1 - r.e).abs() < 2e-5,
+                "{name}: move {k} E {} vs {}",
+                g.1,
+                r.e
+            );
+        }
+    }
+}
+
+#[test]
+fn plate_boss_boss_plan_summary() {
+    let (_dir, plan, _, _) = plan("plate_boss_boss", &[]);
+    let mut s = String::new();
+    for f in plan["features"].as_array().unwrap() {
+        s.push_str(&format!(
+            "feature {} {} layers {} points {} print {:.0} mm travel {:.0} mm extruded {:.1} mm^3 volume {:.1} mm^3 thickness {:.3}..{:.3}\n",
+            f["id"], f["subtype"].as_str().unwrap(), f["layers"], f["points"],
+            f["print_length_mm"].as_f64().unwrap(), f["travel_length_mm"].as_f64().unwrap(),
+            f["extruded_volume_mm3"].as_f64().unwrap(), f["volume_mm3"].as_f64().unwrap(),
+            f["thickness_min_mm"].as_f64().unwrap(), f["thickness_max_mm"].as_f64().unwrap()
+        ));
+    }
+    insta::assert_snapshot!("plate_boss_boss_plan", s);
+}
+
+#[test]
+fn freeform_parts_and_other_machines_are_refused_with_one_line() {
+    for (name, extra) in [("impeller", vec![]), ("box", vec!["--machine", "kuka"])] {
+        let dir = std::env::temp_dir().join(format!(
+            "features-plan-refuse-{}-{name}",
+            std::process::id()
+        ));
+        let out = Command::new(BIN)
+            .arg("plan")
+            .arg(fixture(&format!("{name}.step")))
+            .args(&extra)
+            .arg("-o")
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!dir.exists(), "{name}: wrote output");
+    }
+}
+
+#[test]
+fn process_file_overrides_one_feature_and_rejects_unknown_keys() {
+    let dir = std::env::temp_dir().join(format!("features-plan-process-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("process.toml");
+    std::fs::write(&good, "[defaults]\nuniform_layer_height = 0.25\n\n[features.2]\nuniform_layer_height = 0.1\npath_mode = \"contour\"\n").unwrap();
+    let out_dir = dir.join("out");
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(fixture("plate_boss_boss.step"))
+        .arg("--process")
+        .arg(&good)
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let plan: Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("plan.json")).unwrap()).unwrap();
+    let f = plan["features"].as_array().unwrap();
+    // Feature 2 (the small boss, 8 mm tall) at 0.1 mm; the others at 0.25 mm.
+    assert!(
+        (f[2]["thickness_mean_mm"].as_f64().unwrap() - 0.1).abs() < 1e-6,
+        "{}",
+        f[2]
+    );
+    assert_eq!(f[2]["layers"], 80);
+    assert!(
+        (f[0]["thickness_mean_mm"].as_f64().unwrap() - 0.25).abs() < 0.01,
+        "{}",
+        f[0]
+    );
+    // A misspelled key is one clear line, and nothing is written.
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[defaults]\nlayer_hieght = 0.2\n").unwrap();
+    let bad_out = dir.join("bad_out");
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(fixture("box.step"))
+        .arg("--process")
+        .arg(&bad)
+        .arg("-o")
+        .arg(&bad_out)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("layer_hieght"), "{err}");
+    assert!(!bad_out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
