@@ -145,6 +145,17 @@ impl Curve {
         }
     }
 
+    /// The point and first derivative at `t`, in one evaluation where the curve allows.
+    pub fn eval_d1(&self, t: f64) -> (P3, V3) {
+        match self {
+            Curve::Nurbs(n) => {
+                let [p, d, _] = n.local.ders_upto(t.clamp(n.t0, n.t1), 1);
+                (P3::new(p[0], p[1], p[2]), V3::new(d[0], d[1], d[2]))
+            }
+            _ => (self.eval(t), self.deriv(t)),
+        }
+    }
+
     /// The first derivative `C'(t)`.
     pub fn deriv(&self, t: f64) -> V3 {
         match self {

@@ -90,8 +90,8 @@ fn face_integrals(brep: &Brep, ft: &crate::mesh::FaceTriangulation, origin: &P3)
         for (w, wt) in GAUSS7.iter() {
             let u = w[0] * a[0] + w[1] * b[0] + w[2] * d[0];
             let v = w[0] * a[1] + w[1] * b[1] + w[2] * d[1];
-            let p = s.eval(u, v) - origin;
-            let (su, sv) = s.derivs(u, v);
+            let (q, su, sv) = s.eval_d1(u, v);
+            let p = q - origin;
             let n = su.cross(&sv);
             vol += wt * det * p.dot(&n) / 3.0;
             area += wt * det.abs() * n.norm();

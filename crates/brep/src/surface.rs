@@ -273,6 +273,40 @@ impl Surface {
         }
     }
 
+    /// The point and first partial derivatives `(S, S_u, S_v)` in one evaluation where the
+    /// surface allows (B-splines, surfaces of revolution); the same as `eval` and `derivs`.
+    pub fn eval_d1(&self, u: f64, v: f64) -> (P3, V3, V3) {
+        match self {
+            Surface::Nurbs(n) => {
+                let (u, v) = n.clamp_uv(u, v);
+                let [p, a, b] = n.local.eval_d1(u, v);
+                (
+                    P3::new(p[0], p[1], p[2]),
+                    V3::new(a[0], a[1], a[2]),
+                    V3::new(b[0], b[1], b[2]),
+                )
+            }
+            Surface::Revolution(rev) => {
+                let (pt, w1) = rev.profile.eval_d1(v);
+                let w = pt - rev.origin;
+                let ax = rev.axis;
+                let a = w.dot(&ax);
+                let r = w - ax * a;
+                let a1 = w1.dot(&ax);
+                let r1 = w1 - ax * a1;
+                let (s, c) = u.sin_cos();
+                let p = rev.origin + ax * a + r * c + ax.cross(&r) * s;
+                let su = -r * s + ax.cross(&r) * c;
+                let sv = ax * a1 + r1 * c + ax.cross(&r1) * s;
+                (p, su, sv)
+            }
+            _ => {
+                let (su, sv) = self.derivs(u, v);
+                (self.eval(u, v), su, sv)
+            }
+        }
+    }
+
     /// The first partial derivatives `(S_u, S_v)`.
     pub fn derivs(&self, u: f64, v: f64) -> (V3, V3) {
         match self {
@@ -680,8 +714,8 @@ impl Surface {
         };
         let mut dist = (self.eval(u, v) - p).norm();
         for _ in 0..40 {
-            let d = self.eval(u, v) - p;
-            let (su, sv) = self.derivs(u, v);
+            let (q, su, sv) = self.eval_d1(u, v);
+            let d = q - p;
             let a11 = su.norm_squared();
             let a12 = su.dot(&sv);
             let a22 = sv.norm_squared();
@@ -864,6 +898,34 @@ mod tests {
             dir: (f.z + f.x * 0.2).normalize(),
         };
         check_round_trip(&ext, &uvs);
+    }
+
+    #[test]
+    fn one_pass_evaluation_agrees_with_separate_calls() {
+        let f = frame();
+        let profile = Curve::Line {
+            origin: f.at(2.0, 0.0, 0.0),
+            dir: (f.x + f.z).normalize(),
+        };
+        let rev = Surface::Revolution(Box::new(Revolution::new(profile, f.origin, f.z)));
+        for s in [
+            rev,
+            Surface::Torus {
+                frame: f,
+                major: 5.0,
+                minor: 1.5,
+            },
+        ] {
+            for (u, v) in [(0.3, 0.2), (2.0, -0.4), (-2.5, 0.9)] {
+                let (p, su, sv) = s.eval_d1(u, v);
+                let (a, b) = s.derivs(u, v);
+                assert!(
+                    (p - s.eval(u, v)).norm() < 1e-12
+                        && (su - a).norm() < 1e-12
+                        && (sv - b).norm() < 1e-12
+                );
+            }
+        }
     }
 
     #[test]
