@@ -894,6 +894,15 @@ impl Boundary {
     }
 }
 
+/// How many steps of `step` cover `range`: at least `min`, at most 400 (a grid's side).
+fn step_count(range: (f64, f64), step: f64, min: usize) -> usize {
+    if step.is_finite() {
+        ((range.1 - range.0) / step).ceil().clamp(min as f64, 400.0) as usize
+    } else {
+        min
+    }
+}
+
 /// Parameter steps `(du, dv)` that keep chords within tolerance, from sampled second differences.
 fn grid_steps(s: &Surface, ub: (f64, f64), vb: (f64, f64), opts: &MeshOptions) -> (f64, f64) {
     if matches!(s, Surface::Plane { .. }) {
@@ -1039,16 +1048,7 @@ fn triangulate(
     } else if dv.is_finite() && !du.is_finite() {
         du = dv * sv / su * ASPECT;
     }
-    let nu = if du.is_finite() {
-        ((ub.1 - ub.0) / du).ceil().clamp(1.0, 400.0) as usize
-    } else {
-        1
-    };
-    let nv = if dv.is_finite() {
-        ((vb.1 - vb.0) / dv).ceil().clamp(1.0, 400.0) as usize
-    } else {
-        1
-    };
+    let (nu, nv) = (step_count(ub, du, 1), step_count(vb, dv, 1));
     if nu > 1 || nv > 1 {
         let (gu, gv) = ((ub.1 - ub.0) / nu as f64, (vb.1 - vb.0) / nv as f64);
         let margin = 0.35
@@ -1281,16 +1281,7 @@ fn full_domain(
     let ur = pu.map(|p| (0.0, p)).or(bu)?;
     let vr = pv.map(|p| (0.0, p)).or(bv)?;
     let (du, dv) = grid_steps(s, ur, vr, opts);
-    let nu = if du.is_finite() {
-        ((ur.1 - ur.0) / du).ceil().clamp(4.0, 400.0) as usize
-    } else {
-        4
-    };
-    let nv = if dv.is_finite() {
-        ((vr.1 - vr.0) / dv).ceil().clamp(4.0, 400.0) as usize
-    } else {
-        4
-    };
+    let (nu, nv) = (step_count(ur, du, 4), step_count(vr, dv, 4));
     let size = {
         let mut b = Aabb::empty();
         for i in 0..=4 {
