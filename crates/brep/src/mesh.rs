@@ -706,13 +706,11 @@ fn unwrap_loop(mut chain: Vec<Pt>, periods: [Option<f64>; 2]) -> (Vec<Pt>, [i64;
     for k in 0..n {
         let mut p = chain[k];
         if let Some(prev) = out.last() {
-            let bridge = is_break(&chain[k - 1], &chain[k]);
+            // Periodic coordinates follow the previous point; across a pole bridge this starts
+            // the next run next to where the previous one ended.
             for axis in 0..2 {
                 if let Some(per) = periods[axis] {
-                    // Across a bridge only the fixed coordinate must stay continuous; the free
-                    // one starts a new run next to where the previous one ended.
                     p.uv[axis] = crate::math::nearest_periodic(p.uv[axis], prev.uv[axis], per);
-                    let _ = bridge;
                 }
             }
         }
@@ -1282,18 +1280,7 @@ fn full_domain(
     let vr = pv.map(|p| (0.0, p)).or(bv)?;
     let (du, dv) = grid_steps(s, ur, vr, opts);
     let (nu, nv) = (step_count(ur, du, 4), step_count(vr, dv, 4));
-    let size = {
-        let mut b = Aabb::empty();
-        for i in 0..=4 {
-            for j in 0..=4 {
-                b.add(&s.eval(
-                    ur.0 + (ur.1 - ur.0) * i as f64 / 4.0,
-                    vr.0 + (vr.1 - vr.0) * j as f64 / 4.0,
-                ));
-            }
-        }
-        b.diagonal()
-    };
+    let size = s.size_hint();
     let new_vertex = |p: P3, positions: &mut Vec<P3>| -> u32 {
         if let Some(&i) = pole_vertices
             .iter()

@@ -551,7 +551,9 @@ impl Surface {
         )
     }
 
-    fn size_hint(&self) -> f64 {
+    /// The diagonal of a 5×5 sample of the surface over its bounded or periodic range: a
+    /// length scale for tolerances.
+    pub(crate) fn size_hint(&self) -> f64 {
         let (ur, vr) = self.sample_ranges();
         let mut bb = crate::math::Aabb::empty();
         for i in 0..=4 {

@@ -5,7 +5,7 @@ use crate::mesh::TempFile;
 use crate::{emit, Failure, PlanArgs};
 use features::{extract, ExtractOptions};
 use robot_post::machine::{MachineKind, MachineProfile};
-use serde_json::{json, Value};
+use serde_json::json;
 use slicer::params::{LayerParams, LayerParamsPatch};
 use slicer::planar::{plan_two5d, Bead};
 use slicer::toolpath::ToolPath;
@@ -225,6 +225,3 @@ fn write_atomic(dest: &Path, bytes: &[u8]) -> std::io::Result<()> {
     drop(w);
     tmp.persist(dest)
 }
-
-#[allow(dead_code)]
-fn _value_type_check(_: Value) {}

@@ -118,7 +118,7 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         };
         let segs = pts.len().saturating_sub(1);
         let step = (segs / 12).max(1);
-        let (mut concave, mut convex, mut smooth) = (0, 0, 0);
+        let (mut concave, mut convex) = (0, 0);
         let (mut r12, mut r21, mut nr) = (0.0, 0.0, 0usize);
         let mut max_angle: f64 = 0.0;
         for k in (0..segs).step_by(step) {
@@ -160,7 +160,7 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
             let angle = n1.dot(&n2).clamp(-1.0, 1.0).acos().to_degrees();
             max_angle = max_angle.max(angle);
             if angle < smooth_deg {
-                smooth += 1;
+                // Tangent here: neither concave nor convex.
             } else if n2.dot(&d1) + n1.dot(&d2) > 0.0 {
                 concave += 1;
             } else {
@@ -171,10 +171,7 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
             (true, false) => Convexity::Concave,
             (false, true) => Convexity::Convex,
             (true, true) => Convexity::Mixed,
-            (false, false) => {
-                let _ = smooth;
-                Convexity::Smooth
-            }
+            (false, false) => Convexity::Smooth,
         };
         convexity.insert(e, c);
         if nr > 0 {

@@ -141,7 +141,8 @@ pub struct FeatureTree {
 
 struct Draft {
     faces: Vec<FaceId>,
-    host: Option<(FaceId, Vec<LoopId>)>,
+    /// The face it was cut from and how many root loops the cut followed.
+    host: Option<(FaceId, usize)>,
     heal: Vec<FaceId>,
 }
 
@@ -398,7 +399,7 @@ pub fn extract(
             heal_faces: d.heal.clone(),
             shell,
             volume,
-            root_loops: d.host.as_ref().map_or(0, |h| h.1.len()),
+            root_loops: d.host.map_or(0, |h| h.1),
             depth: 0,
             closed,
         });
@@ -739,7 +740,7 @@ fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool 
     drafts[i].faces = parent;
     drafts.push(Draft {
         faces: child,
-        host: Some((host, vec![LoopId(u32::MAX); loops_n])),
+        host: Some((host, loops_n)),
         heal,
     });
     true

@@ -6,7 +6,7 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
-use crate::fill::{fill_layer, order_paths, regions_from_loops, PathKind};
+use crate::fill::{fill_layer, order_paths, regions_from_loops};
 use crate::params::LayerParams;
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
@@ -196,7 +196,6 @@ pub fn plan_two5d(
                     width: bead.width,
                 });
             }
-            let _ = path.kind == PathKind::Perimeter;
             *cursor = pts.last().copied();
         }
     }
