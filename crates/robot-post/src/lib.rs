@@ -8,7 +8,9 @@
 //!
 //! Every fallible function returns a [`PostError`] whose message is one line.
 
+pub mod delta5;
 pub mod error;
+pub mod kuka;
 pub mod machine;
 pub mod marlin;
 pub use slicer::toolpath;

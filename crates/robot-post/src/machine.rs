@@ -92,6 +92,12 @@ pub struct MachineProfile {
     pub retraction_speed: f64,
     /// Nozzle lift during travel moves (mm); 0 for none.
     pub z_hop: f64,
+    /// The bed's kinematics (`[delta5]` table); required when `kind = "delta5"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delta5: Option<crate::delta5::Delta5Geometry>,
+    /// The robot cell (`[kuka]` table); required when `kind = "kuka"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kuka: Option<crate::kuka::KukaCell>,
 }
 
 impl MachineProfile {
@@ -195,6 +201,21 @@ impl MachineProfile {
             if v > max {
                 return Err(bad(field, format!("must be at most {max}, got {v}")));
             }
+        }
+        match (self.kind, &self.delta5, &self.kuka) {
+            (MachineKind::Delta5, None, _) => {
+                return Err(bad("[delta5]", "table is required for kind = \"delta5\"".into()))
+            }
+            (MachineKind::Kuka, _, None) => {
+                return Err(bad("[kuka]", "table is required for kind = \"kuka\"".into()))
+            }
+            _ => {}
+        }
+        if let Some(d) = &self.delta5 {
+            d.validate(&self.name)?;
+        }
+        if let Some(k) = &self.kuka {
+            k.validate(&self.name)?;
         }
         Ok(())
     }

@@ -10,6 +10,8 @@
 //! Polygon offsets and booleans come from the `i_overlay` crate.
 
 pub mod fill;
+pub mod freeform;
+pub mod orient;
 pub mod params;
 pub mod planar;
 pub mod toolpath;
