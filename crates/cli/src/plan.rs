@@ -6,6 +6,8 @@ use crate::{emit, Failure, PlanArgs};
 use features::{extract, ExtractOptions};
 use robot_post::machine::{MachineKind, MachineProfile};
 use serde_json::json;
+use slicer::freeform::plan_freeform;
+use slicer::orient::{smooth, SmoothParams};
 use slicer::params::{LayerParams, LayerParamsPatch};
 use slicer::planar::{plan_two5d, Bead};
 use slicer::toolpath::ToolPath;
@@ -21,6 +23,9 @@ struct ProcessFile {
     defaults: Option<LayerParamsPatch>,
     #[serde(default)]
     features: HashMap<String, LayerParamsPatch>,
+    /// Tool-axis smoothing (Chalvin et al. 2022, Eq. 3–7).
+    #[serde(default)]
+    orientation: SmoothParams,
 }
 
 fn round(x: f64, scale: f64) -> f64 {
@@ -72,16 +77,12 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         }
         (None, None) => MachineProfile::builtin(MachineKind::Marlin),
     };
-    if machine.kind != MachineKind::Marlin {
-        return Err(Failure::new(
-            path,
-            format!(
-                "machine `{}`: the {} post is not available yet; use `--machine marlin`",
-                machine.name,
-                machine.kind.as_str()
-            ),
-        ));
-    }
+    process.orientation.validate().map_err(|e| {
+        Failure::new(
+            args.process.as_deref().unwrap_or(path),
+            format!("process [orientation]: {e}"),
+        )
+    })?;
     let bead = Bead {
         width: machine.bead_width,
         filament_diameter: machine.filament_diameter,
@@ -130,8 +131,18 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 )
             })?;
             let start = points.len();
-            let fig = plan_two5d(t, f, &params, bead, &mut points, &mut cursor)
-                .map_err(|e| Failure::new(path, e))?;
+            let (fig, freeform) = match f.kind {
+                features::FeatureKind::Two5d => (
+                    plan_two5d(t, f, &params, bead, &mut points, &mut cursor)
+                        .map_err(|e| Failure::new(path, e))?,
+                    None,
+                ),
+                features::FeatureKind::Freeform => {
+                    let (fig, ff) = plan_freeform(t, f, &params, bead, &mut points, &mut cursor)
+                        .map_err(|e| Failure::new(path, e))?;
+                    (fig, Some(ff))
+                }
+            };
             for p in &mut points[start..] {
                 p.feature = id;
             }
@@ -164,7 +175,35 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 "thickness_max_mm".into(),
                 json!(round(fig.thickness.2, 1e6)),
             );
-            o.insert("warnings".into(), json!(fig.warnings));
+            if let Some(ff) = freeform {
+                o.insert("chart".into(), json!(ff.chart));
+                o.insert(
+                    "concave_radius_mm".into(),
+                    if ff.concave_radius.is_finite() {
+                        json!(round(ff.concave_radius, 1e3))
+                    } else {
+                        serde_json::Value::Null
+                    },
+                );
+            }
+            let mut fw = fig.warnings.clone();
+            // Below the build plate: the base feature's reference plane.
+            if let Some(plate) = t
+                .features
+                .first()
+                .and_then(|b| slicer::planar::reference_plane(t, b))
+            {
+                let depth = points[start..]
+                    .iter()
+                    .map(|q| -plate.height(&brep::math::P3::from(q.p)))
+                    .fold(0.0f64, f64::max);
+                if depth > 1e-3 {
+                    let w = format!("feature {id} reaches {depth:.3} mm below the build plate");
+                    fw.push(w.clone());
+                    warnings.push(w);
+                }
+            }
+            o.insert("warnings".into(), json!(fw));
             feature_values.push(v);
             bar.inc(1);
         }
@@ -172,10 +211,77 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         offset += t.features.len();
     }
     bar.finish_and_clear();
-    let toolpath = ToolPath { points };
+    let mut toolpath = ToolPath { points };
+    // Orientation smoothing between planning and posting.
+    let orientation = smooth(&mut toolpath, &process.orientation);
+    for v in &mut feature_values {
+        let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
+        if let (Some(o), Some(fig)) = (v.as_object_mut(), orientation.get(&id)) {
+            if let Ok(serde_json::Value::Object(m)) = serde_json::to_value(fig) {
+                for (k, x) in m {
+                    let x = x.as_f64().map(|f| json!(round(f, 1e6))).unwrap_or(x);
+                    o.insert(k, x);
+                }
+            }
+        }
+    }
     let source = path.display().to_string();
-    let program = robot_post::marlin::marlin(&toolpath, &machine, &source)
-        .map_err(|e| Failure::new(path, e))?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "part".into());
+    let mut files: Vec<(String, Vec<u8>)> = vec![];
+    match machine.kind {
+        MachineKind::Marlin => {
+            let program = robot_post::marlin::marlin(&toolpath, &machine, &source)
+                .map_err(|e| Failure::new(path, e))?;
+            files.push(("program.gcode".into(), program.into_bytes()));
+        }
+        MachineKind::Delta5 => {
+            let program = robot_post::delta5::delta5(&toolpath, &machine, &source)
+                .map_err(|e| Failure::new(path, e))?;
+            for v in &mut feature_values {
+                let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
+                if let (Some(o), Some(k)) = (v.as_object_mut(), program.figures.get(&id)) {
+                    o.insert("kinematic_error_max_mm".into(), json!(round(k.max_mm, 1e6)));
+                    o.insert(
+                        "kinematic_error_mean_mm".into(),
+                        json!(round(k.mean_mm, 1e6)),
+                    );
+                    o.insert("subdivided_segments".into(), json!(k.subdivided_segments));
+                    o.insert("singular_points".into(), json!(k.singular_points));
+                    o.insert("c_step_max_deg".into(), json!(round(k.max_c_step_deg, 1e6)));
+                }
+            }
+            files.push(("program.gcode".into(), program.gcode.into_bytes()));
+            files.push((
+                "kinematic_error.svg".into(),
+                program.error_plot_svg.into_bytes(),
+            ));
+        }
+        MachineKind::Kuka => {
+            let program = robot_post::kuka::kuka(&toolpath, &machine, &stem, &source)
+                .map_err(|e| Failure::new(path, e))?;
+            for v in &mut feature_values {
+                let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
+                if let (Some(o), Some(k)) = (v.as_object_mut(), program.figures.get(&id)) {
+                    o.insert("unreachable_points".into(), json!(k.unreachable_points));
+                    o.insert(
+                        "wrist_singular_points".into(),
+                        json!(k.wrist_singular_points),
+                    );
+                    o.insert(
+                        "configuration_changes".into(),
+                        json!(k.configuration_changes),
+                    );
+                }
+            }
+            warnings.extend(program.warnings.iter().cloned());
+            for (name, text) in program.files {
+                files.push((name, text.into_bytes()));
+            }
+        }
+    }
     let plan = json!({
         "schema": "features.plan/1",
         "source": source,
@@ -189,12 +295,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let dir = &args.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
-    for (name, text) in [
-        ("toolpath.csv", toolpath.to_csv()),
-        ("plan.json", plan_text),
-        ("program.gcode", program),
-    ] {
-        write_atomic(&dir.join(name), text.as_bytes())
+    files.insert(0, ("plan.json".into(), plan_text.into_bytes()));
+    files.insert(0, ("toolpath.csv".into(), toolpath.to_csv().into_bytes()));
+    for (name, bytes) in &files {
+        write_atomic(&dir.join(name), bytes)
             .map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))?;
     }
     let print: f64 = feature_values

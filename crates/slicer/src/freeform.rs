@@ -1,2 +1,1063 @@
-//! Freeform features: offset reference-surface layers, spatial slicing, paths on curved
-//! layers. Work in progress.
+//! Freeform features: offset reference-surface layers, spatial slicing, paths on curved layers
+//! (feature-based AM paper, "Feature-based five-axis path planning methodology": offset the
+//! reference surface, spatially slice the freeform layers, generate the toolpaths of each
+//! layer).
+//!
+//! - **Chart.** Every computation runs in a 2-D chart `q = (s, t)` of the reference surface S
+//!   and the signed distance `d` from it along its unit normal N (pointing into the feature):
+//!   the point `(q, d)` is `S(q) + d·N(q)`. The chart is the surface's own `(u, v)` scaled to
+//!   millimetres at the feature's centre ([`ChartKind::Native`]), or, where `(u, v)` collapses
+//!   under the feature (a boss on a sphere's pole), the orthogonal projection onto the tangent
+//!   plane at the feature's centre ([`ChartKind::Ortho`]).
+//! - **Offset surfaces.** Layer k lies on `S_k(q) = S(q) + z_k·N(q)`, `z_k` the sum of the
+//!   first k layer thicknesses (`k·h` for uniform layers): exact for every surface, since it is
+//!   evaluated from the exact S and N point by point. Deterioration (paper, Fig. 9: where the
+//!   reference is concave with a radius of curvature under `z_k` the offset folds over itself)
+//!   is detected from the principal curvatures of S under the feature: the plan stops with
+//!   [`PlanError::OffsetFolds`], naming the feature and the first layer that would fold.
+//! - **Spatial slicing.** The feature's exact-surface mesh is mapped into `(s, t, d)`; its
+//!   section by the plane `d = z_k − h_k/2` (the middle of layer k) gives the layer's region
+//!   in the chart, boundaries sampled within the mesh tolerance.
+//! - **Paths.** [`crate::geodesic`] triangulates each region, lifts it onto `S_k`, and fills it
+//!   by the feature's `path_mode` with iso-lines of geodesic distances (spacing measured on the
+//!   surface). Each path is lifted onto `S_k` with points inserted until every chord is within
+//!   the feature's `tolerance` of the surface; the tool axis is N (or `fixed_tool_axis`);
+//!   extrusion follows Isa & Lazoglu 2019, Eq. 1 with the layer's thickness.
+
+use crate::fill::{regions_from_loops, Path2, PathKind, Point2, Region};
+use crate::geodesic::{clip_above, LayerMesh};
+use crate::params::{LayerParams, PathMode};
+use crate::planar::{filament_length, Bead, FeatureFigures, PlanError};
+use crate::toolpath::{MoveKind, PathPoint};
+use brep::math::{any_perpendicular, P3, V3};
+use brep::mesh::{mesh_faces, Mesh, MeshOptions};
+use brep::section::{section, Plane};
+use brep::surface::Surface;
+use features::{Feature, FeatureKind, FeatureTree};
+
+/// Longest edge of the feature mesh mapped into `(s, t, d)`, mm: over 1 mm the distance to a
+/// reference of curvature 1/R strays from linear by at most 1/(8R) mm (3 µm for R = 40 mm).
+const MAX_MAPPED_EDGE: f64 = 1.0;
+
+/// How chart coordinates map to the reference surface.
+#[derive(Debug, Clone, Copy)]
+pub enum ChartKind {
+    /// `q = ((u − u0)·su, (v − v0)·sv)`: the surface's parameters scaled by `|S_u|`, `|S_v|` at
+    /// the feature's centre (`su` negated where needed so the chart turns as N does).
+    Native {
+        /// Centre parameters.
+        u0: f64,
+        /// Centre parameters.
+        v0: f64,
+        /// Scale of u, mm per unit (signed).
+        su: f64,
+        /// Scale of v, mm per unit.
+        sv: f64,
+    },
+    /// `q = ((F − c)·e1, (F − c)·e2)` for the surface point F: projection onto the tangent
+    /// plane at the centre c.
+    Ortho {
+        /// Centre point.
+        c: P3,
+        /// First in-plane axis.
+        e1: V3,
+        /// Second in-plane axis (`e1 × e2` is the normal into the feature).
+        e2: V3,
+    },
+}
+
+/// A chart of a feature's reference surface with the normal into the feature.
+#[derive(Debug, Clone, Copy)]
+pub struct Chart<'a> {
+    surf: &'a Surface,
+    /// +1 when N is the surface's natural normal, −1 when reversed.
+    sign: f64,
+    /// The chart's form.
+    pub kind: ChartKind,
+}
+
+impl<'a> Chart<'a> {
+    fn normal_at(&self, u: f64, v: f64) -> Option<V3> {
+        self.surf.normal(u, v).map(|n| n * self.sign)
+    }
+
+    /// Surface parameters of chart point `q`.
+    fn uv(&self, q: Point2) -> Option<(f64, f64)> {
+        match self.kind {
+            ChartKind::Native { u0, v0, su, sv } => Some((u0 + q[0] / su, v0 + q[1] / sv)),
+            ChartKind::Ortho { c, e1, e2 } => {
+                // Iterated projection: move the target by the chart residual and project again.
+                let mut x = c + e1 * q[0] + e2 * q[1];
+                let mut uv = self.surf.project(&x, None);
+                for _ in 0..40 {
+                    let f = self.surf.eval(uv.0, uv.1);
+                    let r = [q[0] - (f - c).dot(&e1), q[1] - (f - c).dot(&e2)];
+                    if r[0].abs() + r[1].abs() < 1e-10 {
+                        return Some(uv);
+                    }
+                    x = f + e1 * r[0] + e2 * r[1];
+                    uv = self.surf.project(&x, Some(uv));
+                }
+                let f = self.surf.eval(uv.0, uv.1);
+                let r = [q[0] - (f - c).dot(&e1), q[1] - (f - c).dot(&e2)];
+                (r[0].abs() + r[1].abs() < 1e-6).then_some(uv)
+            }
+        }
+    }
+
+    /// The point at chart `q` and distance `d` from the reference, and the unit normal there
+    /// (the offset surface's normal is the reference's).
+    pub fn at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
+        let (u, v) = self.uv(q)?;
+        let n = self.normal_at(u, v)?;
+        let p = self.surf.eval(u, v) + n * d;
+        (p.coords.iter().all(|x| x.is_finite()) && n.iter().all(|x| x.is_finite()))
+            .then_some((p, n))
+    }
+
+    /// Chart coordinates and distance `d` of `p` (its nearest point on the reference).
+    pub fn inverse(&self, p: &P3) -> Option<(Point2, f64)> {
+        let (u, v) = self.surf.project(p, None);
+        let f = self.surf.eval(u, v);
+        let n = self.normal_at(u, v)?;
+        let d = (p - f).dot(&n);
+        let q = match self.kind {
+            ChartKind::Native { u0, v0, su, sv } => {
+                let (u, v) = self.surf.unwrap_near((u, v), (u0, v0));
+                [(u - u0) * su, (v - v0) * sv]
+            }
+            ChartKind::Ortho { c, e1, e2 } => [(f - c).dot(&e1), (f - c).dot(&e2)],
+        };
+        (q[0].is_finite() && q[1].is_finite() && d.is_finite()).then_some((q, d))
+    }
+
+    /// The smallest principal curvature `λ` of the reference at `q`, with `dN = λ·dS` along
+    /// principal directions (N into the feature): negative where the surface curves towards
+    /// the feature, whose offset at distance `d` then folds where `1 + d·λ ≤ 0`.
+    fn min_curvature(&self, q: Point2, step: f64) -> Option<f64> {
+        let e = |dq: [f64; 2]| self.at([q[0] + dq[0], q[1] + dq[1]], 0.0);
+        let (ps, ns) = e([step, 0.0])?;
+        let (pm, nm) = e([-step, 0.0])?;
+        let (pt, nt) = e([0.0, step])?;
+        let (pn, nn) = e([0.0, -step])?;
+        let (js, jt) = (ps - pm, pt - pn);
+        let (ks, kt) = (ns - nm, nt - nn);
+        // Least squares W with [ks kt] = [js jt]·W, then its eigenvalues.
+        let g = [[js.dot(&js), js.dot(&jt)], [js.dot(&jt), jt.dot(&jt)]];
+        let det = g[0][0] * g[1][1] - g[0][1] * g[1][0];
+        if det.abs() < 1e-18 {
+            return None;
+        }
+        let gi = [
+            [g[1][1] / det, -g[0][1] / det],
+            [-g[1][0] / det, g[0][0] / det],
+        ];
+        let b = [[js.dot(&ks), js.dot(&kt)], [jt.dot(&ks), jt.dot(&kt)]];
+        let w = [
+            [
+                gi[0][0] * b[0][0] + gi[0][1] * b[1][0],
+                gi[0][0] * b[0][1] + gi[0][1] * b[1][1],
+            ],
+            [
+                gi[1][0] * b[0][0] + gi[1][1] * b[1][0],
+                gi[1][0] * b[0][1] + gi[1][1] * b[1][1],
+            ],
+        ];
+        let tr = w[0][0] + w[1][1];
+        let dt = w[0][0] * w[1][1] - w[0][1] * w[1][0];
+        let disc = (0.25 * tr * tr - dt).max(0.0).sqrt();
+        let l = 0.5 * tr - disc;
+        l.is_finite().then_some(l)
+    }
+}
+
+/// The feature's chart: the surface's own parameters unless they collapse under the feature.
+fn choose_chart<'a>(
+    surf: &'a Surface,
+    sign: f64,
+    id: usize,
+    mesh: &Mesh,
+) -> Result<Chart<'a>, PlanError> {
+    let err = |msg: String| PlanError::Freeform { id, msg };
+    let n = mesh.positions.len().max(1) as f64;
+    let centroid = mesh.positions.iter().fold(V3::zeros(), |a, p| a + p.coords) / n;
+    let centroid = P3::from(centroid);
+    let (u0, v0) = surf.project(&centroid, None);
+    let (su, sv) = surf.derivs(u0, v0);
+    let area = |u: f64, v: f64| {
+        let (a, b) = surf.derivs(u, v);
+        a.cross(&b).norm()
+    };
+    let a0 = area(u0, v0);
+    // Native when the parameters stay regular under the whole feature.
+    let stride = (mesh.positions.len() / 400).max(1);
+    let mut native = a0 > 1e-12 && su.norm() > 1e-9 && sv.norm() > 1e-9;
+    if native {
+        let (mut ulo, mut uhi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in mesh.positions.iter().step_by(stride) {
+            let (u, v) = surf.unwrap_near(surf.project(p, None), (u0, v0));
+            ulo = ulo.min(u);
+            uhi = uhi.max(u);
+            if area(u, v) < 0.2 * a0 {
+                native = false;
+                break;
+            }
+        }
+        if let Some(per) = surf.u_period() {
+            if uhi - ulo > 0.9 * per {
+                native = false;
+            }
+        }
+    }
+    let n0 = surf
+        .normal(u0, v0)
+        .map(|n| n * sign)
+        .ok_or_else(|| err("its reference surface has no normal under its centre".into()))?;
+    if native {
+        let flip = if su.cross(&sv).dot(&n0) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        return Ok(Chart {
+            surf,
+            sign,
+            kind: ChartKind::Native {
+                u0,
+                v0,
+                su: su.norm() * flip,
+                sv: sv.norm(),
+            },
+        });
+    }
+    let c = surf.eval(u0, v0);
+    let e1 = any_perpendicular(&n0).normalize();
+    let e2 = n0.cross(&e1);
+    let chart = Chart {
+        surf,
+        sign,
+        kind: ChartKind::Ortho { c, e1, e2 },
+    };
+    // The projection chart needs the reference to be a height field over the tangent plane.
+    for p in mesh.positions.iter().step_by(stride) {
+        let (u, v) = surf.project(p, None);
+        let ok = chart.normal_at(u, v).is_some_and(|n| n.dot(&n0) > 0.17);
+        if !ok {
+            return Err(err(
+                "its reference surface turns more than 80° under it and its parameters collapse there: no chart for curved layers"
+                    .into(),
+            ));
+        }
+    }
+    Ok(chart)
+}
+
+/// The mesh with every edge longer than `max_edge` split (conforming: a triangle is cut by
+/// the midpoints of its long edges, shared with its neighbours), as one triangle list. The
+/// distance field is linear over each triangle of the mapped mesh, so a planar face's few large
+/// triangles would cut a curved layer along chords far from the true section curve.
+fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
+    let mut pos = mesh.positions.clone();
+    let mut tris = mesh.triangles();
+    for _ in 0..12 {
+        let long =
+            |a: u32, b: u32, pos: &[P3]| (pos[a as usize] - pos[b as usize]).norm() > max_edge;
+        let mut mid: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if long(a, b, &pos) {
+                    let key = (a.min(b), a.max(b));
+                    if !mid.contains_key(&key) {
+                        let m = P3::from(0.5 * (pos[a as usize].coords + pos[b as usize].coords));
+                        pos.push(m);
+                        mid.insert(key, (pos.len() - 1) as u32);
+                    }
+                }
+            }
+        }
+        if mid.is_empty() {
+            break;
+        }
+        let mut next = Vec::with_capacity(tris.len() * 2);
+        for t in &tris {
+            let m = [0, 1, 2].map(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                mid.get(&(a.min(b), a.max(b))).copied()
+            });
+            match m {
+                [None, None, None] => next.push(*t),
+                [Some(x), Some(y), Some(z)] => {
+                    next.extend([[t[0], x, z], [x, t[1], y], [z, y, t[2]], [x, y, z]]);
+                }
+                _ => {
+                    // One or two split edges: fan from the first split edge's midpoint.
+                    let k = (0..3).find(|&k| m[k].is_some()).unwrap_or(0);
+                    let x = m[k].unwrap_or(t[k]);
+                    let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                    let (mb, mc) = (m[(k + 1) % 3], m[(k + 2) % 3]);
+                    // Polygon a, x, b, [mb], c, [mc]; fan around x.
+                    let mut poly = vec![b];
+                    if let Some(y) = mb {
+                        poly.push(y);
+                    }
+                    poly.push(c);
+                    if let Some(z) = mc {
+                        poly.push(z);
+                    }
+                    poly.push(a);
+                    for w in poly.windows(2) {
+                        next.push([x, w[0], w[1]]);
+                    }
+                }
+            }
+        }
+        tris = next;
+    }
+    let n = pos.len();
+    Mesh {
+        positions: pos,
+        faces: vec![brep::mesh::FaceTriangulation {
+            face: mesh
+                .faces
+                .first()
+                .map(|f| f.face)
+                .unwrap_or(brep::topology::FaceId(0)),
+            uv: vec![[0.0, 0.0]; n],
+            vertex: (0..n as u32).collect(),
+            triangles: tris,
+        }],
+        edge_points: Default::default(),
+    }
+}
+
+/// Chart coordinates and distance of every mesh vertex, as a mesh in `(s, t, d)` space.
+fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, PlanError> {
+    let mut m = mesh.clone();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let (q, d) = chart.inverse(p).ok_or_else(|| PlanError::Freeform {
+            id,
+            msg: format!(
+                "a point ({:.3}, {:.3}, {:.3}) of it has no foot on its reference surface",
+                p.x, p.y, p.z
+            ),
+        })?;
+        m.positions[i] = P3::new(q[0], q[1], d);
+    }
+    Ok(m)
+}
+
+/// Paths of one region of a curved layer at offset `z`, in chart coordinates.
+#[allow(clippy::too_many_arguments)]
+fn fill_region(
+    chart: &Chart,
+    region: &Region,
+    z: f64,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+) -> Vec<(Path2, f64)> {
+    let mut out = vec![];
+    let mut lm = LayerMesh::build(region, spacing / 3.0);
+    if lm.tris.is_empty() {
+        return out;
+    }
+    let mut pts = Vec::with_capacity(lm.q.len());
+    for q in &lm.q {
+        match chart.at(*q, z) {
+            Some((p, _)) => pts.push(p),
+            None => return out,
+        }
+    }
+    lm.p = pts;
+    let db = lm.march(&lm.boundary_seeds(spacing));
+    let (deep, dmax) = db.iter().enumerate().filter(|(_, d)| d.is_finite()).fold(
+        (0usize, 0.0f64),
+        |a, (i, &d)| if d > a.1 { (i, d) } else { a },
+    );
+    // Rings: iso-lines of the distance to the boundary, half a bead in, then a spacing apart;
+    // a ring whose two sides would pinch closer than half a bead at the ridge is left out.
+    let rings = match params.path_mode {
+        PathMode::Raster | PathMode::Zigzag => 0,
+        PathMode::Contour => usize::MAX,
+        PathMode::ContourZigzag => params.perimeters,
+    };
+    let mut last_ring = None;
+    let mut j = 0usize;
+    while j < rings {
+        let c = 0.5 * width + j as f64 * spacing;
+        if c > dmax - 0.25 * width {
+            break;
+        }
+        for line in lm.iso_lines(&db, c, &db) {
+            out.push((
+                Path2 {
+                    points: line.q,
+                    kind: if line.closed {
+                        PathKind::Perimeter
+                    } else {
+                        PathKind::Infill
+                    },
+                },
+                width,
+            ));
+        }
+        last_ring = Some(c);
+        j += 1;
+    }
+    // Infill where the rings stop: lines end a spacing past the last ring, joined along that
+    // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
+    // the rings leave only a strip narrower than that (a thin blade), the lines cross the strip
+    // from the edge of the last ring's bead instead, filling the gap.
+    let inner = match last_ring {
+        Some(c) if dmax > c + 1.5 * spacing => c + spacing,
+        Some(c) => {
+            // Gap fill: the strip along the ridge that the last ring's bead leaves, of width
+            // 2β, gets one more ring in its middle with beads β wide (one on each side of the
+            // ridge), extruded for that width by Eq. 1.
+            let beta = dmax - (c + 0.5 * width);
+            if beta > 0.05 * width {
+                for line in lm.iso_lines(&db, c + 0.5 * width + 0.5 * beta, &db) {
+                    out.push((
+                        Path2 {
+                            points: line.q,
+                            kind: PathKind::Infill,
+                        },
+                        beta.min(width),
+                    ));
+                }
+            }
+            return out;
+        }
+        None => 0.5 * width,
+    };
+    if dmax <= inner {
+        return out;
+    }
+    let zig = params.path_mode != PathMode::Raster;
+    let angle = if zig && layer % 2 == 1 {
+        params.raster_angle_deg + 90.0
+    } else {
+        params.raster_angle_deg
+    }
+    .to_radians();
+    let dir = [angle.cos(), angle.sin()];
+    let nrm = [-dir[1], dir[0]];
+    // The seed curve: the chart line along `dir` through the deepest point; the field is the
+    // signed geodesic distance to it, so its iso-lines are geodesic parallels.
+    let q0 = lm.q[deep];
+    let l: Vec<f64> =
+        lm.q.iter()
+            .map(|q| (q[0] - q0[0]) * nrm[0] + (q[1] - q0[1]) * nrm[1])
+            .collect();
+    // Vertices within a spacing of the seed line start at their distance across it: the
+    // chart offset times the surface's stretch across the line there.
+    let stretch = {
+        let e = 1e-3;
+        match (
+            chart.at([q0[0] + e * nrm[0], q0[1] + e * nrm[1]], z),
+            chart.at([q0[0] - e * nrm[0], q0[1] - e * nrm[1]], z),
+        ) {
+            (Some(a), Some(b)) => (a.0 - b.0).norm() / (2.0 * e),
+            _ => 1.0,
+        }
+    };
+    let seeds: Vec<(u32, f64)> = l
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.abs() * stretch <= spacing)
+        .map(|(i, x)| (i as u32, x.abs() * stretch))
+        .collect();
+    let dist = lm.march(&seeds);
+    let phi: Vec<f64> = dist
+        .iter()
+        .zip(&l)
+        .map(|(d, l)| if *l < 0.0 { -d } else { *d })
+        .collect();
+    let (lo, hi) = phi
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
+            (a.0.min(x), a.1.max(x))
+        });
+    if !(lo.is_finite() && hi.is_finite()) || (hi - lo) / spacing > 1e5 {
+        return out;
+    }
+    // Levels half a spacing off the seed curve, then a spacing apart.
+    let j0 = (lo / spacing - 0.5).floor() as i64;
+    let j1 = (hi / spacing - 0.5).ceil() as i64;
+    let mut pieces: Vec<(i64, Vec<Point2>)> = vec![];
+    for j in j0..=j1 {
+        let level = (j as f64 + 0.5) * spacing;
+        for line in lm.iso_lines(&phi, level, &db) {
+            for mut piece in clip_above(&line, inner) {
+                let (a, b) = (piece[0], piece[piece.len() - 1]);
+                if (b[0] - a[0]) * dir[0] + (b[1] - a[1]) * dir[1] < 0.0 {
+                    piece.reverse();
+                }
+                pieces.push((j, piece));
+            }
+        }
+    }
+    if !zig {
+        out.extend(pieces.into_iter().map(|(_, p)| {
+            (
+                Path2 {
+                    points: p,
+                    kind: PathKind::Infill,
+                },
+                width,
+            )
+        }));
+        return out;
+    }
+    // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
+    // infill boundary (the iso-line where the lines were cut), when that way is short.
+    let border = lm.iso_lines(&db, inner, &db);
+    let along = Border::new(&border);
+    let mut used = vec![false; pieces.len()];
+    for s in 0..pieces.len() {
+        if used[s] {
+            continue;
+        }
+        used[s] = true;
+        let (mut level, mut pts) = (pieces[s].0, pieces[s].1.clone());
+        loop {
+            let end = pts[pts.len() - 1];
+            let mut best: Option<(f64, usize, bool, Vec<Point2>)> = None;
+            for (i, (lv, p)) in pieces.iter().enumerate() {
+                if used[i] || *lv != level + 1 {
+                    continue;
+                }
+                for (rev, q) in [(false, p[0]), (true, p[p.len() - 1])] {
+                    if let Some((len, way)) = along.connect(end, q, 2.5 * spacing) {
+                        if best.as_ref().is_none_or(|b| len < b.0) {
+                            best = Some((len, i, rev, way));
+                        }
+                    }
+                }
+            }
+            match best {
+                Some((_, i, rev, way)) => {
+                    used[i] = true;
+                    let mut next = pieces[i].1.clone();
+                    if rev {
+                        next.reverse();
+                    }
+                    pts.extend(way);
+                    pts.extend(next);
+                    level += 1;
+                }
+                None => break,
+            }
+        }
+        out.push((
+            Path2 {
+                points: pts,
+                kind: PathKind::Infill,
+            },
+            width,
+        ));
+    }
+    out
+}
+
+/// The infill boundary's rings, to run zig-zag connectors along.
+struct Border<'a> {
+    rings: &'a [crate::geodesic::IsoLine],
+    /// Arc length at each point of each ring.
+    arc: Vec<Vec<f64>>,
+}
+
+impl<'a> Border<'a> {
+    fn new(rings: &'a [crate::geodesic::IsoLine]) -> Self {
+        let arc = rings
+            .iter()
+            .map(|r| {
+                let mut a = vec![0.0];
+                for w in r.q.windows(2) {
+                    let l = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+                    a.push(a[a.len() - 1] + l);
+                }
+                a
+            })
+            .collect();
+        Border { rings, arc }
+    }
+
+    /// Ring, segment and arc length of the ring point nearest `q`, with its distance.
+    fn locate(&self, q: Point2) -> Option<(usize, usize, f64, f64)> {
+        let mut best: Option<(usize, usize, f64, f64)> = None;
+        for (r, ring) in self.rings.iter().enumerate() {
+            for (i, w) in ring.q.windows(2).enumerate() {
+                let (a, b) = (w[0], w[1]);
+                let ab = [b[0] - a[0], b[1] - a[1]];
+                let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+                let t = if l2 > 0.0 {
+                    (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let x = [a[0] + ab[0] * t, a[1] + ab[1] * t];
+                let d = ((q[0] - x[0]).powi(2) + (q[1] - x[1]).powi(2)).sqrt();
+                if best.is_none_or(|b| d < b.3) {
+                    best = Some((r, i, self.arc[r][i] + t * l2.sqrt(), d));
+                }
+            }
+        }
+        best
+    }
+
+    /// The way from `a` to `b` along one ring (interior ring points only), if both lie on the
+    /// same ring (within a few micrometres... of a spacing) and the shorter way is at most `max`.
+    fn connect(&self, a: Point2, b: Point2, max: f64) -> Option<(f64, Vec<Point2>)> {
+        let (ra, ia, sa, da) = self.locate(a)?;
+        let (rb, ib, sb, db) = self.locate(b)?;
+        if ra != rb || da > 0.05 * max || db > 0.05 * max {
+            return None;
+        }
+        let ring = &self.rings[ra];
+        let total = self.arc[ra][self.arc[ra].len() - 1];
+        let fwd = sb - sa;
+        let (len, forward) = if ring.closed {
+            let f = fwd.rem_euclid(total);
+            if f <= total - f {
+                (f, true)
+            } else {
+                (total - f, false)
+            }
+        } else {
+            (fwd.abs(), fwd >= 0.0)
+        };
+        if len > max {
+            return None;
+        }
+        let n = ring.q.len() - usize::from(ring.closed);
+        let mut way = vec![];
+        if n > 0 {
+            // Ring points strictly between the two segments, walking the chosen way.
+            let mut i = ia;
+            let mut guard = 0;
+            while i != ib && guard <= n {
+                if forward {
+                    i = (i + 1) % n.max(1);
+                    way.push(ring.q[i]);
+                } else {
+                    way.push(ring.q[i]);
+                    i = (i + n - 1) % n.max(1);
+                }
+                guard += 1;
+            }
+        }
+        Some((len, way))
+    }
+}
+
+/// [`crate::fill::order_paths`] for paths that carry their bead width: greedy nearest start
+/// (or end, reversing an open path) from `start`; closed paths are entered at their first point.
+fn order_with_widths(paths: Vec<(Path2, f64)>, start: Point2) -> Vec<(Path2, f64)> {
+    let mut todo: Vec<Option<(Path2, f64)>> = paths
+        .into_iter()
+        .filter(|p| !p.0.points.is_empty())
+        .map(Some)
+        .collect();
+    let d = |a: Point2, b: Point2| {
+        let v = (a[0] - b[0]).hypot(a[1] - b[1]);
+        if v.is_nan() {
+            f64::INFINITY
+        } else {
+            v
+        }
+    };
+    let mut out = Vec::with_capacity(todo.len());
+    let mut cur = start;
+    for _ in 0..todo.len() {
+        let mut best: Option<(f64, usize, bool)> = None;
+        for (i, p) in todo.iter().enumerate() {
+            let Some((p, _)) = p else { continue };
+            let ds = d(cur, p.points[0]);
+            if best.is_none_or(|b| ds < b.0) {
+                best = Some((ds, i, false));
+            }
+            if !p.is_closed() {
+                let de = d(cur, p.points[p.points.len() - 1]);
+                if best.is_none_or(|b| de < b.0) {
+                    best = Some((de, i, true));
+                }
+            }
+        }
+        let Some((_, i, reverse)) = best else { break };
+        let Some((mut p, w)) = todo[i].take() else {
+            break;
+        };
+        if reverse {
+            p.points.reverse();
+        }
+        cur = p.points[p.points.len() - 1];
+        out.push((p, w));
+    }
+    out
+}
+
+/// A lifted path point: chart coordinates, position and unit normal.
+#[derive(Debug, Clone, Copy)]
+struct Lifted {
+    q: Point2,
+    p: P3,
+    n: V3,
+}
+
+/// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
+/// is within `tol` of the surface, then dropping points whose removal keeps the polyline
+/// within `tol / 2` of the dense one (Douglas–Peucker in 3-D).
+fn lift(chart: &Chart, path: &[Point2], z: f64, tol: f64) -> Vec<Lifted> {
+    fn refine(
+        chart: &Chart,
+        a: Lifted,
+        b: Lifted,
+        z: f64,
+        tol: f64,
+        depth: u32,
+        out: &mut Vec<Lifted>,
+    ) {
+        if depth < 10 {
+            let qm = [0.5 * (a.q[0] + b.q[0]), 0.5 * (a.q[1] + b.q[1])];
+            if let Some((p, n)) = chart.at(qm, z) {
+                let mid = Lifted { q: qm, p, n };
+                if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
+                    refine(chart, a, mid, z, tol, depth + 1, out);
+                    refine(chart, mid, b, z, tol, depth + 1, out);
+                    return;
+                }
+            }
+        }
+        out.push(b);
+    }
+    let mut dense: Vec<Lifted> = vec![];
+    for q in path {
+        let Some((p, n)) = chart.at(*q, z) else {
+            continue;
+        };
+        let cur = Lifted { q: *q, p, n };
+        match dense.last().copied() {
+            Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
+            None => dense.push(cur),
+        }
+    }
+    if dense.len() <= 2 {
+        return dense;
+    }
+    let mut keep = vec![false; dense.len()];
+    keep[0] = true;
+    keep[dense.len() - 1] = true;
+    let mut stack = vec![(0usize, dense.len() - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let (a, b) = (dense[i].p, dense[j].p);
+        let ab = b - a;
+        let l2 = ab.norm_squared();
+        let (mut worst, mut at) = (0.0f64, i);
+        for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
+            let t = if l2 > 0.0 {
+                ((x.p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d = (x.p - (a + ab * t)).norm();
+            if d > worst {
+                worst = d;
+                at = k;
+            }
+        }
+        if worst > 0.5 * tol {
+            keep[at] = true;
+            stack.push((i, at));
+            stack.push((at, j));
+        }
+    }
+    dense
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(x, k)| k.then_some(x))
+        .collect()
+}
+
+/// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FreeformFigures {
+    /// `native` (the surface's parameters) or `projection` (tangent-plane chart).
+    pub chart: &'static str,
+    /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
+    /// when it curves away from the feature everywhere).
+    pub concave_radius: f64,
+}
+
+/// Plans one freeform feature on offsets of its reference surface, appending its points to
+/// `out` (travel from `cursor`, which is left at the last point).
+pub fn plan_freeform(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+    out: &mut Vec<PathPoint>,
+    cursor: &mut Option<P3>,
+) -> Result<(FeatureFigures, FreeformFigures), PlanError> {
+    let id = f.id;
+    let err = |msg: String| PlanError::Freeform { id, msg };
+    if f.kind != FeatureKind::Freeform {
+        return Err(err("it is not freeform".into()));
+    }
+    params
+        .validate()
+        .map_err(|msg| PlanError::Params { id, msg })?;
+    let b = &tree.brep;
+    let rf = f
+        .reference
+        .face
+        .ok_or_else(|| err("it has no reference face".into()))?;
+    let surf = b.face_surface(rf);
+    // N into the feature: the host face's outward normal (the parent's outside).
+    let mut sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
+    let mut faces = f.faces.clone();
+    for v in &f.voids {
+        faces.extend(v.iter().copied());
+    }
+    let tol = (params.tolerance * 0.25)
+        .min(0.25 * params.uniform_layer_height)
+        .max(1e-3);
+    let mesh =
+        mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
+            id,
+            msg: e.to_string(),
+        })?;
+    if mesh.positions.is_empty() {
+        return Err(err("its mesh is empty".into()));
+    }
+    let mesh = refined(&mesh, MAX_MAPPED_EDGE);
+    let mut chart = choose_chart(surf, sign, id, &mesh)?;
+    let mut mapped = mapped_mesh(&chart, &mesh, id)?;
+    // The feature lies on the side N points to: check, and turn N round if the face said
+    // otherwise.
+    let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
+    if mean_d < 0.0 {
+        sign = -sign;
+        chart = choose_chart(surf, sign, id, &mesh)?;
+        mapped = mapped_mesh(&chart, &mesh, id)?;
+    }
+    let top = mapped.positions.iter().map(|p| p.z).fold(0.0f64, f64::max);
+    let heights = params.layer_heights(top);
+    // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature.
+    let stride = (mapped.positions.len() / 300).max(1);
+    let step = (0.5 * params.uniform_layer_height).max(1e-3);
+    let mut lambda = 0.0f64;
+    for p in mapped.positions.iter().step_by(stride) {
+        if let Some(l) = chart.min_curvature([p.x, p.y], step) {
+            lambda = lambda.min(l);
+        }
+    }
+    let concave_radius = if lambda < -1e-9 {
+        -1.0 / lambda
+    } else {
+        f64::INFINITY
+    };
+    let spacing = params.spacing(bead.width);
+    let mut fig = FeatureFigures::default();
+    let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
+    let mut z = 0.0;
+    let up = Plane::new(P3::origin(), V3::z());
+    let fixed = params
+        .fixed_tool_axis
+        .map(|a| V3::new(a[0], a[1], a[2]).normalize());
+    for (layer, &dl) in heights.iter().enumerate() {
+        let mid = z + 0.5 * dl;
+        z += dl;
+        if z >= concave_radius {
+            return Err(PlanError::OffsetFolds {
+                id,
+                layer: layer + 1,
+                offset: z,
+                radius: concave_radius,
+            });
+        }
+        let loops: Vec<Vec<Point2>> = section(&mapped, &up.offset(mid))
+            .iter()
+            .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
+            .collect();
+        let regions = regions_from_loops(&loops);
+        let spacing = params
+            .spacing_for_layer(bead.width, layer)
+            .max(1e-3)
+            .min(spacing.max(1e-3) * 1e3);
+        let mut paths = vec![];
+        for r in &regions {
+            paths.extend(fill_region(
+                &chart, r, z, params, layer, bead.width, spacing,
+            ));
+        }
+        let start = cursor
+            .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
+            .unwrap_or([0.0, 0.0]);
+        let paths = if params.path_mode == PathMode::Raster {
+            paths
+        } else {
+            order_with_widths(paths, start)
+        };
+        let mut printed = false;
+        for (path, width) in paths {
+            let pts = lift(&chart, &path.points, z, params.tolerance);
+            if pts.len() < 2 {
+                continue;
+            }
+            printed = true;
+            let axis = |n: V3| {
+                let a = fixed.unwrap_or(n);
+                [a.x, a.y, a.z]
+            };
+            // Travel: up one layer over the start of the path, along the layer above
+            // (clear of this layer's beads on a curved surface), then down.
+            let first = pts[0];
+            let lift_to = z + dl;
+            let mut travel: Vec<(P3, V3)> = vec![];
+            if let Some(c) = *cursor {
+                if let Some((qc, dc)) = chart.inverse(&c) {
+                    let hz = lift_to.max(dc + dl);
+                    let span = ((first.q[0] - qc[0]).powi(2) + (first.q[1] - qc[1]).powi(2)).sqrt();
+                    let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
+                    for i in 0..=n {
+                        let t = i as f64 / n as f64;
+                        let q = [
+                            qc[0] + (first.q[0] - qc[0]) * t,
+                            qc[1] + (first.q[1] - qc[1]) * t,
+                        ];
+                        if let Some(x) = chart.at(q, hz) {
+                            travel.push(x);
+                        }
+                    }
+                }
+            }
+            travel.push((first.p, first.n));
+            for (p, n) in travel {
+                if let Some(c) = *cursor {
+                    fig.travel_length += (p - c).norm();
+                }
+                out.push(PathPoint {
+                    feature: id,
+                    layer,
+                    kind: MoveKind::Travel,
+                    p: [p.x, p.y, p.z],
+                    axis: axis(n),
+                    e: 0.0,
+                    thickness: dl,
+                    width: bead.width,
+                });
+                *cursor = Some(p);
+            }
+            for w in pts.windows(2) {
+                let l = (w[1].p - w[0].p).norm();
+                let e = filament_length(width, dl, l, bead.filament_diameter);
+                fig.print_length += l;
+                fig.filament += e;
+                out.push(PathPoint {
+                    feature: id,
+                    layer,
+                    kind: MoveKind::Print,
+                    p: [w[1].p.x, w[1].p.y, w[1].p.z],
+                    axis: axis(w[1].n),
+                    e,
+                    thickness: dl,
+                    width,
+                });
+            }
+            *cursor = pts.last().map(|x| x.p);
+        }
+        if printed {
+            fig.layers += 1;
+            tmin = tmin.min(dl);
+            tmax = tmax.max(dl);
+            tsum += dl;
+        }
+    }
+    fig.points = out.iter().filter(|p| p.feature == id).count();
+    fig.thickness = if fig.layers > 0 {
+        (tmin, tsum / fig.layers as f64, tmax)
+    } else {
+        (0.0, 0.0, 0.0)
+    };
+    if fig.layers == 0 {
+        fig.warnings.push(format!(
+            "feature {id} has no printable layer (thinner than a bead?)"
+        ));
+    }
+    let chart_name = match chart.kind {
+        ChartKind::Native { .. } => "native",
+        ChartKind::Ortho { .. } => "projection",
+    };
+    Ok((
+        fig,
+        FreeformFigures {
+            chart: chart_name,
+            concave_radius,
+        },
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use brep::math::Frame;
+
+    #[test]
+    fn a_flat_disc_is_covered_in_every_mode() {
+        // On a plane the chart is exact: the fills must cover the disc like planar fills do.
+        let surf = Surface::Plane {
+            frame: Frame::world(P3::origin()),
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 1.0,
+                sv: 1.0,
+            },
+        };
+        let outer: Vec<Point2> = (0..64)
+            .map(|i| {
+                let a = i as f64 / 64.0 * std::f64::consts::TAU;
+                [6.0 * a.cos(), 6.0 * a.sin()]
+            })
+            .collect();
+        let area = brep::section::signed_area(&outer);
+        let region = Region {
+            outer,
+            holes: vec![],
+        };
+        for (mode, lo) in [
+            (PathMode::ContourZigzag, 0.97),
+            (PathMode::Contour, 0.98),
+            (PathMode::Zigzag, 0.97),
+            (PathMode::Raster, 0.9),
+        ] {
+            let params = LayerParams {
+                path_mode: mode,
+                ..LayerParams::default()
+            };
+            let paths = fill_region(&chart, &region, 0.2, &params, 1, 0.45, 0.45);
+            let covered: f64 = paths.iter().map(|(p, w)| p.length() * w).sum::<f64>();
+            let r = covered / area;
+            assert!(r > lo && r < 1.02, "{mode:?}: {r}");
+            for (p, _) in &paths {
+                for q in &p.points {
+                    assert!(
+                        q[0].hypot(q[1]) < 6.0 - 0.2,
+                        "{mode:?}: {q:?} outside the bead inset"
+                    );
+                }
+            }
+        }
+    }
+}

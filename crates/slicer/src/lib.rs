@@ -4,6 +4,9 @@
 //!   validation, per-feature patches and the layer thicknesses they give;
 //! - [`fill`]: filling one planar layer by path mode (raster, zig-zag, contour,
 //!   contour-zig-zag) and ordering the paths for print;
+//! - [`freeform`]: curved layers of `freeform` features: offsets of the reference surface,
+//!   spatial slicing, paths spaced by geodesic distance ([`geodesic`]);
+//! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume.
 //!
@@ -11,6 +14,7 @@
 
 pub mod fill;
 pub mod freeform;
+pub mod geodesic;
 pub mod orient;
 pub mod params;
 pub mod planar;

@@ -66,6 +66,10 @@ pub struct LayerParams {
     /// Direction of raster and zig-zag lines, degrees from +x. Default 45; zig-zag adds 90° on
     /// odd layers.
     pub raster_angle_deg: f64,
+    /// Tool axis of every point of a freeform feature's curved layers: `None` (the default)
+    /// puts it along the layer surface's normal at the point; a vector fixes it (the paper:
+    /// "the direction could be constant for the entire layers if needed"). Normalised on use.
+    pub fixed_tool_axis: Option<[f64; 3]>,
 }
 
 impl Default for LayerParams {
@@ -81,6 +85,7 @@ impl Default for LayerParams {
             filling_ratio: 1.0,
             perimeters: 2,
             raster_angle_deg: 45.0,
+            fixed_tool_axis: None,
         }
     }
 }
@@ -204,6 +209,14 @@ impl LayerParams {
                 self.raster_angle_deg
             ));
         }
+        if let Some(a) = self.fixed_tool_axis {
+            let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            if !(n.is_finite() && n > 1e-9) {
+                return Err(format!(
+                    "fixed_tool_axis must be a non-zero finite vector, got {a:?}"
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -239,6 +252,9 @@ impl LayerParams {
         }
         if let Some(v) = p.raster_angle_deg {
             out.raster_angle_deg = v;
+        }
+        if let Some(v) = p.fixed_tool_axis {
+            out.fixed_tool_axis = Some(v);
         }
         out
     }
@@ -280,6 +296,9 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::raster_angle_deg`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub raster_angle_deg: Option<f64>,
+    /// Overrides [`LayerParams::fixed_tool_axis`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fixed_tool_axis: Option<[f64; 3]>,
 }
 
 #[cfg(test)]

@@ -1,0 +1,532 @@
+//! Geodesic distances on a curved layer, and the iso-lines of those distances.
+//!
+//! The feature-based AM paper asks that on a curved layer "the distance between the parallel
+//! toolpaths should be geodesic distance, namely geodesic offset on the surface". A layer's
+//! region, given in a 2-D chart of its surface, is triangulated ([`LayerMesh::build`]); each
+//! vertex is then placed on the layer surface in 3-D, and distances are marched over the
+//! triangles in 3-D ([`LayerMesh::march`], the fast marching method of Kimmel & Sethian 1998
+//! with the planar-wavefront triangle update). Paths are the iso-lines of such distance fields
+//! ([`LayerMesh::iso_lines`]): contour rings are iso-lines of the distance to the region's
+//! boundary; raster and zig-zag lines are iso-lines of the signed distance to a seed curve, so
+//! neighbouring lines are one spacing apart measured on the surface, not in the chart.
+
+use crate::fill::{Point2, Region};
+use brep::math::P3;
+use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap};
+
+/// A triangulated layer region: chart coordinates, 3-D points on the layer surface, triangles.
+#[derive(Debug, Clone, Default)]
+pub struct LayerMesh {
+    /// Chart coordinates of each vertex.
+    pub q: Vec<Point2>,
+    /// The vertex on the layer surface, mm (filled by the caller after [`LayerMesh::build`]).
+    pub p: Vec<P3>,
+    /// Triangles (vertex indices), all inside the region.
+    pub tris: Vec<[u32; 3]>,
+    /// Whether each vertex lies on the region's boundary.
+    pub boundary: Vec<bool>,
+    /// The region's rings as closed vertex chains (first vertex not repeated).
+    pub rings: Vec<Vec<u32>>,
+    /// Triangles around each vertex.
+    around: Vec<Vec<u32>>,
+}
+
+/// One iso-line: chart points, and the value of a second field at each.
+#[derive(Debug, Clone, Default)]
+pub struct IsoLine {
+    /// Chart coordinates along the line.
+    pub q: Vec<Point2>,
+    /// The second field interpolated at each point.
+    pub other: Vec<f64>,
+    /// The line is a closed ring (the first point is repeated at the end).
+    pub closed: bool,
+}
+
+fn dist2(a: Point2, b: Point2) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Even-odd inside test against every ring of a region.
+pub fn region_contains(region: &Region, q: Point2) -> bool {
+    let mut inside = false;
+    for ring in std::iter::once(&region.outer).chain(region.holes.iter()) {
+        let n = ring.len();
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if (a[1] > q[1]) != (b[1] > q[1]) {
+                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > q[0] {
+                    inside = !inside;
+                }
+            }
+        }
+    }
+    inside
+}
+
+/// Resamples a closed ring so no segment is longer than `step`.
+fn resample(ring: &[Point2], step: f64) -> Vec<Point2> {
+    let n = ring.len();
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        let k = (dist2(a, b).sqrt() / step).ceil().clamp(1.0, 1e4) as usize;
+        for j in 0..k {
+            let t = j as f64 / k as f64;
+            out.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    out
+}
+
+/// Min-heap entry for marching.
+#[derive(PartialEq)]
+struct Entry(f64, u32);
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
+    }
+}
+
+/// The planar-wavefront update of vertex `c` from the known vertices `a`, `b` of a triangle
+/// (Kimmel & Sethian 1998): unfold the triangle into the plane, take the distance as linear
+/// over it with a unit gradient matching `da`, `db` along `ab`, and use it when the
+/// characteristic through `c` comes from within `ab` (upwind); otherwise the shorter path along
+/// an edge.
+fn triangle_update(pa: &P3, pb: &P3, pc: &P3, da: f64, db: f64) -> f64 {
+    let along_edges = (da + (pc - pa).norm()).min(db + (pc - pb).norm());
+    let ab = pb - pa;
+    let c = ab.norm();
+    if c < 1e-12 {
+        return along_edges;
+    }
+    let ex = ab / c;
+    let ac = pc - pa;
+    let cx = ac.dot(&ex);
+    let cy = (ac - ex * cx).norm();
+    let gx = (db - da) / c;
+    if cy < 1e-12 || gx.abs() >= 1.0 {
+        return along_edges;
+    }
+    let gy = (1.0 - gx * gx).sqrt();
+    // Where the characteristic through c crosses the line through a and b.
+    let x = cx - gx * cy / gy;
+    let through = da + gx * cx + gy * cy;
+    if (0.0..=c).contains(&x) && through >= da.max(db) {
+        through.min(along_edges)
+    } else {
+        along_edges
+    }
+}
+
+impl LayerMesh {
+    /// Triangulates `region` (chart coordinates): its rings resampled to `step`, a triangular
+    /// lattice of spacing `step` inside, constrained Delaunay, triangles kept whose centroid is
+    /// inside the region. [`LayerMesh::p`] is left empty for the caller to fill.
+    pub fn build(region: &Region, step: f64) -> LayerMesh {
+        let mut m = LayerMesh::default();
+        if !(step.is_finite() && step > 0.0) {
+            return m;
+        }
+        let rings: Vec<Vec<Point2>> = std::iter::once(&region.outer)
+            .chain(region.holes.iter())
+            .filter(|r| r.len() >= 3)
+            .map(|r| resample(r, step))
+            .collect();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for q in rings.iter().flatten() {
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        if !(lo[0].is_finite() && hi[0].is_finite() && lo[1].is_finite() && hi[1].is_finite()) {
+            return m;
+        }
+        let cells = ((hi[0] - lo[0]) / step) * ((hi[1] - lo[1]) / step);
+        if cells > 4e6 {
+            return m;
+        }
+        // Boundary points in a bucket grid, to keep lattice points off the boundary.
+        let cell = |q: Point2| {
+            (
+                ((q[0] - lo[0]) / step).floor() as i64,
+                ((q[1] - lo[1]) / step).floor() as i64,
+            )
+        };
+        let mut grid: HashMap<(i64, i64), Vec<Point2>> = HashMap::new();
+        for q in rings.iter().flatten() {
+            grid.entry(cell(*q)).or_default().push(*q);
+        }
+        let near_boundary = |q: Point2| {
+            let (i, j) = cell(q);
+            (i - 1..=i + 1).any(|a| {
+                (j - 1..=j + 1).any(|b| {
+                    grid.get(&(a, b)).is_some_and(|v| {
+                        v.iter().any(|p| dist2(*p, q) < (0.6 * step) * (0.6 * step))
+                    })
+                })
+            })
+        };
+        let mut cdt: ConstrainedDelaunayTriangulation<SPoint<f64>> =
+            ConstrainedDelaunayTriangulation::new();
+        let mut index: HashMap<usize, u32> = HashMap::new();
+        let mut add = |cdt: &mut ConstrainedDelaunayTriangulation<SPoint<f64>>,
+                       m: &mut LayerMesh,
+                       q: Point2,
+                       on_boundary: bool| {
+            let h = cdt.insert(SPoint::new(q[0], q[1])).ok()?;
+            index.entry(h.index()).or_insert_with(|| {
+                m.q.push(q);
+                m.boundary.push(on_boundary);
+                (m.q.len() - 1) as u32
+            });
+            Some(h)
+        };
+        let mut ring_handles = vec![];
+        for ring in &rings {
+            let hs: Vec<_> = ring
+                .iter()
+                .filter_map(|q| add(&mut cdt, &mut m, *q, true))
+                .collect();
+            ring_handles.push(hs.clone());
+            for i in 0..hs.len() {
+                let (a, b) = (hs[i], hs[(i + 1) % hs.len()]);
+                if a != b && cdt.can_add_constraint(a, b) {
+                    cdt.add_constraint(a, b);
+                }
+            }
+        }
+        let dy = step * 0.75f64.sqrt();
+        let rows = ((hi[1] - lo[1]) / dy).ceil() as usize;
+        let cols = ((hi[0] - lo[0]) / step).ceil() as usize;
+        for r in 0..=rows {
+            let y = lo[1] + r as f64 * dy;
+            let shift = if r % 2 == 1 { 0.5 * step } else { 0.0 };
+            for c in 0..=cols {
+                let q = [lo[0] + shift + c as f64 * step, y];
+                if region_contains(region, q) && !near_boundary(q) {
+                    add(&mut cdt, &mut m, q, false);
+                }
+            }
+        }
+        m.rings = ring_handles
+            .iter()
+            .map(|hs| {
+                hs.iter()
+                    .filter_map(|h| index.get(&h.index()).copied())
+                    .collect()
+            })
+            .collect();
+        for f in cdt.inner_faces() {
+            let vs = f.vertices();
+            let ids: Option<Vec<u32>> = vs
+                .iter()
+                .map(|v| index.get(&v.fix().index()).copied())
+                .collect();
+            let Some(ids) = ids else { continue };
+            let c = [
+                (m.q[ids[0] as usize][0] + m.q[ids[1] as usize][0] + m.q[ids[2] as usize][0]) / 3.0,
+                (m.q[ids[0] as usize][1] + m.q[ids[1] as usize][1] + m.q[ids[2] as usize][1]) / 3.0,
+            ];
+            if region_contains(region, c) {
+                m.tris.push([ids[0], ids[1], ids[2]]);
+            }
+        }
+        m.around = vec![vec![]; m.q.len()];
+        for (t, tri) in m.tris.iter().enumerate() {
+            for &v in tri {
+                m.around[v as usize].push(t as u32);
+            }
+        }
+        m
+    }
+
+    /// Exact 3-D distances to the boundary (the lifted ring polylines) of every vertex within
+    /// `reach` (chart units) of it, as seeds for [`LayerMesh::march`]: a front started from
+    /// exact values a few triangles deep is far more accurate than one started at the ring.
+    pub fn boundary_seeds(&self, reach: f64) -> Vec<(u32, f64)> {
+        let cell = reach.max(1e-9);
+        let key = |q: Point2| ((q[0] / cell).floor() as i64, (q[1] / cell).floor() as i64);
+        let mut grid: HashMap<(i64, i64), Vec<(u32, u32)>> = HashMap::new();
+        for ring in &self.rings {
+            let n = ring.len();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let qa = self.q[a as usize];
+                let qb = self.q[b as usize];
+                let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
+                grid.entry(key(mid)).or_default().push((a, b));
+            }
+        }
+        let mut out = vec![];
+        for (v, q) in self.q.iter().enumerate() {
+            let (i, j) = key(*q);
+            let p = self.p[v];
+            let mut best = f64::INFINITY;
+            for a in i - 2..=i + 2 {
+                for b in j - 2..=j + 2 {
+                    for &(s, e) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
+                        let (ps, pe) = (self.p[s as usize], self.p[e as usize]);
+                        let d = pe - ps;
+                        let l2 = d.norm_squared();
+                        let t = if l2 > 0.0 {
+                            ((p - ps).dot(&d) / l2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        best = best.min((p - (ps + d * t)).norm());
+                    }
+                }
+            }
+            if self.boundary[v] {
+                best = 0.0;
+            }
+            if best.is_finite() && (best <= reach || self.boundary[v]) {
+                out.push((v as u32, best));
+            }
+        }
+        out
+    }
+
+    /// Distances over the mesh's 3-D points from `seeds` (vertex, starting distance), by fast
+    /// marching. Vertices the front never reaches keep `f64::INFINITY`.
+    pub fn march(&self, seeds: &[(u32, f64)]) -> Vec<f64> {
+        let n = self.p.len();
+        let mut d = vec![f64::INFINITY; n];
+        let mut known = vec![false; n];
+        let mut heap = BinaryHeap::new();
+        for &(v, s) in seeds {
+            if (v as usize) < n && s < d[v as usize] {
+                d[v as usize] = s;
+                heap.push(Entry(s, v));
+            }
+        }
+        while let Some(Entry(dv, v)) = heap.pop() {
+            let vi = v as usize;
+            if known[vi] || dv > d[vi] {
+                continue;
+            }
+            known[vi] = true;
+            for &t in &self.around[vi] {
+                let tri = self.tris[t as usize];
+                for k in 0..3 {
+                    let c = tri[k] as usize;
+                    if known[c] {
+                        continue;
+                    }
+                    let (a, b) = (tri[(k + 1) % 3] as usize, tri[(k + 2) % 3] as usize);
+                    let cand = match (known[a], known[b]) {
+                        (true, true) => {
+                            triangle_update(&self.p[a], &self.p[b], &self.p[c], d[a], d[b])
+                        }
+                        (true, false) => d[a] + (self.p[c] - self.p[a]).norm(),
+                        (false, true) => d[b] + (self.p[c] - self.p[b]).norm(),
+                        _ => continue,
+                    };
+                    if cand < d[c] {
+                        d[c] = cand;
+                        heap.push(Entry(cand, c as u32));
+                    }
+                }
+            }
+        }
+        d
+    }
+
+    /// The iso-lines `f = level` over the mesh, chained into polylines, with `other`
+    /// interpolated along them. Triangles where `f` is not finite at a vertex are skipped.
+    pub fn iso_lines(&self, f: &[f64], level: f64, other: &[f64]) -> Vec<IsoLine> {
+        type Key = (u32, u32);
+        let key = |a: u32, b: u32| (a.min(b), a.max(b));
+        let mut point: HashMap<Key, (Point2, f64)> = HashMap::new();
+        let mut links: HashMap<Key, Vec<Key>> = HashMap::new();
+        let at = |a: u32, b: u32| -> (Point2, f64) {
+            let (fa, fb) = (f[a as usize], f[b as usize]);
+            let t = if (fb - fa).abs() > 0.0 {
+                ((level - fa) / (fb - fa)).clamp(0.0, 1.0)
+            } else {
+                0.5
+            };
+            let (qa, qb) = (self.q[a as usize], self.q[b as usize]);
+            (
+                [qa[0] + (qb[0] - qa[0]) * t, qa[1] + (qb[1] - qa[1]) * t],
+                other[a as usize] + (other[b as usize] - other[a as usize]) * t,
+            )
+        };
+        for tri in &self.tris {
+            if tri.iter().any(|&v| !f[v as usize].is_finite()) {
+                continue;
+            }
+            let up = [0, 1, 2].map(|k| f[tri[k] as usize] >= level);
+            let n_up = up.iter().filter(|x| **x).count();
+            if n_up == 0 || n_up == 3 {
+                continue;
+            }
+            let lone = (0..3)
+                .find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3])
+                .unwrap_or(0);
+            let (a, b, c) = (tri[lone], tri[(lone + 1) % 3], tri[(lone + 2) % 3]);
+            let (e1, e2) = (key(a, b), key(a, c));
+            point.entry(e1).or_insert_with(|| at(a, b));
+            point.entry(e2).or_insert_with(|| at(a, c));
+            links.entry(e1).or_default().push(e2);
+            links.entry(e2).or_default().push(e1);
+        }
+        let mut used: std::collections::HashSet<Key> = std::collections::HashSet::new();
+        let mut keys: Vec<Key> = links.keys().copied().collect();
+        keys.sort_unstable();
+        // Chain from the open ends first, then the rings.
+        keys.sort_by_key(|k| links[k].len() != 1);
+        let mut out = vec![];
+        for s in keys {
+            if used.contains(&s) {
+                continue;
+            }
+            let mut chain = vec![s];
+            used.insert(s);
+            let mut cur = s;
+            loop {
+                let next = links[&cur].iter().copied().find(|k| !used.contains(k));
+                match next {
+                    Some(k) => {
+                        used.insert(k);
+                        chain.push(k);
+                        cur = k;
+                    }
+                    None => break,
+                }
+            }
+            let closed = chain.len() > 2 && links[&cur].contains(&s) && links[&s].len() == 2;
+            let mut line = IsoLine {
+                closed,
+                ..IsoLine::default()
+            };
+            for k in &chain {
+                let (q, o) = point[k];
+                line.q.push(q);
+                line.other.push(o);
+            }
+            if closed {
+                line.q.push(line.q[0]);
+                line.other.push(line.other[0]);
+            }
+            if line.q.len() >= 2 {
+                out.push(line);
+            }
+        }
+        out
+    }
+}
+
+/// The pieces of `line` where its `other` value is at least `min`, cut exactly at the crossings.
+pub fn clip_above(line: &IsoLine, min: f64) -> Vec<Vec<Point2>> {
+    let mut out = vec![];
+    let mut cur: Vec<Point2> = vec![];
+    for i in 0..line.q.len() {
+        let inside = line.other[i] >= min;
+        if i > 0 {
+            let (a, b) = (line.other[i - 1], line.other[i]);
+            if (a >= min) != inside {
+                let t = ((min - a) / (b - a)).clamp(0.0, 1.0);
+                let (qa, qb) = (line.q[i - 1], line.q[i]);
+                let x = [qa[0] + (qb[0] - qa[0]) * t, qa[1] + (qb[1] - qa[1]) * t];
+                cur.push(x);
+                if !inside {
+                    out.push(std::mem::take(&mut cur));
+                }
+            }
+        }
+        if inside {
+            cur.push(line.q[i]);
+        }
+    }
+    out.push(cur);
+    out.retain(|p| p.len() >= 2);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(a: f64) -> Region {
+        Region {
+            outer: vec![[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]],
+            holes: vec![],
+        }
+    }
+
+    #[test]
+    fn marching_on_a_flat_square_gives_euclidean_distance() {
+        let mut m = LayerMesh::build(&square(10.0), 0.25);
+        m.p = m.q.iter().map(|q| P3::new(q[0], q[1], 0.0)).collect();
+        let seeds: Vec<(u32, f64)> = (0..m.q.len() as u32)
+            .filter(|&v| m.boundary[v as usize])
+            .map(|v| (v, 0.0))
+            .collect();
+        let d = m.march(&m.boundary_seeds(0.5));
+        let _ = seeds;
+        let mut worst = 0.0f64;
+        let mut bias = 0.0;
+        for (q, d) in m.q.iter().zip(&d) {
+            let exact = q[0].min(q[1]).min(10.0 - q[0]).min(10.0 - q[1]);
+            worst = worst.max((d - exact).abs());
+            bias += d - exact;
+        }
+        assert!(bias.abs() / (m.q.len() as f64) < 0.01, "bias {bias}");
+        // Exact seeds at the boundary, planar fronts: exact up to the square's corners.
+        assert!(worst < 0.05, "worst error {worst}");
+        // Iso-line at 2 mm: a square ring 6 mm a side.
+        let rings = m.iso_lines(&d, 2.0, &d);
+        assert_eq!(rings.len(), 1);
+        assert!(rings[0].closed);
+        let len: f64 = rings[0]
+            .q
+            .windows(2)
+            .map(|w| dist2(w[0], w[1]).sqrt())
+            .sum();
+        assert!((len - 24.0).abs() < 1.0, "ring length {len}");
+    }
+
+    #[test]
+    fn marching_on_a_cylinder_measures_along_the_surface() {
+        // Chart (s, t) = (R·angle, z) of a cylinder of radius 5: distances from the line s = 0
+        // are arc lengths, which the chart keeps, not chords.
+        let r = 5.0;
+        let mut m = LayerMesh::build(&square(10.0), 0.2);
+        m.p =
+            m.q.iter()
+                .map(|q| P3::new(r * (q[0] / r).cos(), r * (q[0] / r).sin(), q[1]))
+                .collect();
+        let seeds: Vec<(u32, f64)> = (0..m.q.len() as u32)
+            .filter(|&v| m.q[v as usize][0] < 1e-9)
+            .map(|v| (v, 0.0))
+            .collect();
+        let d = m.march(&seeds);
+        for (q, d) in m.q.iter().zip(&d) {
+            assert!((d - q[0]).abs() < 0.05 + 0.01 * q[0], "at {q:?}: {d}");
+        }
+    }
+
+    #[test]
+    fn clipping_cuts_at_the_crossings() {
+        let line = IsoLine {
+            q: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]],
+            other: vec![0.0, 1.0, 1.0, 0.0],
+            closed: false,
+        };
+        let pieces = clip_above(&line, 0.5);
+        assert_eq!(pieces.len(), 1);
+        assert_eq!(pieces[0].first(), Some(&[0.5, 0.0]));
+        assert_eq!(pieces[0].last(), Some(&[2.5, 0.0]));
+    }
+}

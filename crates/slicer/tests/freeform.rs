@@ -1,0 +1,317 @@
+//! Curved layers of freeform features, checked against the exact reference surfaces of the
+//! fixtures: offset distance, containment, tool axis, volume, support.
+
+use brep::math::{P3, V3};
+use brep::mesh::{mesh_faces, Mesh, MeshOptions};
+use features::{extract, ExtractOptions, FeatureKind, FeatureTree};
+use slicer::freeform::plan_freeform;
+use slicer::params::{LayerParams, PathMode};
+use slicer::planar::{Bead, PlanError};
+use slicer::toolpath::{MoveKind, PathPoint};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+const BEAD: Bead = Bead {
+    width: 0.45,
+    filament_diameter: 1.75,
+};
+
+fn tree(name: &str) -> FeatureTree {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(format!("{name}.step"));
+    let part = brep::read_step(&path).expect("fixture reads");
+    let s = part.brep.solid_ids().next().expect("a solid");
+    extract(&part.brep, s, &ExtractOptions::default()).expect("extracts")
+}
+
+fn mesh_of(t: &FeatureTree, id: usize) -> Mesh {
+    let f = &t.features[id];
+    mesh_faces(&t.brep, &f.faces, &MeshOptions::with_tolerance(0.01)).expect("meshes")
+}
+
+/// Points within `r` of a query, over a hash grid of samples of the print segments.
+struct Near {
+    cell: f64,
+    grid: HashMap<(i64, i64, i64), Vec<P3>>,
+}
+
+impl Near {
+    fn new(points: &[PathPoint], cell: f64) -> Near {
+        let mut grid: HashMap<(i64, i64, i64), Vec<P3>> = HashMap::new();
+        let key = |p: &P3| {
+            (
+                (p.x / cell).floor() as i64,
+                (p.y / cell).floor() as i64,
+                (p.z / cell).floor() as i64,
+            )
+        };
+        for w in points.windows(2) {
+            if w[1].kind != MoveKind::Print {
+                continue;
+            }
+            let (a, b) = (P3::from(w[0].p), P3::from(w[1].p));
+            let n = ((b - a).norm() / 0.05).ceil().max(1.0) as usize;
+            for i in 0..=n {
+                let p = a + (b - a) * (i as f64 / n as f64);
+                grid.entry(key(&p)).or_default().push(p);
+            }
+        }
+        Near { cell, grid }
+    }
+
+    fn distance(&self, p: &P3) -> f64 {
+        let c = |x: f64| (x / self.cell).floor() as i64;
+        let (i, j, k) = (c(p.x), c(p.y), c(p.z));
+        let mut best = f64::INFINITY;
+        for a in i - 1..=i + 1 {
+            for b in j - 1..=j + 1 {
+                for d in k - 1..=k + 1 {
+                    if let Some(v) = self.grid.get(&(a, b, d)) {
+                        for q in v {
+                            best = best.min((q - p).norm());
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+struct Checked {
+    layers: usize,
+    volume: f64,
+    extruded: f64,
+}
+
+/// Plans every freeform feature of `name` with `params` and checks the properties on
+/// every print point.
+fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> {
+    let t = tree(name);
+    let area = std::f64::consts::PI * BEAD.filament_diameter.powi(2) / 4.0;
+    let mut out = vec![];
+    for &k in &t.build_order {
+        let f = &t.features[k];
+        if f.kind != FeatureKind::Freeform {
+            continue;
+        }
+        let mut pts = vec![];
+        let mut cursor = None;
+        let (fig, ff) = plan_freeform(&t, f, params, BEAD, &mut pts, &mut cursor)
+            .unwrap_or_else(|e| panic!("{name} feature {k}: {e}"));
+        let rf = f.reference.face.expect("reference face");
+        let surf = t.brep.face_surface(rf);
+        let mesh = mesh_of(&t, k);
+        let h = params.uniform_layer_height;
+        // Layer tops: the running sum of the thicknesses.
+        let mut tops: HashMap<usize, f64> = HashMap::new();
+        let mut thick: Vec<(usize, f64)> = pts.iter().map(|p| (p.layer, p.thickness)).collect();
+        thick.sort_by_key(|x| x.0);
+        thick.dedup_by_key(|x| x.0);
+        let mut z = 0.0;
+        let mut last = None;
+        for (layer, dl) in thick {
+            if let Some(l) = last {
+                assert_eq!(layer, l + 1, "{name} feature {k}: layers skip");
+            }
+            z += dl;
+            tops.insert(layer, z);
+            last = Some(layer);
+        }
+        let by_layer =
+            |l: usize| -> Vec<PathPoint> { pts.iter().filter(|p| p.layer == l).copied().collect() };
+        let mut below_cache: HashMap<usize, Near> = HashMap::new();
+        let (mut worst_d, mut worst_axis, mut worst_support) = (0.0f64, 0.0f64, 0.0f64);
+        for (i, p) in pts.iter().enumerate() {
+            if p.kind != MoveKind::Print {
+                continue;
+            }
+            let x = P3::from(p.p);
+            let (u, v) = surf.project(&x, None);
+            let foot = surf.eval(u, v);
+            let d = (x - foot).norm();
+            let top = tops[&p.layer];
+            worst_d = worst_d.max((d - top).abs());
+            assert!(
+                (d - top).abs() <= 0.02 * h,
+                "{name} feature {k} point {i} layer {}: {d} mm off the reference, layer top {top}",
+                p.layer
+            );
+            let n = surf.normal(u, v).expect("normal");
+            let n = if n.dot(&(x - foot)) < 0.0 { -n } else { n };
+            let a = V3::from(p.axis);
+            assert!((a.norm() - 1.0).abs() < 1e-6, "axis not unit");
+            let ang = a.dot(&n).clamp(-1.0, 1.0).acos().to_degrees();
+            worst_axis = worst_axis.max(ang);
+            assert!(
+                ang < 1.0,
+                "{name} feature {k} point {i}: axis {ang}° off the normal"
+            );
+            // The bead's middle is inside the feature.
+            let mid = x - n * (0.5 * p.thickness);
+            if i % 7 == 0 {
+                let w = mesh.winding_number(&mid);
+                if w <= 0.5 {
+                    let mut txt = String::new();
+                    for q in pts.iter().filter(|q| q.layer == p.layer) {
+                        let m = P3::from(q.p) - V3::from(q.axis) * (0.5 * q.thickness);
+                        txt.push_str(&format!(
+                            "{},{},{},{},{}\n",
+                            q.p[0],
+                            q.p[1],
+                            q.p[2],
+                            q.kind.as_str(),
+                            mesh.winding_number(&m)
+                        ));
+                    }
+                    std::fs::write("/tmp/layer.csv", txt).ok();
+                }
+                assert!(w > 0.5, "{name} feature {k} point {i} layer {} of {}: bead middle outside ({w}) at {:?}, prev {:?} {:?}", p.layer, fig.layers, p.p, pts[i-1].p, pts[i-1].kind);
+            }
+            if !check_support {
+                continue;
+            }
+            // Support-free: below every point is the layer before or the reference surface.
+            if p.layer == 0 {
+                // On the reference surface under the feature: just above the foot is inside.
+                let w = mesh.winding_number(&(foot + n * 0.05));
+                assert!(
+                    w > 0.5,
+                    "{name} feature {k} point {i}: first layer off the reference face ({w})"
+                );
+            } else {
+                // Layer k−1 lies under the bead: a quarter of a layer below the bottom of
+                // layer k is still inside the feature (an overhang would put it outside), and
+                // the beads of layer k−1 run there (a pocket of the fill is at most a small
+                // fraction of a bead).
+                if i % 7 == 0 {
+                    let below = x - n * (1.25 * p.thickness);
+                    let w = mesh.winding_number(&below);
+                    assert!(
+                        w > 0.5,
+                        "{name} feature {k} point {i} layer {}: nothing below ({w})",
+                        p.layer
+                    );
+                }
+                let near = below_cache
+                    .entry(p.layer - 1)
+                    .or_insert_with(|| Near::new(&by_layer(p.layer - 1), 0.5));
+                let gap = near.distance(&(x - n * p.thickness));
+                worst_support = worst_support.max(gap);
+                assert!(
+                    gap <= BEAD.width,
+                    "{name} feature {k} point {i} layer {}: {gap} mm from the beads below",
+                    p.layer
+                );
+            }
+        }
+        if let Ok(v) = std::env::var("DUMP_LAYER") {
+            let mut it = v.split(':').filter_map(|x| x.parse::<usize>().ok());
+            if let (Some(fk), Some(l)) = (it.next(), it.next()) {
+                if fk == k {
+                    let mut txt = String::new();
+                    for q in pts.iter().filter(|q| q.layer == l) {
+                        txt.push_str(&format!(
+                            "{},{},{},{},0\n",
+                            q.p[0],
+                            q.p[1],
+                            q.p[2],
+                            q.kind.as_str()
+                        ));
+                    }
+                    std::fs::write("/tmp/layer.csv", txt).ok();
+                }
+            }
+        }
+        let extruded: f64 = pts.iter().map(|p| p.e).sum::<f64>() * area;
+        eprintln!(
+            "{name} feature {k}: {} layers, {} points, chart {}, concave radius {:.2}, volume {:.2} extruded {:.2} ({:+.2}%), worst offset error {:.4} mm, axis {:.3}°, support gap {:.3} mm",
+            fig.layers,
+            pts.len(),
+            ff.chart,
+            ff.concave_radius,
+            f.volume,
+            extruded,
+            100.0 * (extruded / f.volume - 1.0),
+            worst_d,
+            worst_axis,
+            worst_support
+        );
+        out.push(Checked {
+            layers: fig.layers,
+            volume: f.volume,
+            extruded,
+        });
+    }
+    out
+}
+
+fn assert_volume(name: &str, c: &[Checked]) {
+    assert!(!c.is_empty(), "{name} has freeform features");
+    for x in c {
+        assert!(x.layers > 0);
+        let r = x.extruded / x.volume - 1.0;
+        assert!(
+            r.abs() < 0.02,
+            "{name}: extruded {} of {} mm³",
+            x.extruded,
+            x.volume
+        );
+    }
+}
+
+#[test]
+fn impeller_blades_lie_on_hub_offsets_inside_supported_and_conserve_volume() {
+    let c = check("impeller", &LayerParams::default(), false);
+    assert_eq!(c.len(), 6);
+    assert_volume("impeller", &c);
+}
+
+#[test]
+fn fan_blades_lie_on_cylinder_offsets_inside_supported_and_conserve_volume() {
+    let c = check("fan", &LayerParams::default(), true);
+    assert_eq!(c.len(), 5);
+    assert_volume("fan", &c);
+}
+
+#[test]
+fn capsule_bosses_lie_on_cone_and_sphere_offsets_inside_supported_and_conserve_volume() {
+    let c = check("capsule", &LayerParams::default(), true);
+    assert_eq!(c.len(), 2);
+    assert_volume("capsule", &c);
+}
+
+#[test]
+fn every_path_mode_keeps_points_on_the_offsets_and_inside() {
+    for mode in [PathMode::Raster, PathMode::Zigzag, PathMode::Contour] {
+        let params = LayerParams {
+            path_mode: mode,
+            ..LayerParams::default()
+        };
+        let c = check("capsule", &params, false);
+        for x in &c {
+            let r = x.extruded / x.volume;
+            // Raster leaves the half-bead band along the boundary by design.
+            let lo = if mode == PathMode::Raster { 0.85 } else { 0.97 };
+            assert!(r > lo && r < 1.03, "{mode:?}: extruded {r} of the volume");
+        }
+    }
+}
+
+#[test]
+fn a_two5d_feature_is_refused_by_the_freeform_planner() {
+    let t = tree("capsule");
+    let mut pts = vec![];
+    let e = plan_freeform(
+        &t,
+        &t.features[0],
+        &LayerParams::default(),
+        BEAD,
+        &mut pts,
+        &mut None,
+    )
+    .unwrap_err();
+    assert!(matches!(e, PlanError::Freeform { id: 0, .. }), "{e}");
+    assert!(pts.is_empty());
+}
