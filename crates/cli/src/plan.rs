@@ -177,6 +177,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             );
             if let Some(ff) = freeform {
                 o.insert("chart".into(), json!(ff.chart));
+                o.insert("overhang_points".into(), json!(ff.overhang_points));
                 o.insert(
                     "concave_radius_mm".into(),
                     if ff.concave_radius.is_finite() {

@@ -24,7 +24,7 @@
 //!   the feature's `tolerance` of the surface; the tool axis is N (or `fixed_tool_axis`);
 //!   extrusion follows Isa & Lazoglu 2019, Eq. 1 with the layer's thickness.
 
-use crate::fill::{regions_from_loops, Path2, PathKind, Point2, Region};
+use crate::fill::{regions_from_loops, Point2, Region};
 use crate::geodesic::{clip_above, LayerMesh};
 use crate::params::{LayerParams, PathMode};
 use crate::planar::{filament_length, Bead, FeatureFigures, PlanError};
@@ -105,21 +105,106 @@ impl<'a> Chart<'a> {
         }
     }
 
+    /// The reference surface at `(u, v)` and its unit normal into the feature, continued past
+    /// a bounded parameter range (a revolved profile's or a B-spline's end) by its tangent
+    /// plane along the boundary, so that a feature overhanging its reference face's edge still
+    /// has a foot under every point. Poles are not continued.
+    fn eval_ext(&self, u: f64, v: f64) -> Option<(P3, V3)> {
+        let (bu, bv) = if matches!(self.surf, Surface::Sphere { .. }) {
+            (None, None)
+        } else {
+            self.surf.bounds()
+        };
+        let clamp = |x: f64, r: Option<(f64, f64)>| {
+            r.map(|(a, b)| x.clamp(a.min(b), a.max(b))).unwrap_or(x)
+        };
+        let (uc, vc) = (clamp(u, bu), clamp(v, bv));
+        let n = self.normal_at(uc, vc)?;
+        if uc == u && vc == v {
+            return Some((self.surf.eval(u, v), n));
+        }
+        let (p, su, sv) = self.surf.eval_d1(uc, vc);
+        Some((p + su * (u - uc) + sv * (v - vc), n))
+    }
+
+    /// Whether chart point `q` lies on the reference surface proper, not on its continuation
+    /// past a bounded parameter range.
+    fn on_face(&self, q: Point2) -> bool {
+        let Some((u, v)) = self.uv(q) else {
+            return false;
+        };
+        if matches!(self.kind, ChartKind::Ortho { .. }) {
+            return true;
+        }
+        let (bu, bv) = self.surf.bounds();
+        let inside = |x: f64, r: Option<(f64, f64)>| {
+            r.is_none_or(|(a, b)| x >= a.min(b) - 1e-9 && x <= a.max(b) + 1e-9)
+        };
+        inside(u, bu) && inside(v, bv)
+    }
+
+    /// The most millimetres one chart unit spans at `q` on the offset at `d` (the chart's
+    /// largest stretch there), to turn 3-D lengths into chart lengths conservatively.
+    fn stretch(&self, q: Point2, d: f64) -> f64 {
+        let e = 1e-4;
+        let at = |dq: [f64; 2]| self.at([q[0] + dq[0], q[1] + dq[1]], d).map(|x| x.0);
+        match (at([0.0, 0.0]), at([e, 0.0]), at([0.0, e])) {
+            (Some(p), Some(a), Some(b)) => ((a - p).norm().max((b - p).norm()) / e).max(1e-6),
+            _ => 1.0,
+        }
+    }
+
     /// The point at chart `q` and distance `d` from the reference, and the unit normal there
     /// (the offset surface's normal is the reference's).
     pub fn at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
         let (u, v) = self.uv(q)?;
-        let n = self.normal_at(u, v)?;
-        let p = self.surf.eval(u, v) + n * d;
+        let (f, n) = match self.kind {
+            ChartKind::Native { .. } => self.eval_ext(u, v)?,
+            ChartKind::Ortho { .. } => (self.surf.eval(u, v), self.normal_at(u, v)?),
+        };
+        let p = f + n * d;
         (p.coords.iter().all(|x| x.is_finite()) && n.iter().all(|x| x.is_finite()))
             .then_some((p, n))
     }
 
     /// Chart coordinates and distance `d` of `p` (its nearest point on the reference).
     pub fn inverse(&self, p: &P3) -> Option<(Point2, f64)> {
-        let (u, v) = self.surf.project(p, None);
-        let f = self.surf.eval(u, v);
-        let n = self.normal_at(u, v)?;
+        let (mut u, mut v) = self.surf.project(p, None);
+        let (mut f, mut n) = (self.surf.eval(u, v), self.normal_at(u, v)?);
+        if let ChartKind::Native { u0, v0, .. } = self.kind {
+            // A foot on the boundary with `p` off its normal: continue onto the extension
+            // (Gauss–Newton on the continued surface).
+            let off = |f: P3, n: V3| (p - f - n * (p - f).dot(&n)).norm();
+            if off(f, n) > 1e-7 * (1.0 + (p - f).norm()) {
+                let uv = self.surf.unwrap_near((u, v), (u0, v0));
+                u = uv.0;
+                v = uv.1;
+                for _ in 0..30 {
+                    let (e, _) = self.eval_ext(u, v)?;
+                    let h = 1e-6;
+                    let (eu, _) = self.eval_ext(u + h, v)?;
+                    let (ev, _) = self.eval_ext(u, v + h)?;
+                    let (a, b) = ((eu - e) / h, (ev - e) / h);
+                    let r = p - e;
+                    let g = [[a.dot(&a), a.dot(&b)], [a.dot(&b), b.dot(&b)]];
+                    let det = g[0][0] * g[1][1] - g[0][1] * g[1][0];
+                    if det.abs() < 1e-18 {
+                        break;
+                    }
+                    let (ra, rb) = (a.dot(&r), b.dot(&r));
+                    let du = (g[1][1] * ra - g[0][1] * rb) / det;
+                    let dv = (g[0][0] * rb - g[0][1] * ra) / det;
+                    u += du;
+                    v += dv;
+                    if du.abs() + dv.abs() < 1e-12 {
+                        break;
+                    }
+                }
+                let (e, m) = self.eval_ext(u, v)?;
+                f = e;
+                n = m;
+            }
+        }
         let d = (p - f).dot(&n);
         let q = match self.kind {
             ChartKind::Native { u0, v0, su, sv } => {
@@ -347,6 +432,29 @@ fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, PlanError>
     Ok(m)
 }
 
+/// One path of a curved layer in chart coordinates, with the bead width at each point.
+#[derive(Debug, Clone, Default)]
+struct FillPath {
+    points: Vec<Point2>,
+    widths: Vec<f64>,
+}
+
+impl FillPath {
+    fn uniform(points: Vec<Point2>, width: f64) -> Self {
+        let widths = vec![width; points.len()];
+        FillPath { points, widths }
+    }
+
+    fn is_closed(&self) -> bool {
+        self.points.len() > 2 && self.points.first() == self.points.last()
+    }
+
+    fn reverse(&mut self) {
+        self.points.reverse();
+        self.widths.reverse();
+    }
+}
+
 /// Paths of one region of a curved layer at offset `z`, in chart coordinates.
 #[allow(clippy::too_many_arguments)]
 fn fill_region(
@@ -357,7 +465,7 @@ fn fill_region(
     layer: usize,
     width: f64,
     spacing: f64,
-) -> Vec<(Path2, f64)> {
+) -> Vec<FillPath> {
     let mut out = vec![];
     let mut lm = LayerMesh::build(region, spacing / 3.0);
     if lm.tris.is_empty() {
@@ -391,17 +499,7 @@ fn fill_region(
             break;
         }
         for line in lm.iso_lines(&db, c, &db) {
-            out.push((
-                Path2 {
-                    points: line.q,
-                    kind: if line.closed {
-                        PathKind::Perimeter
-                    } else {
-                        PathKind::Infill
-                    },
-                },
-                width,
-            ));
+            out.push(FillPath::uniform(line.q, width));
         }
         last_ring = Some(c);
         j += 1;
@@ -413,19 +511,35 @@ fn fill_region(
     let inner = match last_ring {
         Some(c) if dmax > c + 1.5 * spacing => c + spacing,
         Some(c) => {
-            // Gap fill: the strip along the ridge that the last ring's bead leaves, of width
-            // 2β, gets one more ring in its middle with beads β wide (one on each side of the
-            // ridge), extruded for that width by Eq. 1.
-            let beta = dmax - (c + 0.5 * width);
-            if beta > 0.05 * width {
-                for line in lm.iso_lines(&db, c + 0.5 * width + 0.5 * beta, &db) {
-                    out.push((
-                        Path2 {
-                            points: line.q,
-                            kind: PathKind::Infill,
-                        },
-                        beta.min(width),
-                    ));
+            // Gap fill: the strip along the ridge that the last ring's bead leaves gets one
+            // more ring just inside its edge, each side as wide as the strip's local half
+            // width β (the ridge's local height above the edge), extruded for that width by
+            // Eq. 1, so the two sides together fill the strip.
+            let edge = c + 0.5 * width;
+            if dmax > edge + 0.05 * width {
+                let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
+                let ridge = lm.local_max(&db, 1.5 * spacing, &mask);
+                for line in lm.iso_lines(&db, edge + 0.02 * width, &ridge) {
+                    let widths: Vec<f64> = line
+                        .other
+                        .iter()
+                        .map(|r| (r - edge).clamp(0.0, width))
+                        .collect();
+                    // Drop the stretches where the strip pinches out.
+                    let mut cur = FillPath::default();
+                    for (q, w) in line.q.iter().zip(&widths) {
+                        if *w >= 0.1 * width {
+                            cur.points.push(*q);
+                            cur.widths.push(*w);
+                        } else if cur.points.len() >= 2 {
+                            out.push(std::mem::take(&mut cur));
+                        } else {
+                            cur = FillPath::default();
+                        }
+                    }
+                    if cur.points.len() >= 2 {
+                        out.push(cur);
+                    }
                 }
             }
             return out;
@@ -501,15 +615,7 @@ fn fill_region(
         }
     }
     if !zig {
-        out.extend(pieces.into_iter().map(|(_, p)| {
-            (
-                Path2 {
-                    points: p,
-                    kind: PathKind::Infill,
-                },
-                width,
-            )
-        }));
+        out.extend(pieces.into_iter().map(|(_, p)| FillPath::uniform(p, width)));
         return out;
     }
     // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
@@ -552,13 +658,7 @@ fn fill_region(
                 None => break,
             }
         }
-        out.push((
-            Path2 {
-                points: pts,
-                kind: PathKind::Infill,
-            },
-            width,
-        ));
+        out.push(FillPath::uniform(pts, width));
     }
     out
 }
@@ -654,12 +754,12 @@ impl<'a> Border<'a> {
     }
 }
 
-/// [`crate::fill::order_paths`] for paths that carry their bead width: greedy nearest start
+/// [`crate::fill::order_paths`] for paths that carry their bead widths: greedy nearest start
 /// (or end, reversing an open path) from `start`; closed paths are entered at their first point.
-fn order_with_widths(paths: Vec<(Path2, f64)>, start: Point2) -> Vec<(Path2, f64)> {
-    let mut todo: Vec<Option<(Path2, f64)>> = paths
+fn order_fill_paths(paths: Vec<FillPath>, start: Point2) -> Vec<FillPath> {
+    let mut todo: Vec<Option<FillPath>> = paths
         .into_iter()
-        .filter(|p| !p.0.points.is_empty())
+        .filter(|p| p.points.len() >= 2)
         .map(Some)
         .collect();
     let d = |a: Point2, b: Point2| {
@@ -675,7 +775,7 @@ fn order_with_widths(paths: Vec<(Path2, f64)>, start: Point2) -> Vec<(Path2, f64
     for _ in 0..todo.len() {
         let mut best: Option<(f64, usize, bool)> = None;
         for (i, p) in todo.iter().enumerate() {
-            let Some((p, _)) = p else { continue };
+            let Some(p) = p else { continue };
             let ds = d(cur, p.points[0]);
             if best.is_none_or(|b| ds < b.0) {
                 best = Some((ds, i, false));
@@ -688,14 +788,12 @@ fn order_with_widths(paths: Vec<(Path2, f64)>, start: Point2) -> Vec<(Path2, f64
             }
         }
         let Some((_, i, reverse)) = best else { break };
-        let Some((mut p, w)) = todo[i].take() else {
-            break;
-        };
+        let Some(mut p) = todo[i].take() else { break };
         if reverse {
-            p.points.reverse();
+            p.reverse();
         }
         cur = p.points[p.points.len() - 1];
-        out.push((p, w));
+        out.push(p);
     }
     out
 }
@@ -706,12 +804,14 @@ struct Lifted {
     q: Point2,
     p: P3,
     n: V3,
+    /// Bead width here.
+    w: f64,
 }
 
 /// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
 /// is within `tol` of the surface, then dropping points whose removal keeps the polyline
 /// within `tol / 2` of the dense one (Douglas–Peucker in 3-D).
-fn lift(chart: &Chart, path: &[Point2], z: f64, tol: f64) -> Vec<Lifted> {
+fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lifted> {
     fn refine(
         chart: &Chart,
         a: Lifted,
@@ -724,7 +824,12 @@ fn lift(chart: &Chart, path: &[Point2], z: f64, tol: f64) -> Vec<Lifted> {
         if depth < 10 {
             let qm = [0.5 * (a.q[0] + b.q[0]), 0.5 * (a.q[1] + b.q[1])];
             if let Some((p, n)) = chart.at(qm, z) {
-                let mid = Lifted { q: qm, p, n };
+                let mid = Lifted {
+                    q: qm,
+                    p,
+                    n,
+                    w: 0.5 * (a.w + b.w),
+                };
                 if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
                     refine(chart, a, mid, z, tol, depth + 1, out);
                     refine(chart, mid, b, z, tol, depth + 1, out);
@@ -735,11 +840,11 @@ fn lift(chart: &Chart, path: &[Point2], z: f64, tol: f64) -> Vec<Lifted> {
         out.push(b);
     }
     let mut dense: Vec<Lifted> = vec![];
-    for q in path {
+    for (q, w) in path.points.iter().zip(&path.widths) {
         let Some((p, n)) = chart.at(*q, z) else {
             continue;
         };
-        let cur = Lifted { q: *q, p, n };
+        let cur = Lifted { q: *q, p, n, w: *w };
         match dense.last().copied() {
             Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
             None => dense.push(cur),
@@ -793,6 +898,41 @@ pub struct FreeformFigures {
     /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
     /// when it curves away from the feature everywhere).
     pub concave_radius: f64,
+    /// Print points with nothing under them: on layer k ≥ 2 more than half a bead outside
+    /// layer k−1's region, or on layer 1 over the reference surface's continuation past its
+    /// face (overhangs the reference surface's offsets cannot avoid, e.g. a wall leaning
+    /// over the reference).
+    pub overhang_points: usize,
+    /// First and last layer (1-based) with such points.
+    pub overhang_layers: Option<(usize, usize)>,
+}
+
+/// Whether chart point `q` lies in one of `regions` or within `reach` (chart units) of one.
+fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
+    if regions
+        .iter()
+        .any(|r| crate::geodesic::region_contains(r, q))
+    {
+        return true;
+    }
+    let r2 = reach * reach;
+    regions.iter().any(|r| {
+        std::iter::once(&r.outer).chain(r.holes.iter()).any(|ring| {
+            let n = ring.len();
+            (0..n).any(|i| {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let ab = [b[0] - a[0], b[1] - a[1]];
+                let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+                let t = if l2 > 0.0 {
+                    (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let x = [a[0] + ab[0] * t - q[0], a[1] + ab[1] * t - q[1]];
+                x[0] * x[0] + x[1] * x[1] <= r2
+            })
+        })
+    })
 }
 
 /// Plans one freeform feature on offsets of its reference surface, appending its points to
@@ -865,6 +1005,16 @@ pub fn plan_freeform(
     };
     let spacing = params.spacing(bead.width);
     let mut fig = FeatureFigures::default();
+    let mut ff = FreeformFigures {
+        chart: match chart.kind {
+            ChartKind::Native { .. } => "native",
+            ChartKind::Ortho { .. } => "projection",
+        },
+        concave_radius,
+        overhang_points: 0,
+        overhang_layers: None,
+    };
+    let mut prev_regions: Vec<Region> = vec![];
     let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
@@ -892,10 +1042,10 @@ pub fn plan_freeform(
             .max(1e-3)
             .min(spacing.max(1e-3) * 1e3);
         let mut paths = vec![];
+        let below = std::mem::replace(&mut prev_regions, regions.clone());
         for r in &regions {
-            paths.extend(fill_region(
-                &chart, r, z, params, layer, bead.width, spacing,
-            ));
+            let got = fill_region(&chart, r, z, params, layer, bead.width, spacing);
+            paths.extend(got);
         }
         let start = cursor
             .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -903,13 +1053,29 @@ pub fn plan_freeform(
         let paths = if params.path_mode == PathMode::Raster {
             paths
         } else {
-            order_with_widths(paths, start)
+            order_fill_paths(paths, start)
         };
         let mut printed = false;
-        for (path, width) in paths {
-            let pts = lift(&chart, &path.points, z, params.tolerance);
+        for path in paths {
+            let pts = lift(&chart, &path, z, params.tolerance);
             if pts.len() < 2 {
                 continue;
+            }
+            // Support: the layer below (or, under the first layer, the reference face).
+            for x in &pts {
+                let held = if layer == 0 {
+                    chart.on_face(x.q)
+                } else {
+                    near_regions(&below, x.q, 0.5 * bead.width / chart.stretch(x.q, z))
+                };
+                if !held {
+                    ff.overhang_points += 1;
+                    let l = layer + 1;
+                    ff.overhang_layers = Some(match ff.overhang_layers {
+                        Some((a, b)) => (a.min(l), b.max(l)),
+                        None => (l, l),
+                    });
+                }
             }
             printed = true;
             let axis = |n: V3| {
@@ -957,6 +1123,7 @@ pub fn plan_freeform(
             }
             for w in pts.windows(2) {
                 let l = (w[1].p - w[0].p).norm();
+                let width = 0.5 * (w[0].w + w[1].w);
                 let e = filament_length(width, dl, l, bead.filament_diameter);
                 fig.print_length += l;
                 fig.filament += e;
@@ -991,17 +1158,13 @@ pub fn plan_freeform(
             "feature {id} has no printable layer (thinner than a bead?)"
         ));
     }
-    let chart_name = match chart.kind {
-        ChartKind::Native { .. } => "native",
-        ChartKind::Ortho { .. } => "projection",
-    };
-    Ok((
-        fig,
-        FreeformFigures {
-            chart: chart_name,
-            concave_radius,
-        },
-    ))
+    if let Some((a, b)) = ff.overhang_layers {
+        fig.warnings.push(format!(
+            "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
+            ff.overhang_points
+        ));
+    }
+    Ok((fig, ff))
 }
 
 #[cfg(test)]
@@ -1047,10 +1210,21 @@ mod tests {
                 ..LayerParams::default()
             };
             let paths = fill_region(&chart, &region, 0.2, &params, 1, 0.45, 0.45);
-            let covered: f64 = paths.iter().map(|(p, w)| p.length() * w).sum::<f64>();
+            let covered: f64 = paths
+                .iter()
+                .map(|p| {
+                    p.points
+                        .windows(2)
+                        .zip(p.widths.windows(2))
+                        .map(|(q, w)| {
+                            (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1])
+                        })
+                        .sum::<f64>()
+                })
+                .sum();
             let r = covered / area;
             assert!(r > lo && r < 1.02, "{mode:?}: {r}");
-            for (p, _) in &paths {
+            for p in &paths {
                 for q in &p.points {
                     assert!(
                         q[0].hypot(q[1]) < 6.0 - 0.2,

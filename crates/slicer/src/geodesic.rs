@@ -297,6 +297,40 @@ impl LayerMesh {
         out
     }
 
+    /// For each vertex where `mask` holds, the largest `f` over the vertices joined to it
+    /// through the mesh within 3-D distance `radius` (others get `f` itself): the local height
+    /// of a ridge of `f` seen from its flanks.
+    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
+        let mut out = f.to_vec();
+        let mut seen: HashMap<u32, ()> = HashMap::new();
+        for v in 0..self.q.len() {
+            if !mask[v] {
+                continue;
+            }
+            seen.clear();
+            let mut stack = vec![v as u32];
+            seen.insert(v as u32, ());
+            let mut best = f[v];
+            while let Some(u) = stack.pop() {
+                if f[u as usize].is_finite() {
+                    best = best.max(f[u as usize]);
+                }
+                for &t in &self.around[u as usize] {
+                    for &x in &self.tris[t as usize] {
+                        if !seen.contains_key(&x)
+                            && (self.p[x as usize] - self.p[v]).norm() <= radius
+                        {
+                            seen.insert(x, ());
+                            stack.push(x);
+                        }
+                    }
+                }
+            }
+            out[v] = best;
+        }
+        out
+    }
+
     /// Distances over the mesh's 3-D points from `seeds` (vertex, starting distance), by fast
     /// marching. Vertices the front never reaches keep `f64::INFINITY`.
     pub fn march(&self, seeds: &[(u32, f64)]) -> Vec<f64> {
