@@ -46,7 +46,8 @@ fn plan(name: &str, extra: &[&str]) -> (Out, Value, String, String) {
         serde_json::from_str(&std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"))
             .expect("json");
     let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("csv");
-    let gcode = std::fs::read_to_string(dir.join("program.gcode")).expect("gcode");
+    // The KUKA post writes KRL instead of G-code.
+    let gcode = std::fs::read_to_string(dir.join("program.gcode")).unwrap_or_default();
     (Out(dir), plan, csv, gcode)
 }
 
@@ -265,8 +266,16 @@ fn plate_boss_boss_plan_summary() {
 }
 
 #[test]
-fn freeform_parts_and_other_machines_are_refused_with_one_line() {
-    for (name, extra) in [("impeller", vec![]), ("box", vec!["--machine", "kuka"])] {
+fn tilted_axes_on_a_3_axis_printer_and_unknown_machines_are_refused_with_one_line() {
+    for (name, extra, needle) in [
+        ("impeller", vec![], "feature 1 has tool axis"),
+        ("box", vec!["--machine", "prusa"], "unknown machine `prusa`"),
+        (
+            "capsule",
+            vec!["--machine", "delta5"],
+            "outside the B limits",
+        ),
+    ] {
         let dir = std::env::temp_dir().join(format!(
             "features-plan-refuse-{}-{name}",
             std::process::id()
@@ -282,8 +291,121 @@ fn freeform_parts_and_other_machines_are_refused_with_one_line() {
         assert_eq!(out.status.code(), Some(2), "{name}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{err}");
         assert!(!dir.exists(), "{name}: wrote output");
     }
+}
+
+/// One line per feature of a plan: what the issue asks the snapshots to hold (layers per
+/// feature, volumes, lengths), rounded so that last-digit noise does not churn them.
+fn summary(plan: &Value) -> String {
+    let mut s = String::new();
+    for f in plan["features"].as_array().unwrap() {
+        let num = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
+        s.push_str(&format!(
+            "feature {} {} layers {} print {:.0} mm extruded {:.0} mm^3 volume {:.1} mm^3\n",
+            f["id"],
+            f["kind"].as_str().unwrap(),
+            f["layers"],
+            num("print_length_mm"),
+            num("extruded_volume_mm3"),
+            num("volume_mm3"),
+        ));
+    }
+    s
+}
+
+#[test]
+fn freeform_plans_on_the_delta5_printer() {
+    // The capsule's boss on the cone points 36° below the horizon: the default bed tilts
+    // only ±90°, so it is planned for a bed that tilts ±135°.
+    let wide =
+        std::env::temp_dir().join(format!("features-delta5-wide-{}.toml", std::process::id()));
+    let text = robot_post::machine::DELTA5_TOML.replace(
+        "b_limits_deg = [-90.0, 90.0]",
+        "b_limits_deg = [-135.0, 135.0]",
+    );
+    assert_ne!(text, robot_post::machine::DELTA5_TOML);
+    std::fs::write(&wide, text).unwrap();
+    for name in ["impeller", "capsule", "fan"] {
+        let machine = if name == "capsule" {
+            vec!["--machine-profile".to_string(), wide.display().to_string()]
+        } else {
+            vec!["--machine".to_string(), "delta5".to_string()]
+        };
+        let machine: Vec<&str> = machine.iter().map(|s| s.as_str()).collect();
+        let (dir, plan, csv, gcode) = plan(name, &machine);
+        let features = plan["features"].as_array().unwrap();
+        assert!(features.iter().any(|f| f["kind"] == "freeform"), "{name}");
+        for f in features {
+            let id = &f["id"];
+            // Extrusion within 2 % of each feature's volume.
+            let r = f["extruded_volume_mm3"].as_f64().unwrap() / f["volume_mm3"].as_f64().unwrap();
+            assert!(
+                (r - 1.0).abs() < 0.02,
+                "{name} feature {id}: extruded {r} of its volume"
+            );
+            // Kinematic error within the profile's goal, and the smoothing figures.
+            let k = f["kinematic_error_max_mm"].as_f64().unwrap();
+            assert!(k <= 0.05 + 1e-9, "{name} feature {id}: kinematic error {k}");
+            assert!(f["kinematic_error_mean_mm"].as_f64().unwrap() <= k);
+            for key in [
+                "orientation_step_max_deg",
+                "orientation_rate_max_deg_per_mm",
+            ] {
+                let before = f[format!("{key}_before")].as_f64().unwrap();
+                let after = f[format!("{key}_after")].as_f64().unwrap();
+                assert!(
+                    after <= before + 1e-9,
+                    "{name} feature {id}: {key} {before} -> {after}"
+                );
+            }
+        }
+        assert!(gcode
+            .lines()
+            .any(|l| l.starts_with("G1 ") && l.contains(" B") && l.contains(" C")));
+        let svg = std::fs::read_to_string(dir.0.join("kinematic_error.svg")).expect("plot");
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(csv.lines().count() > 1000);
+        insta::assert_snapshot!(format!("{name}_delta5_plan"), summary(&plan));
+    }
+}
+
+#[test]
+fn the_impeller_plans_for_the_kuka_cell_and_its_krl_reads_back() {
+    let (dir, plan, csv, _) = plan("impeller", &["--machine", "kuka"]);
+    let mut files = vec![];
+    for e in std::fs::read_dir(&dir.0).unwrap() {
+        let path = e.unwrap().path();
+        let ext = path.extension().and_then(|x| x.to_str()).unwrap_or("");
+        if ext == "src" || ext == "dat" {
+            let name = path.file_name().unwrap().to_string_lossy().to_string();
+            files.push((name, std::fs::read_to_string(&path).unwrap()));
+        }
+    }
+    files.sort();
+    assert!(files.iter().any(|(n, _)| n == "impeller.src"), "{files:?}");
+    let read = robot_post::krl::read(&files).expect("KRL reads back");
+    let prints = csv.lines().filter(|l| l.contains(",print,")).count();
+    assert!(
+        read.moves.len() >= prints,
+        "{} moves for {prints} print points",
+        read.moves.len()
+    );
+    // Unreachable poses are reported per feature, and marked on their LINs.
+    let reported: u64 = plan["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["unreachable_points"].as_u64().expect("a count"))
+        .sum();
+    let marked: usize = files
+        .iter()
+        .map(|(_, t)| t.matches("; UNREACHABLE").count())
+        .sum();
+    // (A point's approach and retreat poses are marked too, so there may be more marks.)
+    assert!(marked >= reported as usize, "{marked} marks for {reported} points");
+    assert_eq!(marked == 0, reported == 0);
 }
 
 #[test]

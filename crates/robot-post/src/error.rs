@@ -56,4 +56,59 @@ pub enum PostError {
         /// By how much, per axis, e.g. `X 30.000 mm, Z 2.500 mm`.
         excess: String,
     },
+    /// A tool axis the `delta5` bed cannot turn to machine +Z (beyond its B limits, or not a
+    /// direction).
+    #[error("feature {feature}: tool axis ({i:.6}, {j:.6}, {k:.6}) {reason} of `{name}`")]
+    Delta5Axis {
+        /// The feature's id.
+        feature: usize,
+        /// Tool axis X component.
+        i: f64,
+        /// Tool axis Y component.
+        j: f64,
+        /// Tool axis Z component.
+        k: f64,
+        /// The profile's `name`.
+        name: String,
+        /// Why, e.g. `needs B 120.000 or -120.000 degrees, outside the B limits [-90, 90]`.
+        reason: String,
+    },
+    /// A path of a feature turns C further than the `delta5` profile's C limits allow.
+    #[error("feature {feature}: C turns through {span:.3} degrees on one path, which does not fit the C limits [{c_min}, {c_max}] of `{name}` (c_continuous = true allows it)")]
+    Delta5CLimits {
+        /// The feature's id.
+        feature: usize,
+        /// The path's C span (degrees).
+        span: f64,
+        /// Lowest C (degrees).
+        c_min: f64,
+        /// Highest C (degrees).
+        c_max: f64,
+        /// The profile's `name`.
+        name: String,
+    },
+    /// A move of a feature leaves the `delta5` machine's work envelope.
+    #[error("feature {feature} leaves the work envelope of `{name}`: {excess}")]
+    Delta5Envelope {
+        /// The feature's id.
+        feature: usize,
+        /// The profile's `name`.
+        name: String,
+        /// Where and by how much, e.g. `Z -63.210 is 13.210 mm below -50.000`.
+        excess: String,
+    },
+    /// A tool path point's tool axis is not a unit vector (KUKA post).
+    #[error("tool path point {index} (feature {feature}): tool axis ({i:.6}, {j:.6}, {k:.6}) is not a unit vector")]
+    KukaAxisNotUnit {
+        /// Zero-based index of the point in the path.
+        index: usize,
+        /// The point's feature.
+        feature: usize,
+        /// Tool axis X component.
+        i: f64,
+        /// Tool axis Y component.
+        j: f64,
+        /// Tool axis Z component.
+        k: f64,
+    },
 }

@@ -10,12 +10,15 @@
 
 pub mod delta5;
 pub mod error;
+pub mod krl;
 pub mod kuka;
 pub mod machine;
 pub mod marlin;
 pub use slicer::toolpath;
 
+pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;
+pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
 pub use marlin::marlin;
 pub use toolpath::{MoveKind, PathPoint, ToolPath};

@@ -1,0 +1,724 @@
+//! Stair-step error of our curved-layer (freeform) plans against PrusaSlicer's planar slicing of
+//! the same part (issue #6: "stair-step a tenth of planar").
+//!
+//! For every freeform feature of a part, the true outer surface (the feature's faces without its
+//! healing faces, meshed at 0.01 mm chord tolerance) is sampled at the mesh vertices and triangle
+//! centroids. At each sample the error is the distance to the nearest bead-centre segment of a
+//! plan, minus half a bead (0.225 mm): zero where the bead's side just touches the surface,
+//! positive where the beads fall short of it (the stairs), negative where a bead's top or side
+//! reaches past the centre-offset (a layer top lying on the surface is −(w − h)/2). Both plans
+//! are measured the same way, over their extrusion segments of any feature or type whose box
+//! meets the feature's box grown by 2 mm:
+//!
+//! - ours: `features plan PART.step --machine delta5`, `toolpath.csv` print rows; a row's segment
+//!   runs from the previous row; the bead centre is the nozzle tip minus axis × thickness / 2;
+//! - PrusaSlicer: planar slicing of `features mesh PART.step --tolerance 0.01` at the same 0.2 mm
+//!   layers and 0.45 mm beads; G1 moves in X/Y that add filament; the bead centre is the layer's
+//!   Z − h/2; coordinates mapped back from the bed (the XY box centred on `--center`, the lowest
+//!   point on Z = 0) into the part's.
+//!
+//! Also reported: material (our `extruded_volume_mm3` from `plan.json`, PrusaSlicer's filament
+//! used × filament area) and the wall time of each run.
+//!
+//! `cargo bench -p features-cli --bench stairstep [-- impeller fan PATH.step ...]` (default: the
+//! impeller and fan fixtures). Without `prusa-slicer` on the PATH (or `$PRUSA_SLICER`) only ours
+//! is measured.
+
+use brep::math::{Aabb, P3, V3};
+use brep::mesh::{mesh_faces, MeshOptions};
+use features::{extract, ExtractOptions, FeatureKind};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// Bead width of both plans, mm.
+const W: f64 = 0.45;
+/// Layer height of both plans, mm.
+const H: f64 = 0.2;
+/// Filament diameter of both, mm.
+const FILAMENT: f64 = 1.75;
+/// PrusaSlicer puts the part's XY box centre here.
+const CENTER: (f64, f64) = (100.0, 100.0);
+/// Segments whose box meets the feature's box grown by this much are candidates, mm.
+const GROW: f64 = 2.0;
+/// Sample points further than this from every segment count as this far, mm.
+const FAR: f64 = 20.0;
+
+/// One extrusion, bead centre to bead centre.
+#[derive(Clone, Copy)]
+struct Seg {
+    a: P3,
+    b: P3,
+}
+
+impl Seg {
+    fn distance(&self, p: &P3) -> f64 {
+        let d = self.b - self.a;
+        let l2 = d.norm_squared();
+        let t = if l2 > 0.0 {
+            ((p - self.a).dot(&d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (self.a + d * t)).norm()
+    }
+
+    fn meets(&self, b: &Aabb) -> bool {
+        let lo = self.a.inf(&self.b);
+        let hi = self.a.sup(&self.b);
+        (0..3).all(|i| hi[i] >= b.min[i] && lo[i] <= b.max[i])
+    }
+}
+
+/// Nearest-segment queries over a uniform hash grid.
+struct SegGrid {
+    cell: f64,
+    segs: Vec<Seg>,
+    grid: HashMap<(i64, i64, i64), Vec<u32>>,
+}
+
+impl SegGrid {
+    fn new(segs: Vec<Seg>, cell: f64) -> SegGrid {
+        let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
+        let c = |x: f64| (x / cell).floor() as i64;
+        for (idx, s) in segs.iter().enumerate() {
+            let idx = idx as u32;
+            let d = s.b - s.a;
+            let n = (d.norm() / cell).ceil().max(1.0) as usize;
+            for k in 0..n {
+                let p = s.a + d * (k as f64 / n as f64);
+                let q = s.a + d * ((k + 1) as f64 / n as f64);
+                let (lo, hi) = (p.inf(&q), p.sup(&q));
+                for i in c(lo.x)..=c(hi.x) {
+                    for j in c(lo.y)..=c(hi.y) {
+                        for l in c(lo.z)..=c(hi.z) {
+                            let v = grid.entry((i, j, l)).or_default();
+                            if v.last() != Some(&idx) {
+                                v.push(idx);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        SegGrid { cell, segs, grid }
+    }
+
+    /// Distance from `p` to the nearest segment, at most [`FAR`].
+    fn nearest(&self, p: &P3) -> f64 {
+        let c = |x: f64| (x / self.cell).floor() as i64;
+        let (i0, j0, l0) = (c(p.x), c(p.y), c(p.z));
+        let mut best = FAR;
+        let rmax = (FAR / self.cell).ceil() as i64 + 1;
+        for r in 0..=rmax {
+            // The shell of cells at Chebyshev distance r.
+            for i in i0 - r..=i0 + r {
+                for j in j0 - r..=j0 + r {
+                    let edge = (i - i0).abs() == r || (j - j0).abs() == r;
+                    let ls: Vec<i64> = if edge {
+                        (l0 - r..=l0 + r).collect()
+                    } else {
+                        vec![l0 - r, l0 + r]
+                    };
+                    for l in ls {
+                        if let Some(v) = self.grid.get(&(i, j, l)) {
+                            for &s in v {
+                                best = best.min(self.segs[s as usize].distance(p));
+                            }
+                        }
+                    }
+                }
+            }
+            // Everything unseen lies in cells at least r + 1 away: at least r cells from p.
+            if best <= r as f64 * self.cell {
+                break;
+            }
+        }
+        best
+    }
+}
+
+/// Stair-step errors of one plan at each sample, mm.
+#[derive(Clone, Default)]
+struct Err {
+    each: Vec<f64>,
+}
+
+impl Err {
+    /// Measures the samples against the segments that meet the box grown by [`GROW`].
+    fn measure(samples: &[P3], segs: &[Seg], bbox: &Aabb) -> Err {
+        let mut grown = *bbox;
+        grown.min -= V3::repeat(GROW);
+        grown.max += V3::repeat(GROW);
+        let near: Vec<Seg> = segs.iter().copied().filter(|s| s.meets(&grown)).collect();
+        let grid = SegGrid::new(near, 0.5);
+        Err {
+            each: samples.iter().map(|p| grid.nearest(p) - W / 2.0).collect(),
+        }
+    }
+
+    fn merge(&mut self, o: &Err) {
+        self.each.extend_from_slice(&o.each);
+    }
+
+    fn max(&self) -> f64 {
+        self.each.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    fn mean(&self) -> f64 {
+        self.each.iter().sum::<f64>() / self.each.len().max(1) as f64
+    }
+
+    /// The `q`-quantile (nearest rank).
+    fn quantile(&self, q: f64) -> f64 {
+        let mut v = self.each.clone();
+        v.sort_by(f64::total_cmp);
+        let i = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len().max(1)) - 1;
+        v.get(i).copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// One freeform feature's true outer surface.
+struct Surface {
+    id: usize,
+    samples: Vec<P3>,
+    bbox: Aabb,
+    volume: f64,
+    step_faces: Vec<u64>,
+}
+
+fn filament_area() -> f64 {
+    std::f64::consts::PI * FILAMENT * FILAMENT / 4.0
+}
+
+fn surfaces(step: &Path) -> Result<(Vec<Surface>, f64), String> {
+    let part = brep::read_step(step).map_err(|e| format!("reading: {e}"))?;
+    let solid = part.brep.solid_ids().next().ok_or("no solid in the file")?;
+    let tree = extract(&part.brep, solid, &ExtractOptions::default())
+        .map_err(|e| format!("extracting: {e}"))?;
+    let mut out = vec![];
+    for f in &tree.features {
+        if f.kind != FeatureKind::Freeform {
+            continue;
+        }
+        let outer: Vec<_> = f
+            .faces
+            .iter()
+            .copied()
+            .filter(|x| !f.heal_faces.contains(x))
+            .collect();
+        let mesh = mesh_faces(&tree.brep, &outer, &MeshOptions::with_tolerance(0.01))
+            .map_err(|e| format!("meshing feature {}: {e}", f.id))?;
+        let mut samples = mesh.positions.clone();
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize].coords);
+            samples.push(P3::from((a + b + c) / 3.0));
+        }
+        out.push(Surface {
+            id: f.id,
+            samples,
+            bbox: mesh.bbox(),
+            volume: f.volume,
+            step_faces: f.step_faces(&tree.brep),
+        });
+    }
+    Ok((out, tree.part_volume))
+}
+
+/// Our plan: bead-centre segments of the print rows, and `plan.json`.
+struct Ours {
+    segs: Vec<Seg>,
+    /// Extruded volume by feature id, mm³.
+    volume: HashMap<usize, f64>,
+    /// STEP face ids by feature id.
+    faces: HashMap<usize, Vec<u64>>,
+    seconds: f64,
+}
+
+fn run_ours(exe: &Path, step: &Path, dir: &Path) -> Result<Ours, String> {
+    let t = Instant::now();
+    let out = Command::new(exe)
+        .args(["plan"])
+        .arg(step)
+        .arg("-o")
+        .arg(dir)
+        .args(["--machine", "delta5"])
+        .output()
+        .map_err(|e| format!("running {}: {e}", exe.display()))?;
+    let seconds = t.elapsed().as_secs_f64();
+    if !out.status.success() {
+        return Err(format!(
+            "features plan failed: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    let csv_path = dir.join("toolpath.csv");
+    let csv =
+        std::fs::read_to_string(&csv_path).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    let mut segs = vec![];
+    let mut prev: Option<P3> = None;
+    for (n, line) in csv.lines().enumerate().skip(1) {
+        let bad = |what: &str| format!("{}:{}: {what}", csv_path.display(), n + 1);
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() < 12 {
+            return Err(bad("fewer than 12 fields"));
+        }
+        let num = |i: usize| -> Result<f64, String> {
+            f[i].trim()
+                .parse::<f64>()
+                .map_err(|_| bad(&format!("field {} is not a number", i + 1)))
+        };
+        let p = P3::new(num(3)?, num(4)?, num(5)?);
+        let axis = V3::new(num(6)?, num(7)?, num(8)?);
+        let centre = p - axis * (num(10)? / 2.0);
+        if f[2] == "print" {
+            if let Some(a) = prev {
+                segs.push(Seg { a, b: centre });
+            }
+        }
+        prev = Some(centre);
+    }
+    let json_path = dir.join("plan.json");
+    let text =
+        std::fs::read_to_string(&json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let mut volume = HashMap::new();
+    let mut faces = HashMap::new();
+    for f in json["features"]
+        .as_array()
+        .ok_or_else(|| format!("{}: no features", json_path.display()))?
+    {
+        let id = f["id"]
+            .as_u64()
+            .ok_or_else(|| format!("{}: a feature without id", json_path.display()))?
+            as usize;
+        volume.insert(id, f["extruded_volume_mm3"].as_f64().unwrap_or(0.0));
+        let mut fs: Vec<u64> = f["faces"]
+            .as_array()
+            .map(|a| a.iter().filter_map(|x| x.as_u64()).collect())
+            .unwrap_or_default();
+        fs.sort_unstable();
+        faces.insert(id, fs);
+    }
+    Ok(Ours {
+        segs,
+        volume,
+        faces,
+        seconds,
+    })
+}
+
+/// PrusaSlicer's plan of the STL, in part coordinates.
+struct Prusa {
+    segs: Vec<Seg>,
+    volume: f64,
+    seconds: f64,
+}
+
+enum PrusaRun {
+    Missing(String),
+    Failed(String),
+    Done(Prusa),
+}
+
+/// The box of a binary STL's vertices.
+fn stl_bbox(path: &Path) -> Result<Aabb, String> {
+    let b = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if b.len() < 84 {
+        return Err(format!("{}: too short for a binary STL", path.display()));
+    }
+    let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize;
+    if b.len() < 84 + 50 * n {
+        return Err(format!("{}: truncated binary STL", path.display()));
+    }
+    let mut bb = Aabb::empty();
+    let f = |o: usize| f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]) as f64;
+    for t in 0..n {
+        for v in 0..3 {
+            let o = 84 + 50 * t + 12 + 12 * v;
+            bb.add(&P3::new(f(o), f(o + 4), f(o + 8)));
+        }
+    }
+    Ok(bb)
+}
+
+fn prusa_exe() -> String {
+    std::env::var("PRUSA_SLICER").unwrap_or_else(|_| "prusa-slicer".into())
+}
+
+fn run_prusa(stl: &Path, gcode: &Path) -> PrusaRun {
+    let exe = prusa_exe();
+    let bbox = match stl_bbox(stl) {
+        Ok(b) => b,
+        Err(e) => return PrusaRun::Failed(e),
+    };
+    let w = format!("{W}");
+    let h = format!("{H}");
+    let mut cmd = Command::new(&exe);
+    cmd.args(["--export-gcode", "--loglevel", "1"])
+        .args(["--layer-height", &h, "--first-layer-height", &h])
+        .args(["--fill-density", "100%", "--fill-pattern", "rectilinear"])
+        .args(["--perimeters", "2", "--perimeter-generator", "classic"])
+        .args(["--extrusion-width", &w, "--first-layer-extrusion-width", &w])
+        .args(["--perimeter-extrusion-width", &w])
+        .args(["--external-perimeter-extrusion-width", &w])
+        .args(["--infill-extrusion-width", &w])
+        .args(["--solid-infill-extrusion-width", &w])
+        .args(["--top-infill-extrusion-width", &w])
+        .args(["--nozzle-diameter", "0.4", "--filament-diameter"])
+        .arg(format!("{FILAMENT}"))
+        .args(["--skirts", "0", "--brim-width", "0"])
+        .arg("--center")
+        .arg(format!("{},{}", CENTER.0, CENTER.1))
+        .arg("-o")
+        .arg(gcode)
+        .arg(stl);
+    let t = Instant::now();
+    let out = match cmd.output() {
+        Ok(o) => o,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return PrusaRun::Missing(format!("{exe} not found"))
+        }
+        Err(e) => return PrusaRun::Failed(format!("running {exe}: {e}")),
+    };
+    let seconds = t.elapsed().as_secs_f64();
+    if !out.status.success() || !gcode.exists() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(3).collect();
+        return PrusaRun::Failed(format!(
+            "{exe} exited with {}: {}",
+            out.status,
+            tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
+        ));
+    }
+    let text = match std::fs::read_to_string(gcode) {
+        Ok(t) => t,
+        Err(e) => return PrusaRun::Failed(format!("{}: {e}", gcode.display())),
+    };
+    // Bed → part: the XY box centre moved to CENTER, the lowest point to Z = 0.
+    let shift = V3::new(
+        0.5 * (bbox.min.x + bbox.max.x) - CENTER.0,
+        0.5 * (bbox.min.y + bbox.max.y) - CENTER.1,
+        bbox.min.z,
+    );
+    match parse_gcode(&text, shift) {
+        Ok(mut p) => {
+            p.seconds = seconds;
+            PrusaRun::Done(p)
+        }
+        Err(e) => PrusaRun::Failed(format!("{}: {e}", gcode.display())),
+    }
+}
+
+/// Extrusions of a Marlin/RepRap G-code file: G0/G1 moves in X/Y that add filament, at bead
+/// centres (Z − h/2, h from `;HEIGHT:` or the layer step), shifted by `shift`.
+fn parse_gcode(text: &str, shift: V3) -> Result<Prusa, String> {
+    let (mut x, mut y, mut z, mut e) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut abs_xyz, mut abs_e) = (true, true);
+    let mut height = H;
+    let mut segs = vec![];
+    let mut extruded = 0.0;
+    let mut used_mm: Option<f64> = None;
+    for (n, raw) in text.lines().enumerate() {
+        let (code, comment) = match raw.find(';') {
+            Some(i) => (&raw[..i], raw[i + 1..].trim()),
+            None => (raw, ""),
+        };
+        if let Some(v) = comment.strip_prefix("HEIGHT:") {
+            height = v.trim().parse().unwrap_or(H);
+        }
+        if let Some(v) = comment.strip_prefix("filament used [mm] =") {
+            used_mm = v.trim().parse().ok();
+        }
+        let mut words = code.split_whitespace();
+        let Some(cmd) = words.next() else { continue };
+        let mut val: HashMap<char, f64> = HashMap::new();
+        for w in words {
+            let mut ch = w.chars();
+            let Some(letter) = ch.next() else { continue };
+            let v: f64 = ch
+                .as_str()
+                .parse()
+                .map_err(|_| format!("line {}: bad word {w:?}", n + 1))?;
+            val.insert(letter.to_ascii_uppercase(), v);
+        }
+        match cmd.to_ascii_uppercase().as_str() {
+            "G90" => abs_xyz = true,
+            "G91" => abs_xyz = false,
+            "M82" => abs_e = true,
+            "M83" => abs_e = false,
+            "G92" => {
+                if let Some(v) = val.get(&'E') {
+                    e = *v;
+                }
+            }
+            "G0" | "G1" | "G2" | "G3" => {
+                let ax = |cur: f64, k: char, abs: bool| match val.get(&k) {
+                    Some(v) if abs => *v,
+                    Some(v) => cur + v,
+                    None => cur,
+                };
+                let (nx, ny, nz) = (
+                    ax(x, 'X', abs_xyz),
+                    ax(y, 'Y', abs_xyz),
+                    ax(z, 'Z', abs_xyz),
+                );
+                let ne = ax(e, 'E', abs_e);
+                let moved = nx != x || ny != y;
+                if moved && ne > e + 1e-9 && nz == z {
+                    let c = V3::new(0.0, 0.0, -height / 2.0) + shift;
+                    segs.push(Seg {
+                        a: P3::new(x, y, z) + c,
+                        b: P3::new(nx, ny, nz) + c,
+                    });
+                    extruded += ne - e;
+                }
+                (x, y, z, e) = (nx, ny, nz, ne);
+            }
+            _ => {}
+        }
+    }
+    let volume = used_mm.unwrap_or(extruded) * filament_area();
+    Ok(Prusa {
+        segs,
+        volume,
+        seconds: 0.0,
+    })
+}
+
+/// One line of the table.
+struct Row {
+    part: String,
+    feature: String,
+    ours: Option<Err>,
+    prusa: Option<Err>,
+    ours_volume: f64,
+    prusa_volume: Option<f64>,
+    cad_volume: f64,
+    ours_s: Option<f64>,
+    prusa_s: Option<f64>,
+}
+
+fn fmt_opt(v: Option<f64>, prec: usize) -> String {
+    v.map_or("-".into(), |v| format!("{v:.prec$}"))
+}
+
+fn print_table(rows: &[Row]) {
+    println!();
+    println!(
+        "{:<9} {:<12} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>6} | {:>8} {:>8} {:>8} | {:>6} {:>6}",
+        "", "", "ours", "", "", "prusa", "", "", "ratio", "volume", "mm3", "", "time", "s"
+    );
+    println!(
+        "{:<9} {:<12} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>6} | {:>8} {:>8} {:>8} | {:>6} {:>6}",
+        "part",
+        "feature",
+        "max",
+        "p95",
+        "mean",
+        "max",
+        "p95",
+        "mean",
+        "max",
+        "ours",
+        "prusa",
+        "CAD",
+        "ours",
+        "prusa"
+    );
+    println!("{}", "-".repeat(118));
+    for r in rows {
+        let o = r.ours.as_ref();
+        let p = r.prusa.as_ref();
+        let ratio = o.zip(p).map(|(o, p)| o.max() / p.max());
+        println!(
+            "{:<9} {:<12} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>6} | {:>8.1} {:>8} {:>8.1} | {:>6} {:>6}",
+            r.part,
+            r.feature,
+            fmt_opt(o.map(Err::max), 3),
+            fmt_opt(o.map(|o| o.quantile(0.95)), 3),
+            fmt_opt(o.map(Err::mean), 3),
+            fmt_opt(p.map(Err::max), 3),
+            fmt_opt(p.map(|p| p.quantile(0.95)), 3),
+            fmt_opt(p.map(Err::mean), 3),
+            fmt_opt(ratio, 2),
+            r.ours_volume,
+            fmt_opt(r.prusa_volume, 1),
+            r.cad_volume,
+            fmt_opt(r.ours_s, 1),
+            fmt_opt(r.prusa_s, 1),
+        );
+    }
+    println!(
+        "stair-step in mm; ratio = ours max / PrusaSlicer max (goal <= 0.10); feature volumes are \
+         ours only (PrusaSlicer's planar paths do not split by feature)"
+    );
+}
+
+fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String> {
+    let name = step
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "part".into());
+    let exe = PathBuf::from(env!("CARGO_BIN_EXE_features"));
+    let dir = tmp.join(&name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+
+    let (surfs, part_volume) = surfaces(step)?;
+    if surfs.is_empty() {
+        println!("{name}: no freeform features");
+        return Ok(());
+    }
+    let ours = run_ours(&exe, step, &dir.join("plan"))?;
+    for s in &surfs {
+        match ours.faces.get(&s.id) {
+            Some(f) if *f == s.step_faces => {}
+            _ => println!(
+                "{name}: warning: feature {} of the extraction and of plan.json differ in faces",
+                s.id
+            ),
+        }
+    }
+
+    let stl = dir.join(format!("{name}.stl"));
+    let m = Command::new(&exe)
+        .arg("mesh")
+        .arg(step)
+        .arg("-o")
+        .arg(&stl)
+        .args(["--tolerance", "0.01"])
+        .output()
+        .map_err(|e| format!("running {}: {e}", exe.display()))?;
+    if !m.status.success() {
+        return Err(format!(
+            "features mesh failed: {}",
+            String::from_utf8_lossy(&m.stderr).trim()
+        ));
+    }
+    let prusa = match run_prusa(&stl, &dir.join(format!("{name}.gcode"))) {
+        PrusaRun::Done(p) => Some(p),
+        PrusaRun::Missing(why) => {
+            println!("{name}: PrusaSlicer not run ({why}); measuring ours only");
+            None
+        }
+        PrusaRun::Failed(why) => {
+            println!("{name}: PrusaSlicer failed ({why}); measuring ours only");
+            None
+        }
+    };
+
+    let mut total_ours = Err::default();
+    let mut total_prusa = Err::default();
+    let mut ff_volume = 0.0;
+    let mut ff_cad = 0.0;
+    // Every sample's errors, for a look at where they are.
+    let mut dump = String::from("feature,x,y,z,ours,prusa\n");
+    for s in &surfs {
+        let o = Err::measure(&s.samples, &ours.segs, &s.bbox);
+        let p = prusa
+            .as_ref()
+            .map(|p| Err::measure(&s.samples, &p.segs, &s.bbox));
+        for (i, q) in s.samples.iter().enumerate() {
+            let pe = p
+                .as_ref()
+                .map_or(String::new(), |p| format!("{:.4}", p.each[i]));
+            dump.push_str(&format!(
+                "{},{:.4},{:.4},{:.4},{:.4},{pe}\n",
+                s.id, q.x, q.y, q.z, o.each[i]
+            ));
+        }
+        total_ours.merge(&o);
+        if let Some(p) = &p {
+            total_prusa.merge(p);
+        }
+        let v = ours.volume.get(&s.id).copied().unwrap_or(0.0);
+        ff_volume += v;
+        ff_cad += s.volume;
+        rows.push(Row {
+            part: name.clone(),
+            feature: format!("{} freeform", s.id),
+            ours: Some(o),
+            prusa: p,
+            ours_volume: v,
+            prusa_volume: None,
+            cad_volume: s.volume,
+            ours_s: None,
+            prusa_s: None,
+        });
+    }
+    rows.push(Row {
+        part: name.clone(),
+        feature: "all freeform".into(),
+        ours: Some(total_ours),
+        prusa: prusa.as_ref().map(|_| total_prusa.clone()),
+        ours_volume: ff_volume,
+        prusa_volume: None,
+        cad_volume: ff_cad,
+        ours_s: None,
+        prusa_s: None,
+    });
+    rows.push(Row {
+        part: name.clone(),
+        feature: "whole part".into(),
+        ours: None,
+        prusa: None,
+        ours_volume: ours.volume.values().sum(),
+        prusa_volume: prusa.as_ref().map(|p| p.volume),
+        cad_volume: part_volume,
+        ours_s: Some(ours.seconds),
+        prusa_s: prusa.as_ref().map(|p| p.seconds),
+    });
+    let dump_path = dir.join("errors.csv");
+    std::fs::write(&dump_path, dump).map_err(|e| format!("{}: {e}", dump_path.display()))?;
+    let samples: usize = surfs.iter().map(|s| s.samples.len()).sum();
+    println!(
+        "{name}: {} freeform feature(s), {samples} surface samples, {} of our segments, {} of PrusaSlicer's",
+        surfs.len(),
+        ours.segs.len(),
+        fmt_opt(prusa.as_ref().map(|p| p.segs.len() as f64), 0)
+    );
+    Ok(())
+}
+
+fn main() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut parts: Vec<PathBuf> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .map(|a| {
+            if a.ends_with(".step") || a.ends_with(".stp") {
+                PathBuf::from(a)
+            } else {
+                root.join("fixtures").join(format!("{a}.step"))
+            }
+        })
+        .collect();
+    if parts.is_empty() {
+        parts = ["impeller", "fan"]
+            .iter()
+            .map(|n| root.join("fixtures").join(format!("{n}.step")))
+            .collect();
+    }
+    let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("stairstep");
+    println!(
+        "stair-step error = max (mean) over samples of the freeform features' true outer surfaces \
+         of (distance to the nearest bead-centre extrusion segment) - {:.3} mm; same {H} mm layers, \
+         {W} mm beads; goal: ours max <= 0.1 x PrusaSlicer's",
+        W / 2.0
+    );
+    let mut rows = vec![];
+    let mut failed = false;
+    for p in &parts {
+        if let Err(e) = bench_part(p, &tmp, &mut rows) {
+            println!("{}: {e}", p.display());
+            failed = true;
+        }
+    }
+    print_table(&rows);
+    println!("(files in {})", tmp.display());
+    if failed {
+        std::process::exit(1);
+    }
+}
