@@ -404,7 +404,10 @@ fn the_impeller_plans_for_the_kuka_cell_and_its_krl_reads_back() {
         .map(|(_, t)| t.matches("; UNREACHABLE").count())
         .sum();
     // (A point's approach and retreat poses are marked too, so there may be more marks.)
-    assert!(marked >= reported as usize, "{marked} marks for {reported} points");
+    assert!(
+        marked >= reported as usize,
+        "{marked} marks for {reported} points"
+    );
     assert_eq!(marked == 0, reported == 0);
 }
 
@@ -463,5 +466,49 @@ fn process_file_overrides_one_feature_and_rejects_unknown_keys() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("layer_hieght"), "{err}");
     assert!(!bad_out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_documented_process_file_is_accepted_and_smoothing_can_be_turned_off() {
+    let process = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../profiles/process.toml");
+    let p = process.display().to_string();
+    let (_dir, documented, _, _) = plan("box", &["--process", &p]);
+    assert_eq!(documented["features"].as_array().unwrap().len(), 1);
+    let dir = std::env::temp_dir().join(format!("features-plan-nosmooth-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let off = dir.join("process.toml");
+    std::fs::write(&off, "[orientation]\nenabled = false\n").unwrap();
+    let o = off.display().to_string();
+    let (_d2, unsmoothed, _, _) = plan("capsule", &["--process", &o, "--machine", "kuka"]);
+    for f in unsmoothed["features"].as_array().unwrap() {
+        for key in [
+            "orientation_step_max_deg",
+            "orientation_rate_max_deg_per_mm",
+        ] {
+            assert_eq!(
+                f[format!("{key}_before")],
+                f[format!("{key}_after")],
+                "{key}"
+            );
+        }
+    }
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[orientation]\ncone_angle_deg = -5.0\n").unwrap();
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(fixture("box.step"))
+        .arg("--process")
+        .arg(&bad)
+        .arg("-o")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cone_angle_deg") && err.lines().count() == 1,
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
