@@ -315,6 +315,83 @@ fn summary(plan: &Value) -> String {
     s
 }
 
+/// Parses a delta5 program back, applies the forward kinematics of the profile's bed, and
+/// checks that every planned print point of `toolpath.csv` is reached, in order, within
+/// 0.01 mm, with the tool axis within 0.1° (outside the singularity cone, where C is patched
+/// and the axis may differ by up to the cone's half-angle).
+fn delta5_round_trip(name: &str, gcode: &str, csv: &str, profile: &str) {
+    use robot_post::machine::MachineProfile;
+    let m = MachineProfile::from_toml(profile).expect("profile");
+    let g = m.delta5.clone().expect("[delta5]");
+    let offset: Vec<f64> = gcode
+        .lines()
+        .find_map(|l| l.strip_prefix("; offset "))
+        .expect("offset comment")
+        .split_whitespace()
+        .take(3)
+        .map(|w| w[1..].parse::<f64>().expect("offset number"))
+        .collect();
+    let offset = [offset[0], offset[1], offset[2]];
+    // Modal X Y Z B C; the end of every G1 that extrudes.
+    let mut at = [0.0f64; 5];
+    let mut prints = vec![];
+    for line in gcode.lines() {
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let Some(cmd) = words.next() else { continue };
+        if cmd != "G1" && cmd != "G0" {
+            continue;
+        }
+        let mut e = None;
+        for w in words {
+            let (k, v) = w.split_at(1);
+            let v: f64 = v.parse().expect("number");
+            match k {
+                "X" => at[0] = v,
+                "Y" => at[1] = v,
+                "Z" => at[2] = v,
+                "B" => at[3] = v,
+                "C" => at[4] = v,
+                "E" => e = Some(v),
+                _ => {}
+            }
+        }
+        // A print move carries E (a very short one may round to E0.00000); retraction
+        // moves carry a negative E and no motion.
+        if cmd == "G1" && e.is_some_and(|e| e >= 0.0) {
+            prints.push(at);
+        }
+    }
+    let cone = g.singularity_cone_deg;
+    let mut k = 0;
+    let mut checked = 0;
+    for row in rows(csv).iter().filter(|r| r.print) {
+        let found = loop {
+            assert!(
+                k < prints.len(),
+                "{name}: planned point {:?} never reached",
+                row.p
+            );
+            let (p, axis) = robot_post::delta5::forward(prints[k], &g, offset);
+            k += 1;
+            let d =
+                ((p[0] - row.p[0]).powi(2) + (p[1] - row.p[1]).powi(2) + (p[2] - row.p[2]).powi(2))
+                    .sqrt();
+            if d <= 0.01 {
+                break axis;
+            }
+        };
+        let dot = (found[0] * row.axis[0] + found[1] * row.axis[1] + found[2] * row.axis[2])
+            .clamp(-1.0, 1.0);
+        let ang = dot.acos().to_degrees();
+        let off_c = row.axis[2].clamp(-1.0, 1.0).acos().to_degrees();
+        let allowed = if off_c < cone + 1e-9 { cone + 0.1 } else { 0.1 };
+        assert!(ang <= allowed, "{name}: axis {ang}° off at {:?}", row.p);
+        checked += 1;
+    }
+    assert!(checked > 1000, "{name}: {checked} points checked");
+}
+
 #[test]
 fn freeform_plans_on_the_delta5_printer() {
     // The capsule's boss on the cone points 36° below the horizon: the default bed tilts
@@ -367,6 +444,12 @@ fn freeform_plans_on_the_delta5_printer() {
         let svg = std::fs::read_to_string(dir.0.join("kinematic_error.svg")).expect("plot");
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(csv.lines().count() > 1000);
+        let profile_text = if name == "capsule" {
+            std::fs::read_to_string(&wide).unwrap()
+        } else {
+            robot_post::machine::DELTA5_TOML.to_string()
+        };
+        delta5_round_trip(name, &gcode, &csv, &profile_text);
         insta::assert_snapshot!(format!("{name}_delta5_plan"), summary(&plan));
     }
 }
@@ -392,6 +475,49 @@ fn the_impeller_plans_for_the_kuka_cell_and_its_krl_reads_back() {
         "{} moves for {prints} print points",
         read.moves.len()
     );
+    // Round trip: every planned print point is a LIN target, in order, within 0.01 mm, and
+    // R_z(A)·R_y(B)·R_x(C) of the target turns the tool's Z (the nozzle, −axis) onto the
+    // planned axis within 0.1°.
+    let offset = read.offset.expect("part offset comment");
+    let mut k = 0;
+    let mut checked = 0;
+    let all = rows(&csv);
+    for (i, row) in all.iter().enumerate() {
+        if !row.print {
+            continue;
+        }
+        // A print point where the nozzle already is has no motion of its own.
+        if i > 0 && (0..3).all(|c| (all[i - 1].p[c] - row.p[c]).abs() < 1e-6) {
+            checked += 1;
+            continue;
+        }
+        let abc = loop {
+            assert!(
+                k < read.moves.len(),
+                "planned point {:?} never reached",
+                row.p
+            );
+            let m = &read.moves[k];
+            k += 1;
+            if let robot_post::krl::Target::Frame(t) = m.target {
+                let d = ((t[0] - offset[0] - row.p[0]).powi(2)
+                    + (t[1] - offset[1] - row.p[1]).powi(2)
+                    + (t[2] - offset[2] - row.p[2]).powi(2))
+                .sqrt();
+                // Print points are reached with the extruder on (the approach to a path's
+                // start, with it off, may lie within 0.01 mm of the first print point).
+                if d <= 0.01 && m.extruder {
+                    break [t[3], t[4], t[5]];
+                }
+            }
+        };
+        let r = robot_post::kuka::matrix_from_abc(abc);
+        let z = [-r[0][2], -r[1][2], -r[2][2]];
+        let dot = (z[0] * row.axis[0] + z[1] * row.axis[1] + z[2] * row.axis[2]).clamp(-1.0, 1.0);
+        assert!(dot.acos().to_degrees() <= 0.1, "axis off at {:?}", row.p);
+        checked += 1;
+    }
+    assert_eq!(checked, prints);
     // Unreachable poses are reported per feature, and marked on their LINs.
     let reported: u64 = plan["features"]
         .as_array()

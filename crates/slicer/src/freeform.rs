@@ -353,11 +353,11 @@ fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 if long(a, b, &pos) {
                     let key = (a.min(b), a.max(b));
-                    if !mid.contains_key(&key) {
+                    mid.entry(key).or_insert_with(|| {
                         let m = P3::from(0.5 * (pos[a as usize].coords + pos[b as usize].coords));
                         pos.push(m);
-                        mid.insert(key, (pos.len() - 1) as u32);
-                    }
+                        (pos.len() - 1) as u32
+                    });
                 }
             }
         }
