@@ -1234,4 +1234,57 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn rings_on_a_cylinder_layer_are_a_spacing_apart_on_the_surface_not_in_the_chart() {
+        // A cylinder of radius 4 offset by 8: the layer has radius 12, three times the
+        // reference, so one chart unit across the axis spans 3 mm there.
+        let surf = Surface::Cylinder {
+            frame: Frame::world(P3::origin()),
+            radius: 4.0,
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 4.0,
+                sv: 1.0,
+            },
+        };
+        // 3 chart units (9 mm on the layer) around, 8 mm along the axis.
+        let region = Region {
+            outer: vec![[-1.5, -4.0], [1.5, -4.0], [1.5, 4.0], [-1.5, 4.0]],
+            holes: vec![],
+        };
+        let params = LayerParams {
+            path_mode: PathMode::Contour,
+            ..LayerParams::default()
+        };
+        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let lift = |q: Point2| chart.at(q, 8.0).expect("on the layer").0;
+        let rings: Vec<Vec<P3>> = paths
+            .iter()
+            .filter(|p| p.is_closed())
+            .map(|p| p.points.iter().map(|q| lift(*q)).collect())
+            .collect();
+        assert!(rings.len() >= 5, "{} rings", rings.len());
+        // Along the middle of the long sides, where the rings run straight along the axis,
+        // neighbouring rings are one spacing apart on the surface (arc ≈ chord at 0.45 mm on
+        // a 12 mm radius).
+        let side = |ring: &[P3]| -> f64 {
+            ring.iter()
+                .filter(|p| p.z.abs() < 1.0 && p.y > 0.0)
+                .map(|p| p.y.atan2(p.x) * 12.0)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        for w in rings.windows(2).take(4) {
+            let gap = side(&w[0]) - side(&w[1]);
+            assert!(
+                (gap - 0.45).abs() < 0.02,
+                "rings {gap} mm apart on the surface"
+            );
+        }
+    }
 }

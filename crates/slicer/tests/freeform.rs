@@ -308,3 +308,18 @@ fn a_two5d_feature_is_refused_by_the_freeform_planner() {
     assert!(matches!(e, PlanError::Freeform { id: 0, .. }), "{e}");
     assert!(pts.is_empty());
 }
+
+#[test]
+fn a_fixed_tool_axis_holds_on_every_point_of_the_curved_layers() {
+    let t = tree("capsule");
+    let params = LayerParams {
+        fixed_tool_axis: Some([0.0, 0.0, 2.0]),
+        ..LayerParams::default()
+    };
+    let mut pts = vec![];
+    plan_freeform(&t, &t.features[2], &params, BEAD, &mut pts, &mut None).expect("plans");
+    assert!(pts.len() > 100);
+    for p in &pts {
+        assert_eq!(p.axis, [0.0, 0.0, 1.0]);
+    }
+}
