@@ -416,6 +416,83 @@ fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
     }
 }
 
+/// Offset deterioration (paper, Fig. 9) judged from the feature's root: the smallest principal
+/// curvature of the reference where the feature stands on it, against the feature's height
+/// along the normal there. `Err(OffsetFolds)` names the first layer whose offset reaches the
+/// radius of a concave valley.
+fn fold_check(
+    surf: &Surface,
+    sign: f64,
+    mesh: &Mesh,
+    tol: f64,
+    params: &LayerParams,
+    id: usize,
+) -> Result<(), PlanError> {
+    // The root: mesh vertices on the reference surface.
+    let roots: Vec<(f64, f64, P3)> = mesh
+        .positions
+        .iter()
+        .filter_map(|p| {
+            let (u, v) = surf.project(p, None);
+            let f = surf.eval(u, v);
+            ((p - f).norm() < 1e-3f64.max(2.0 * tol)).then_some((u, v, f))
+        })
+        .collect();
+    if roots.is_empty() {
+        return Ok(());
+    }
+    let c = roots.iter().fold(V3::zeros(), |a, r| a + r.2.coords) / roots.len() as f64;
+    let (u0, v0) = surf.project(&P3::from(c), None);
+    let (su, sv) = surf.derivs(u0, v0);
+    let Some(n0) = surf.normal(u0, v0).map(|n| n * sign) else {
+        return Ok(());
+    };
+    if su.norm() < 1e-9 || sv.norm() < 1e-9 {
+        return Ok(());
+    }
+    let flip = if su.cross(&sv).dot(&n0) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let (su, sv) = (su.norm() * flip, sv.norm());
+    let chart = Chart {
+        surf,
+        sign,
+        kind: ChartKind::Native { u0, v0, su, sv },
+    };
+    let f0 = surf.eval(u0, v0);
+    let height = mesh
+        .positions
+        .iter()
+        .map(|p| (p - f0).dot(&n0))
+        .fold(0.0f64, f64::max);
+    let step = (0.5 * params.uniform_layer_height).max(1e-3);
+    let mut lambda = 0.0f64;
+    for r in roots.iter().step_by((roots.len() / 300).max(1)) {
+        let (u, v) = surf.unwrap_near((r.0, r.1), (u0, v0));
+        if let Some(l) = chart.min_curvature([(u - u0) * su, (v - v0) * sv], step) {
+            lambda = lambda.min(l);
+        }
+    }
+    if lambda < -1e-9 {
+        let radius = -1.0 / lambda;
+        let mut z = 0.0;
+        for (layer, dl) in params.layer_heights(height).iter().enumerate() {
+            z += dl;
+            if z >= radius {
+                return Err(PlanError::OffsetFolds {
+                    id,
+                    layer: layer + 1,
+                    offset: z,
+                    radius,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Chart coordinates and distance of every mesh vertex, as a mesh in `(s, t, d)` space.
 fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, PlanError> {
     let mut m = mesh.clone();
@@ -977,6 +1054,10 @@ pub fn plan_freeform(
         return Err(err("its mesh is empty".into()));
     }
     let mesh = refined(&mesh, MAX_MAPPED_EDGE);
+    // Offset deterioration first: a concave reference under the feature folds its offsets
+    // before they reach the feature's top, and the feature may not even have a chart then
+    // (a rib standing across a trough maps onto both of its flanks).
+    fold_check(surf, sign, &mesh, tol, params, id)?;
     let mut chart = choose_chart(surf, sign, id, &mesh)?;
     let mut mapped = mapped_mesh(&chart, &mesh, id)?;
     // The feature lies on the side N points to: check, and turn N round if the face said
