@@ -48,9 +48,9 @@ fn a_rib_taller_than_its_trough_radius_is_refused_at_the_first_folding_layer() {
     let h = params.uniform_layer_height;
     let mut pts = vec![];
     let mut cursor = None;
-    let e = plan_freeform(&t, rib, &params, BEAD, &mut pts, &mut cursor)
-        .err()
-        .expect("the rib is refused");
+    let Err(e) = plan_freeform(&t, rib, &params, BEAD, &mut pts, &mut cursor) else {
+        panic!("the rib is refused");
+    };
     let msg = e.to_string();
     let PlanError::OffsetFolds {
         id,
