@@ -17,6 +17,22 @@
 //!   Z − h/2; coordinates mapped back from the bed (the XY box centred on `--center`, the lowest
 //!   point on Z = 0) into the part's.
 //!
+//! A second table gives the envelope error, which does not let w/2 > h/2 hide the stairs on
+//! surfaces at a shallow angle to the layers: each bead is a w × h rectangle swept along its
+//! centre segment a→b, the height along the tool axis n made perpendicular to the tangent t (ours:
+//! the segment's end row's `i,j,k`, `thickness` and `width`; PrusaSlicer: +Z, the extrusion's
+//! `;HEIGHT:`, i.e. the 0.2 mm layer except on bridges, and 0.45 mm). With c the point of the
+//! segment closest to a sample s and r = s − c, the gap is
+//! √(max(|r·n| − h/2, 0)² + max(|r·l| − w/2, 0)² + (r·t)²), l = n × t: the distance from s to the
+//! bead, 0 inside. A sample's envelope error is the least gap over the beads whose centre
+//! segment lies within 2 mm of it (2 mm if there is none). The same statistics are given for the
+//! face-interior samples only: those farther than 1 mm from every edge of their B-rep face (the
+//! face's boundary in the feature's mesh: the mesh edges of the face's triangles that only one
+//! of them uses, so not a periodic face's seam), away from the edges and corners where any
+//! bead-based plan stops short. `errors.csv` in each part's folder has every sample's errors,
+//! face, distance to its face's edges, normal, and the |cos| between the normal and the height
+//! axis of our bead nearest in envelope.
+//!
 //! Also reported: material (our `extruded_volume_mm3` from `plan.json`, PrusaSlicer's filament
 //! used × filament area) and the wall time of each run.
 //!
@@ -44,15 +60,69 @@ const CENTER: (f64, f64) = (100.0, 100.0);
 const GROW: f64 = 2.0;
 /// Sample points further than this from every segment count as this far, mm.
 const FAR: f64 = 20.0;
+/// Face-interior samples lie farther than this from every edge of their face, mm.
+const EDGE: f64 = 1.0;
+/// Distances to a face's edges are measured up to this, mm.
+const EDGE_CAP: f64 = 2.0;
 
-/// One extrusion, bead centre to bead centre.
+/// One extrusion, bead centre to bead centre, with its w × h cross-section.
 #[derive(Clone, Copy)]
 struct Seg {
     a: P3,
     b: P3,
+    /// Unit tool axis made perpendicular to `b − a`: the bead's height direction.
+    n: V3,
+    /// Half the bead's thickness (along `n`), mm.
+    hh: f64,
+    /// Half the bead's width (along `n × t`), mm.
+    hw: f64,
+}
+
+/// A unit vector perpendicular to the unit vector `t`.
+fn any_perpendicular(t: &V3) -> V3 {
+    let e = if t.x.abs() <= t.y.abs() && t.x.abs() <= t.z.abs() {
+        V3::x()
+    } else if t.y.abs() <= t.z.abs() {
+        V3::y()
+    } else {
+        V3::z()
+    };
+    t.cross(&e).normalize()
 }
 
 impl Seg {
+    /// A bead from `a` to `b` of thickness `h` along `axis` (made perpendicular to the segment)
+    /// and width `w`.
+    fn new(a: P3, b: P3, axis: V3, h: f64, w: f64) -> Seg {
+        let d = b - a;
+        let len = d.norm();
+        let n = if len > 0.0 {
+            let t = d / len;
+            let m = axis - t * axis.dot(&t);
+            if m.norm() > 1e-9 {
+                m.normalize()
+            } else {
+                any_perpendicular(&t)
+            }
+        } else if axis.norm() > 1e-9 {
+            axis.normalize()
+        } else {
+            V3::z()
+        };
+        Seg {
+            a,
+            b,
+            n,
+            hh: h / 2.0,
+            hw: w / 2.0,
+        }
+    }
+
+    /// A bare polyline piece (no cross-section).
+    fn line(a: P3, b: P3) -> Seg {
+        Seg::new(a, b, V3::z(), 0.0, 0.0)
+    }
+
     fn distance(&self, p: &P3) -> f64 {
         let d = self.b - self.a;
         let l2 = d.norm_squared();
@@ -62,6 +132,30 @@ impl Seg {
             0.0
         };
         (p - (self.a + d * t)).norm()
+    }
+
+    /// Distance from `p` to the bead's envelope, the w × h rectangle (height along `n`, width
+    /// along `n × t`) swept from `a` to `b`: 0 inside. Infinite for a segment of no length.
+    fn gap(&self, p: &P3) -> f64 {
+        let d = self.b - self.a;
+        let len = d.norm();
+        if len <= 1e-12 {
+            return f64::INFINITY;
+        }
+        let t = d / len;
+        let u = (p - self.a).dot(&t);
+        let over = if u < 0.0 {
+            -u
+        } else if u > len {
+            u - len
+        } else {
+            0.0
+        };
+        let r = p - (self.a + t * u.clamp(0.0, len));
+        let l = self.n.cross(&t);
+        let dn = (r.dot(&self.n).abs() - self.hh).max(0.0);
+        let dl = (r.dot(&l).abs() - self.hw).max(0.0);
+        (dn * dn + dl * dl + over * over).sqrt()
     }
 
     fn meets(&self, b: &Aabb) -> bool {
@@ -75,6 +169,8 @@ impl Seg {
 struct SegGrid {
     cell: f64,
     segs: Vec<Seg>,
+    /// The largest half-diagonal of a bead's cross-section, mm.
+    diag: f64,
     grid: HashMap<(i64, i64, i64), Vec<u32>>,
 }
 
@@ -102,7 +198,13 @@ impl SegGrid {
                 }
             }
         }
-        SegGrid { cell, segs, grid }
+        let diag = segs.iter().map(|s| s.hh.hypot(s.hw)).fold(0.0, f64::max);
+        SegGrid {
+            cell,
+            segs,
+            diag,
+            grid,
+        }
     }
 
     /// Distance from `p` to the nearest segment, at most [`FAR`].
@@ -137,6 +239,71 @@ impl SegGrid {
         }
         best
     }
+
+    /// Calls `visit` with the index of every segment in the shells of cells around `p`, nearest
+    /// shells first, until everything unseen is farther than the reach `visit` returns (at most
+    /// `reach`).
+    fn scan(&self, p: &P3, reach: f64, mut visit: impl FnMut(usize) -> f64) {
+        let c = |x: f64| (x / self.cell).floor() as i64;
+        let (i0, j0, l0) = (c(p.x), c(p.y), c(p.z));
+        let mut now = reach;
+        let rmax = (reach / self.cell).ceil() as i64 + 1;
+        for r in 0..=rmax {
+            for i in i0 - r..=i0 + r {
+                for j in j0 - r..=j0 + r {
+                    let edge = (i - i0).abs() == r || (j - j0).abs() == r;
+                    let mut cell = |l: i64| {
+                        if let Some(v) = self.grid.get(&(i, j, l)) {
+                            for &s in v {
+                                now = now.min(visit(s as usize));
+                            }
+                        }
+                    };
+                    if edge {
+                        (l0 - r..=l0 + r).for_each(&mut cell);
+                    } else {
+                        cell(l0 - r);
+                        if r > 0 {
+                            cell(l0 + r);
+                        }
+                    }
+                }
+            }
+            if now <= r as f64 * self.cell {
+                break;
+            }
+        }
+    }
+
+    /// Distance from `p` to the nearest segment, at most `cap`.
+    fn nearest_within(&self, p: &P3, cap: f64) -> f64 {
+        let mut best = cap;
+        self.scan(p, cap, |s| {
+            best = best.min(self.segs[s].distance(p));
+            best
+        });
+        best
+    }
+
+    /// The smallest envelope gap from `p` over the beads whose centre segment lies within
+    /// [`GROW`] of it, and that bead's index; [`GROW`] and `None` if there is none.
+    fn envelope(&self, p: &P3) -> (f64, Option<usize>) {
+        let mut best = GROW;
+        let mut which = None;
+        self.scan(p, GROW, |s| {
+            let seg = &self.segs[s];
+            // The envelope lies within `diag` of the centre segment.
+            if seg.distance(p) <= GROW {
+                let g = seg.gap(p);
+                if g < best || (which.is_none() && g <= best) {
+                    best = g;
+                    which = Some(s);
+                }
+            }
+            (best + self.diag).min(GROW)
+        });
+        (best, which)
+    }
 }
 
 /// Stair-step errors of one plan at each sample, mm.
@@ -145,17 +312,64 @@ struct Err {
     each: Vec<f64>,
 }
 
-impl Err {
+/// Both measures of one plan at each sample of a surface.
+struct Measured {
+    /// Distance to the nearest bead centre − w/2 (the issue's definition).
+    centre: Err,
+    /// Distance to the nearest bead envelope.
+    envelope: Err,
+    /// |cos| of the angle between the surface normal and the height axis of the bead giving
+    /// the envelope error (1: the surface lies along the layers), NaN without one.
+    axis_cos: Vec<f64>,
+}
+
+impl Measured {
     /// Measures the samples against the segments that meet the box grown by [`GROW`].
-    fn measure(samples: &[P3], segs: &[Seg], bbox: &Aabb) -> Err {
-        let mut grown = *bbox;
+    fn new(s: &Surface, segs: &[Seg]) -> Measured {
+        let mut grown = s.bbox;
         grown.min -= V3::repeat(GROW);
         grown.max += V3::repeat(GROW);
         let near: Vec<Seg> = segs.iter().copied().filter(|s| s.meets(&grown)).collect();
         let grid = SegGrid::new(near, 0.5);
-        Err {
-            each: samples.iter().map(|p| grid.nearest(p) - W / 2.0).collect(),
+        let centre = Err {
+            each: s
+                .samples
+                .iter()
+                .map(|p| grid.nearest(p) - W / 2.0)
+                .collect(),
+        };
+        let mut envelope = Err::default();
+        let mut axis_cos = vec![];
+        for (p, n) in s.samples.iter().zip(&s.normal) {
+            let (g, which) = grid.envelope(p);
+            envelope.each.push(g);
+            axis_cos.push(which.map_or(f64::NAN, |i| grid.segs[i].n.dot(n).abs()));
         }
+        Measured {
+            centre,
+            envelope,
+            axis_cos,
+        }
+    }
+}
+
+impl Err {
+    /// The errors at the samples farther than [`EDGE`] from their face's edges.
+    fn interior(&self, s: &Surface) -> Err {
+        Err {
+            each: self
+                .each
+                .iter()
+                .zip(&s.edge)
+                .filter(|(_, d)| **d > EDGE)
+                .map(|(e, _)| *e)
+                .collect(),
+        }
+    }
+
+    /// Max, p95 and mean, or `None` without samples.
+    fn stats(&self) -> Option<(f64, f64, f64)> {
+        (!self.each.is_empty()).then(|| (self.max(), self.quantile(0.95), self.mean()))
     }
 
     fn merge(&mut self, o: &Err) {
@@ -183,6 +397,13 @@ impl Err {
 struct Surface {
     id: usize,
     samples: Vec<P3>,
+    /// Unit outward surface normal at each sample (area-weighted at vertices).
+    normal: Vec<V3>,
+    /// Distance from each sample to the nearest edge of its B-rep face (0 on an edge), at most
+    /// [`EDGE_CAP`], mm.
+    edge: Vec<f64>,
+    /// STEP id of each sample's face (the first one for a vertex on an edge).
+    face: Vec<u64>,
     bbox: Aabb,
     volume: f64,
     step_faces: Vec<u64>,
@@ -210,14 +431,81 @@ fn surfaces(step: &Path) -> Result<(Vec<Surface>, f64), String> {
             .collect();
         let mesh = mesh_faces(&tree.brep, &outer, &MeshOptions::with_tolerance(0.01))
             .map_err(|e| format!("meshing feature {}: {e}", f.id))?;
-        let mut samples = mesh.positions.clone();
-        for t in mesh.triangles() {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize].coords);
-            samples.push(P3::from((a + b + c) / 3.0));
+        let pos = &mesh.positions;
+        let mut samples = pos.clone();
+        // Vertices first, then each face's triangle centroids in the order of `mesh.triangles()`.
+        let mut edge = vec![f64::INFINITY; pos.len()];
+        let mut face = vec![0u64; pos.len()];
+        let mut normal = vec![V3::zeros(); pos.len()];
+        let (mut c_edge, mut c_face, mut c_normal) = (vec![], vec![], vec![]);
+        for ft in &mesh.faces {
+            let sid = tree.brep.face(ft.face).step_id;
+            let tris: Vec<[u32; 3]> = ft
+                .triangles
+                .iter()
+                .map(|t| t.map(|i| ft.vertex[i as usize]))
+                .filter(|g| g[0] != g[1] && g[1] != g[2] && g[0] != g[2])
+                .collect();
+            // The face's boundary: its mesh edges used by one triangle only (its B-rep edges,
+            // not a seam, whose two sides share vertices).
+            let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+            for t in &tris {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+                }
+            }
+            let bounds: Vec<Seg> = uses
+                .iter()
+                .filter(|(_, n)| **n == 1)
+                .map(|((a, b), _)| Seg::line(pos[*a as usize], pos[*b as usize]))
+                .collect();
+            let grid = SegGrid::new(bounds, 1.0);
+            for &v in &ft.vertex {
+                let v = v as usize;
+                edge[v] = edge[v].min(grid.nearest_within(&pos[v], EDGE_CAP));
+                if face[v] == 0 {
+                    face[v] = sid;
+                }
+            }
+            for t in &tris {
+                let [a, b, c] = t.map(|i| pos[i as usize]);
+                let n = (b - a).cross(&(c - a));
+                for &i in t {
+                    normal[i as usize] += n;
+                }
+                let m = P3::from((a.coords + b.coords + c.coords) / 3.0);
+                samples.push(m);
+                c_edge.push(grid.nearest_within(&m, EDGE_CAP));
+                c_face.push(sid);
+                c_normal.push(n.try_normalize(0.0).unwrap_or_else(V3::zeros));
+            }
         }
+        if samples.len() != pos.len() + mesh.triangles().len() {
+            return Err(format!(
+                "feature {}: samples out of step with the mesh",
+                f.id
+            ));
+        }
+        // A vertex in no face is not known to lie inside one.
+        for e in &mut edge {
+            if !e.is_finite() {
+                *e = 0.0;
+            }
+        }
+        let mut normal: Vec<V3> = normal
+            .into_iter()
+            .map(|n| n.try_normalize(0.0).unwrap_or_else(V3::zeros))
+            .collect();
+        normal.extend(c_normal);
+        edge.extend(c_edge);
+        face.extend(c_face);
         out.push(Surface {
             id: f.id,
             samples,
+            normal,
+            edge,
+            face,
             bbox: mesh.bbox(),
             volume: f.volume,
             step_faces: f.step_faces(&tree.brep),
@@ -271,10 +559,11 @@ fn run_ours(exe: &Path, step: &Path, dir: &Path) -> Result<Ours, String> {
         };
         let p = P3::new(num(3)?, num(4)?, num(5)?);
         let axis = V3::new(num(6)?, num(7)?, num(8)?);
-        let centre = p - axis * (num(10)? / 2.0);
+        let thickness = num(10)?;
+        let centre = p - axis * (thickness / 2.0);
         if f[2] == "print" {
             if let Some(a) = prev {
-                segs.push(Seg { a, b: centre });
+                segs.push(Seg::new(a, centre, axis, thickness, num(11)?));
             }
         }
         prev = Some(centre);
@@ -469,10 +758,13 @@ fn parse_gcode(text: &str, shift: V3) -> Result<Prusa, String> {
                 let moved = nx != x || ny != y;
                 if moved && ne > e + 1e-9 && nz == z {
                     let c = V3::new(0.0, 0.0, -height / 2.0) + shift;
-                    segs.push(Seg {
-                        a: P3::new(x, y, z) + c,
-                        b: P3::new(nx, ny, nz) + c,
-                    });
+                    segs.push(Seg::new(
+                        P3::new(x, y, z) + c,
+                        P3::new(nx, ny, nz) + c,
+                        V3::z(),
+                        height,
+                        W,
+                    ));
                     extruded += ne - e;
                 }
                 (x, y, z, e) = (nx, ny, nz, ne);
@@ -494,6 +786,11 @@ struct Row {
     feature: String,
     ours: Option<Err>,
     prusa: Option<Err>,
+    /// Envelope errors of ours and PrusaSlicer's, at all samples and at the face-interior ones.
+    ours_env: Option<Err>,
+    prusa_env: Option<Err>,
+    ours_int: Option<Err>,
+    prusa_int: Option<Err>,
     ours_volume: f64,
     prusa_volume: Option<f64>,
     cad_volume: f64,
@@ -557,6 +854,66 @@ fn print_table(rows: &[Row]) {
     );
 }
 
+fn print_envelope_table(rows: &[Row]) {
+    println!();
+    println!(
+        "{:<9} {:<12} | {:<20} | {:<20} | {:<11} || {:<20} | {:<20} | {:<11} | {:>8}",
+        "",
+        "",
+        "envelope: ours",
+        "envelope: prusa",
+        "ours/prusa",
+        "interior: ours",
+        "interior: prusa",
+        "ours/prusa",
+        "interior"
+    );
+    println!(
+        "{:<9} {:<12} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>5} {:>5} || {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>5} {:>5} | {:>8}",
+        "part", "feature", "max", "p95", "mean", "max", "p95", "mean", "max", "p95", "max", "p95",
+        "mean", "max", "p95", "mean", "max", "p95", "samples"
+    );
+    println!("{}", "-".repeat(147));
+    let three = |e: Option<&Err>| {
+        let st = e.and_then(Err::stats);
+        [
+            fmt_opt(st.map(|s| s.0), 3),
+            fmt_opt(st.map(|s| s.1), 3),
+            fmt_opt(st.map(|s| s.2), 3),
+        ]
+    };
+    let ratio = |o: Option<&Err>, p: Option<&Err>| {
+        let (o, p) = (o.and_then(Err::stats), p.and_then(Err::stats));
+        let r = o.zip(p);
+        [
+            fmt_opt(r.map(|(o, p)| o.0 / p.0), 2),
+            fmt_opt(r.map(|(o, p)| o.1 / p.1), 2),
+        ]
+    };
+    for r in rows {
+        if r.ours_env.is_none() && r.prusa_env.is_none() {
+            continue;
+        }
+        let [a, b, c] = three(r.ours_env.as_ref());
+        let [d, e, f] = three(r.prusa_env.as_ref());
+        let [g, h] = ratio(r.ours_env.as_ref(), r.prusa_env.as_ref());
+        let [i, j, k] = three(r.ours_int.as_ref());
+        let [l, m, n] = three(r.prusa_int.as_ref());
+        let [o, p] = ratio(r.ours_int.as_ref(), r.prusa_int.as_ref());
+        let count = r.ours_int.as_ref().map_or(0, |e| e.each.len());
+        println!(
+            "{:<9} {:<12} | {a:>6} {b:>6} {c:>6} | {d:>6} {e:>6} {f:>6} | {g:>5} {h:>5} || {i:>6} {j:>6} {k:>6} | {l:>6} {m:>6} {n:>6} | {o:>5} {p:>5} | {count:>8}",
+            r.part, r.feature
+        );
+    }
+    println!(
+        "envelope error in mm: distance from the true surface to the nearest bead envelope (each \
+         bead a w x h rectangle swept along its centre segment, h along the tool axis; the min over \
+         beads within {GROW} mm, capped at {GROW}); interior: samples farther than {EDGE} mm from \
+         every edge of their B-rep face; ratio = ours / PrusaSlicer of max and of p95"
+    );
+}
+
 fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String> {
     let name = step
         .file_stem()
@@ -611,23 +968,51 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
 
     let mut total_ours = Err::default();
     let mut total_prusa = Err::default();
+    let mut totals: [Err; 4] = Default::default();
     let mut ff_volume = 0.0;
     let mut ff_cad = 0.0;
     // Every sample's errors, for a look at where they are.
-    let mut dump = String::from("feature,x,y,z,ours,prusa\n");
+    let mut dump = String::from(
+        "feature,x,y,z,ours,prusa,face,edge_mm,nx,ny,nz,ours_env,prusa_env,ours_axis_cos\n",
+    );
     for s in &surfs {
-        let o = Err::measure(&s.samples, &ours.segs, &s.bbox);
-        let p = prusa
-            .as_ref()
-            .map(|p| Err::measure(&s.samples, &p.segs, &s.bbox));
+        let om = Measured::new(s, &ours.segs);
+        let pm = prusa.as_ref().map(|p| Measured::new(s, &p.segs));
+        let o = om.centre.clone();
+        let p = pm.as_ref().map(|m| m.centre.clone());
         for (i, q) in s.samples.iter().enumerate() {
             let pe = p
                 .as_ref()
                 .map_or(String::new(), |p| format!("{:.4}", p.each[i]));
+            let pv = pm
+                .as_ref()
+                .map_or(String::new(), |p| format!("{:.4}", p.envelope.each[i]));
+            let n = s.normal[i];
             dump.push_str(&format!(
-                "{},{:.4},{:.4},{:.4},{:.4},{pe}\n",
-                s.id, q.x, q.y, q.z, o.each[i]
+                "{},{:.4},{:.4},{:.4},{:.4},{pe},{},{:.4},{:.4},{:.4},{:.4},{:.4},{pv},{:.4}\n",
+                s.id,
+                q.x,
+                q.y,
+                q.z,
+                o.each[i],
+                s.face[i],
+                s.edge[i],
+                n.x,
+                n.y,
+                n.z,
+                om.envelope.each[i],
+                om.axis_cos[i]
             ));
+        }
+        let oi = om.envelope.interior(s);
+        let pi = pm.as_ref().map(|m| m.envelope.interior(s));
+        totals[0].merge(&om.envelope);
+        totals[2].merge(&oi);
+        if let Some(m) = &pm {
+            totals[1].merge(&m.envelope);
+        }
+        if let Some(m) = &pi {
+            totals[3].merge(m);
         }
         total_ours.merge(&o);
         if let Some(p) = &p {
@@ -641,6 +1026,10 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
             feature: format!("{} freeform", s.id),
             ours: Some(o),
             prusa: p,
+            ours_env: Some(om.envelope),
+            prusa_env: pm.map(|m| m.envelope),
+            ours_int: Some(oi),
+            prusa_int: pi,
             ours_volume: v,
             prusa_volume: None,
             cad_volume: s.volume,
@@ -653,6 +1042,10 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
         feature: "all freeform".into(),
         ours: Some(total_ours),
         prusa: prusa.as_ref().map(|_| total_prusa.clone()),
+        ours_env: Some(totals[0].clone()),
+        prusa_env: prusa.as_ref().map(|_| totals[1].clone()),
+        ours_int: Some(totals[2].clone()),
+        prusa_int: prusa.as_ref().map(|_| totals[3].clone()),
         ours_volume: ff_volume,
         prusa_volume: None,
         cad_volume: ff_cad,
@@ -664,6 +1057,10 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
         feature: "whole part".into(),
         ours: None,
         prusa: None,
+        ours_env: None,
+        prusa_env: None,
+        ours_int: None,
+        prusa_int: None,
         ours_volume: ours.volume.values().sum(),
         prusa_volume: prusa.as_ref().map(|p| p.volume),
         cad_volume: part_volume,
@@ -717,6 +1114,7 @@ fn main() {
         }
     }
     print_table(&rows);
+    print_envelope_table(&rows);
     println!("(files in {})", tmp.display());
     if failed {
         std::process::exit(1);
