@@ -3,10 +3,11 @@
 //! Every B-rep edge is discretised once, in 3-D, and both faces that use it take the same points,
 //! so the mesh has no cracks. Each face's loops are taken into the surface's `(u, v)` domain by
 //! projection, unwrapped across periods, bridged along singular lines (sphere poles, cone apexes),
-//! closed through a pole or paired with each other where they wrap around the surface, and
-//! triangulated there (constrained Delaunay, spade) with interior points spaced by the surface's
-//! curvature. The `(u, v)` triangles are kept: mass properties integrate the exact surface over
-//! them.
+//! closed through a pole or paired with each other where they wrap around the surface (the cut
+//! this draws across the face, on both sides of the seam, is sampled like an edge, both sides
+//! sharing its points), and triangulated there (constrained Delaunay, spade) with interior points
+//! spaced by the surface's curvature. The `(u, v)` triangles are kept: mass properties integrate
+//! the exact surface over them.
 
 use crate::curve::Curve;
 use crate::math::{Aabb, P3};
@@ -599,7 +600,7 @@ fn face_polygons(
         let per = periods[axis].unwrap_or(0.0);
         if let Some(j) = wrapping.iter().position(|(_, wb)| wb[axis] == -wa[axis]) {
             let (b, _) = wrapping.swap_remove(j);
-            polys.push(join_wrapping(a, b, axis, per));
+            polys.push(join_wrapping(a, b, axis, per, s, positions, opts));
         } else {
             // Close through the singular line on the side the face lies.
             let lines = if axis == 0 { &sing_v } else { &sing_u };
@@ -645,11 +646,18 @@ fn face_polygons(
             let sk = if axis == 0 { 1 } else { 2 };
             let mut poly = a;
             let start = poly[0];
-            poly.push(Pt {
+            let end = Pt {
                 uv: uv_end,
                 idx: start.idx,
                 sing: start.sing,
-            });
+            };
+            // The two sides of the cut from the loop to the pole are one curve on the surface
+            // (a meridian of a sphere): sample it like an edge, the same vertices on both sides.
+            let mut shift = [0.0; 2];
+            shift[axis] = wa[axis] as f64 * per;
+            let cut = cut_points(s, uv_end, c1, positions, opts);
+            poly.push(end);
+            poly.extend(cut.iter().copied());
             poly.push(Pt {
                 uv: c1,
                 idx: pole,
@@ -660,6 +668,10 @@ fn face_polygons(
                 idx: pole,
                 sing: sk,
             });
+            poly.extend(cut.iter().rev().map(|p| Pt {
+                uv: [p.uv[0] - shift[0], p.uv[1] - shift[1]],
+                ..*p
+            }));
             polys.push(poly);
         }
     }
@@ -729,9 +741,108 @@ fn unwrap_loop(mut chain: Vec<Pt>, periods: [Option<f64>; 2]) -> (Vec<Pt>, [i64;
     (out, wrap)
 }
 
+/// Points strictly inside a cut the mesher adds across a face (not a B-rep edge: the seam side
+/// of a band or of a loop closed through a pole), from `p` to `q` in `(u, v)`, spaced like an
+/// edge by the chord and angle tolerances of the surface curve between them. A cut is drawn
+/// twice, a period apart, so both sides must take these same vertices: a cut left as one
+/// segment becomes a chord through the solid (a meridian from the rim to a sphere's pole).
+fn cut_points(
+    s: &Surface,
+    p: [f64; 2],
+    q: [f64; 2],
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Vec<Pt> {
+    let at = |t: f64| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+    let eval = |t: f64| {
+        let uv = at(t);
+        s.eval(uv[0], uv[1])
+    };
+    // Uniform steps first (a chord test between the ends alone can miss a curve that comes
+    // back), unless the curve is straight (a cylinder's generator); then bisection by chord
+    // deviation and the turn of the chord direction.
+    const START: usize = 8;
+    let (pp, pq) = (eval(0.0), eval(1.0));
+    let chord = pq - pp;
+    let straight = (1..START).all(|i| {
+        let x = eval(i as f64 / START as f64) - pp;
+        let dev = if chord.norm() > 1e-300 {
+            x.cross(&chord).norm() / chord.norm()
+        } else {
+            x.norm()
+        };
+        dev <= 0.1 * opts.chord_tol
+    });
+    if straight {
+        return vec![];
+    }
+    let mut ts = vec![0.0];
+    for i in 0..START {
+        let (a, b) = (i as f64 / START as f64, (i + 1) as f64 / START as f64);
+        cut_refine(&eval, a, b, opts, 0, &mut ts);
+    }
+    let mut out = vec![];
+    for &t in &ts[1..ts.len() - 1] {
+        let uv = at(t);
+        let sing = singular_kind(s, uv);
+        if sing != 0 {
+            continue;
+        }
+        positions.push(s.eval(uv[0], uv[1]));
+        out.push(Pt {
+            uv,
+            idx: (positions.len() - 1) as u32,
+            sing,
+        });
+    }
+    out
+}
+
+/// Bisects `[a, b]` of a cut until its chords are within tolerance, pushing the right ends.
+fn cut_refine(
+    eval: &dyn Fn(f64) -> P3,
+    a: f64,
+    b: f64,
+    opts: &MeshOptions,
+    depth: u32,
+    out: &mut Vec<f64>,
+) {
+    let m = 0.5 * (a + b);
+    if depth < 12 {
+        let (pa, pm, pb) = (eval(a), eval(m), eval(b));
+        let chord = pb - pa;
+        let l = chord.norm();
+        let dev = if l > 1e-300 {
+            (pm - pa).cross(&chord).norm() / l
+        } else {
+            (pm - pa).norm()
+        };
+        let (d0, d1) = (pm - pa, pb - pm);
+        let turn = if d0.norm() > 1e-300 && d1.norm() > 1e-300 {
+            2.0 * d0.angle(&d1)
+        } else {
+            0.0
+        };
+        if dev > opts.chord_tol || turn > opts.angle_tol {
+            cut_refine(eval, a, m, opts, depth + 1, out);
+            cut_refine(eval, m, b, opts, depth + 1, out);
+            return;
+        }
+    }
+    out.push(b);
+}
+
 /// Joins a loop winding `+1` with one winding `-1` (a band around a cylinder) into one polygon
-/// through a cut at the first loop's start.
-fn join_wrapping(a: Vec<Pt>, b: Vec<Pt>, axis: usize, per: f64) -> Vec<Pt> {
+/// through a cut at the first loop's start; the cut's two sides share their vertices.
+fn join_wrapping(
+    a: Vec<Pt>,
+    b: Vec<Pt>,
+    axis: usize,
+    per: f64,
+    s: &Surface,
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Vec<Pt> {
     let wa = a.clone();
     let first = wa[0];
     let mut end = first;
@@ -759,12 +870,24 @@ fn join_wrapping(a: Vec<Pt>, b: Vec<Pt>, axis: usize, per: f64) -> Vec<Pt> {
     let mut out = a;
     out.push(end);
     let mut prev = target;
+    let mut run = Vec::with_capacity(m + 1);
     for k in 0..=m {
         let mut p = b[(j + k) % m];
         p.uv[axis] = crate::math::nearest_periodic(p.uv[axis], prev, per);
         prev = p.uv[axis];
-        out.push(p);
+        run.push(p);
     }
+    // The cut from `end` to `b`'s first point, and its twin a period away from `b`'s last
+    // point back to the start of `a`.
+    let (b0, bn) = (run[0].uv, run[m].uv);
+    let shift = [b0[0] - bn[0], b0[1] - bn[1]];
+    let cut = cut_points(s, end.uv, b0, positions, opts);
+    out.extend(cut.iter().copied());
+    out.extend(run);
+    out.extend(cut.iter().rev().map(|p| Pt {
+        uv: [p.uv[0] - shift[0], p.uv[1] - shift[1]],
+        ..*p
+    }));
     out
 }
 
