@@ -204,10 +204,16 @@ impl MachineProfile {
         }
         match (self.kind, &self.delta5, &self.kuka) {
             (MachineKind::Delta5, None, _) => {
-                return Err(bad("[delta5]", "table is required for kind = \"delta5\"".into()))
+                return Err(bad(
+                    "[delta5]",
+                    "table is required for kind = \"delta5\"".into(),
+                ))
             }
             (MachineKind::Kuka, _, None) => {
-                return Err(bad("[kuka]", "table is required for kind = \"kuka\"".into()))
+                return Err(bad(
+                    "[kuka]",
+                    "table is required for kind = \"kuka\"".into(),
+                ))
             }
             _ => {}
         }
