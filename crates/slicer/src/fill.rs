@@ -1018,8 +1018,26 @@ fn connector(r: &Ring, e: End, len: f64, forward: bool, pts: &mut Vec<Point2>) {
 pub fn order_paths(paths: Vec<Path2>, start: Point2) -> Vec<Path2> {
     let (todo, empty): (Vec<Path2>, Vec<Path2>) =
         paths.into_iter().partition(|p| !p.points.is_empty());
-    let mut todo: Vec<Option<Path2>> = todo.into_iter().map(Some).collect();
-    let mut out = Vec::with_capacity(todo.len() + empty.len());
+    let mut out = order_greedy(todo, start, |p| &p.points, |p| p.points.reverse());
+    out.extend(empty);
+    out
+}
+
+/// The greedy order of [`order_paths`] for any path type: `points` gives a path's (non-empty)
+/// polyline, closed when it ends where it starts; `reverse` turns a path round (with anything
+/// it carries per point).
+pub fn order_greedy<T>(
+    paths: Vec<T>,
+    start: Point2,
+    points: impl Fn(&T) -> &[Point2],
+    reverse: impl Fn(&mut T),
+) -> Vec<T> {
+    let mut todo: Vec<Option<T>> = paths
+        .into_iter()
+        .filter(|p| !points(p).is_empty())
+        .map(Some)
+        .collect();
+    let mut out = Vec::with_capacity(todo.len());
     let d = |a: Point2, b: Point2| {
         let v = dist(a, b);
         if v.is_nan() {
@@ -1034,26 +1052,28 @@ pub fn order_paths(paths: Vec<Path2>, start: Point2) -> Vec<Path2> {
         let mut best: Option<(f64, usize, bool)> = None;
         for (i, p) in todo.iter().enumerate() {
             let Some(p) = p else { continue };
-            let ds = d(cur, p.points[0]);
+            let pts = points(p);
+            let ds = d(cur, pts[0]);
             if best.is_none_or(|b| ds < b.0) {
                 best = Some((ds, i, false));
             }
-            if !p.is_closed() {
-                let de = d(cur, p.points[p.points.len() - 1]);
+            let closed = pts.len() > 2 && pts.first() == pts.last();
+            if !closed {
+                let de = d(cur, pts[pts.len() - 1]);
                 if best.is_none_or(|b| de < b.0) {
                     best = Some((de, i, true));
                 }
             }
         }
-        let Some((_, i, reverse)) = best else { break };
+        let Some((_, i, rev)) = best else { break };
         let Some(mut p) = todo[i].take() else { break };
-        if reverse {
-            p.points.reverse();
+        if rev {
+            reverse(&mut p);
         }
-        cur = p.points[p.points.len() - 1];
+        let pts = points(&p);
+        cur = pts[pts.len() - 1];
         out.push(p);
     }
-    out.extend(empty);
     out
 }
 

@@ -522,10 +522,6 @@ impl FillPath {
         FillPath { points, widths }
     }
 
-    fn is_closed(&self) -> bool {
-        self.points.len() > 2 && self.points.first() == self.points.last()
-    }
-
     fn reverse(&mut self) {
         self.points.reverse();
         self.widths.reverse();
@@ -831,48 +827,10 @@ impl<'a> Border<'a> {
     }
 }
 
-/// [`crate::fill::order_paths`] for paths that carry their bead widths: greedy nearest start
-/// (or end, reversing an open path) from `start`; closed paths are entered at their first point.
+/// [`crate::fill::order_paths`] for paths that carry their bead widths.
 fn order_fill_paths(paths: Vec<FillPath>, start: Point2) -> Vec<FillPath> {
-    let mut todo: Vec<Option<FillPath>> = paths
-        .into_iter()
-        .filter(|p| p.points.len() >= 2)
-        .map(Some)
-        .collect();
-    let d = |a: Point2, b: Point2| {
-        let v = (a[0] - b[0]).hypot(a[1] - b[1]);
-        if v.is_nan() {
-            f64::INFINITY
-        } else {
-            v
-        }
-    };
-    let mut out = Vec::with_capacity(todo.len());
-    let mut cur = start;
-    for _ in 0..todo.len() {
-        let mut best: Option<(f64, usize, bool)> = None;
-        for (i, p) in todo.iter().enumerate() {
-            let Some(p) = p else { continue };
-            let ds = d(cur, p.points[0]);
-            if best.is_none_or(|b| ds < b.0) {
-                best = Some((ds, i, false));
-            }
-            if !p.is_closed() {
-                let de = d(cur, p.points[p.points.len() - 1]);
-                if best.is_none_or(|b| de < b.0) {
-                    best = Some((de, i, true));
-                }
-            }
-        }
-        let Some((_, i, reverse)) = best else { break };
-        let Some(mut p) = todo[i].take() else { break };
-        if reverse {
-            p.reverse();
-        }
-        cur = p.points[p.points.len() - 1];
-        out.push(p);
-    }
-    out
+    let paths = paths.into_iter().filter(|p| p.points.len() >= 2).collect();
+    crate::fill::order_greedy(paths, start, |p| &p.points, FillPath::reverse)
 }
 
 /// A lifted path point: chart coordinates, position and unit normal.
@@ -1347,7 +1305,7 @@ mod tests {
         let lift = |q: Point2| chart.at(q, 8.0).expect("on the layer").0;
         let rings: Vec<Vec<P3>> = paths
             .iter()
-            .filter(|p| p.is_closed())
+            .filter(|p| p.points.len() > 2 && p.points.first() == p.points.last())
             .map(|p| p.points.iter().map(|q| lift(*q)).collect())
             .collect();
         assert!(rings.len() >= 5, "{} rings", rings.len());
