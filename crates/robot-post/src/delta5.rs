@@ -608,16 +608,7 @@ fn fit_c_limits(
 /// print points) on the table surface. A path without print points is placed by its travel
 /// points; an empty path gets no offset.
 fn placement(path: &ToolPath) -> [f64; 3] {
-    let prints: Vec<&PathPoint> = path
-        .points
-        .iter()
-        .filter(|q| q.kind == MoveKind::Print)
-        .collect();
-    let placed: Vec<&PathPoint> = if prints.is_empty() {
-        path.points.iter().collect()
-    } else {
-        prints
-    };
+    let placed = crate::marlin::placed_points(path);
     if placed.is_empty() {
         return [0.0; 3];
     }
@@ -678,14 +669,7 @@ pub fn delta5(
     m: &MachineProfile,
     source: &str,
 ) -> Result<Delta5Program, PostError> {
-    if m.kind != MachineKind::Delta5 {
-        return Err(PostError::WrongMachine {
-            name: m.name.clone(),
-            kind: m.kind,
-            expected: MachineKind::Delta5,
-        });
-    }
-    m.validate()?;
+    m.check_for(MachineKind::Delta5)?;
     let g = m.delta5.as_ref().ok_or_else(|| PostError::ProfileValue {
         name: m.name.clone(),
         field: "[delta5]",

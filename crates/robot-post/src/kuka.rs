@@ -842,14 +842,7 @@ pub fn kuka(
     program_name: &str,
     source: &str,
 ) -> Result<KrlProgram, PostError> {
-    if m.kind != MachineKind::Kuka {
-        return Err(PostError::WrongMachine {
-            name: m.name.clone(),
-            kind: m.kind,
-            expected: MachineKind::Kuka,
-        });
-    }
-    m.validate()?;
+    m.check_for(MachineKind::Kuka)?;
     let cell = m.kuka.as_ref().ok_or_else(|| PostError::ProfileValue {
         name: m.name.clone(),
         field: "[kuka]",

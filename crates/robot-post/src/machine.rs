@@ -226,6 +226,19 @@ impl MachineProfile {
         Ok(())
     }
 
+    /// Checks that the profile is for `kind` and valid ([`MachineProfile::validate`]): the
+    /// first thing every post does.
+    pub fn check_for(&self, kind: MachineKind) -> Result<(), PostError> {
+        if self.kind != kind {
+            return Err(PostError::WrongMachine {
+                name: self.name.clone(),
+                kind: self.kind,
+                expected: kind,
+            });
+        }
+        self.validate()
+    }
+
     /// Filament length (mm) fed for a bead of width `w`, thickness `dl` and length `len`:
     /// `4·w·dl·len / (π·D²)` with this profile's filament diameter D (Isa & Lazoglu 2019,
     /// Eq. 1). For planners; the posts only write the `e` the planner computed.

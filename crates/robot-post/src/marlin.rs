@@ -32,14 +32,7 @@ const END_LIFT: f64 = 10.0;
 /// on the plate and `print_speed` otherwise. A path that starts with a print point first
 /// travels to it.
 pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<String, PostError> {
-    if m.kind != MachineKind::Marlin {
-        return Err(PostError::WrongMachine {
-            name: m.name.clone(),
-            kind: m.kind,
-            expected: MachineKind::Marlin,
-        });
-    }
-    m.validate()?;
+    m.check_for(MachineKind::Marlin)?;
     path.check_finite()?;
     if let Some(q) = path.points.iter().find(|q| !is_plus_z(q.axis)) {
         return Err(PostError::ToolAxis {
@@ -93,16 +86,7 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
     } else {
         half
     };
-    let prints: Vec<&PathPoint> = path
-        .points
-        .iter()
-        .filter(|q| q.kind == MoveKind::Print)
-        .collect();
-    let placed: Vec<&PathPoint> = if prints.is_empty() {
-        path.points.iter().collect()
-    } else {
-        prints
-    };
+    let placed = placed_points(path);
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for q in &placed {
@@ -357,5 +341,20 @@ impl Writer {
         }
         self.line("G28 X0 Y0 ; home X and Y");
         self.line("M84 ; motors off");
+    }
+}
+
+/// The points a post places the part by: the print points, or every point of a path without
+/// any (travel only).
+pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
+    let prints: Vec<&PathPoint> = path
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .collect();
+    if prints.is_empty() {
+        path.points.iter().collect()
+    } else {
+        prints
     }
 }
