@@ -290,15 +290,7 @@ fn read_src(file: &str, stem: &str, text: &str) -> Result<Module, KrlError> {
             _ => return Err(err(file, line, format!("`{stmt}` after END"))),
         }
     }
-    if state == 0 {
-        return Err(err(file, 0, "no DEF"));
-    }
-    if state == 1 {
-        return Err(err(file, 0, "DEF without END"));
-    }
-    if depth != 0 {
-        return Err(err(file, 0, format!("{depth} ;FOLD without ;ENDFOLD")));
-    }
+    ended(file, state, depth, "DEF", "END")?;
     Ok(module)
 }
 
@@ -343,16 +335,19 @@ fn read_dat(file: &str, stem: &str, text: &str) -> Result<BTreeMap<String, [f64;
             _ => return Err(err(file, line, format!("`{stmt}` after ENDDAT"))),
         }
     }
-    if state == 0 {
-        return Err(err(file, 0, "no DEFDAT"));
-    }
-    if state == 1 {
-        return Err(err(file, 0, "DEFDAT without ENDDAT"));
-    }
-    if depth != 0 {
-        return Err(err(file, 0, format!("{depth} ;FOLD without ;ENDFOLD")));
-    }
+    ended(file, state, depth, "DEFDAT", "ENDDAT")?;
     Ok(axes)
+}
+
+/// The end-of-file check of a module read by states 0 (before `open`), 1 (inside), 2 (after
+/// `close`): it must have opened and closed, with every fold closed.
+fn ended(file: &str, state: u8, depth: usize, open: &str, close: &str) -> Result<(), KrlError> {
+    match state {
+        0 => Err(err(file, 0, format!("no {open}"))),
+        1 => Err(err(file, 0, format!("{open} without {close}"))),
+        _ if depth != 0 => Err(err(file, 0, format!("{depth} ;FOLD without ;ENDFOLD"))),
+        _ => Ok(()),
+    }
 }
 
 /// `X1.5 Y-2 Z3` → `[1.5, -2, 3]`.
