@@ -1130,6 +1130,25 @@ impl Motion {
         }
     }
 
+    /// Travel speed, extruder off, and back off `from` along the tool axis by the clearance;
+    /// returns where it backed off to.
+    fn retreat(&mut self, from: &Pose, point: usize, travel_v: f64) -> [f64; 3] {
+        self.vel(travel_v);
+        if self.on {
+            self.extruder(false);
+        }
+        let retreat = add(from.t, scale(col(&from.r, 2), -self.clearance));
+        self.motion(
+            false,
+            Pose {
+                r: from.r,
+                t: retreat,
+            },
+            point,
+        );
+        retreat
+    }
+
     /// Travel from `cur` (or from home) to the path start `to` (point `point`).
     fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64) {
         let c = self.clearance;
@@ -1147,19 +1166,7 @@ impl Motion {
             self.motion(false, to, point);
             return;
         };
-        self.vel(travel_v);
-        if self.on {
-            self.extruder(false);
-        }
-        let retreat = add(from.t, scale(col(&from.r, 2), -c));
-        self.motion(
-            false,
-            Pose {
-                r: from.r,
-                t: retreat,
-            },
-            point,
-        );
+        let retreat = self.retreat(&from, point, travel_v);
         let h = (self.height.max_along(retreat, approach) + c)
             .max(retreat[2])
             .max(approach[2]);
@@ -1194,20 +1201,8 @@ impl Motion {
 
     /// The end: extruder off, retreat along the tool axis and rise to the safe height.
     fn leave(&mut self, from: &Pose, point: usize, travel_v: f64) {
-        self.vel(travel_v);
-        if self.on {
-            self.extruder(false);
-        }
         let c = self.clearance;
-        let retreat = add(from.t, scale(col(&from.r, 2), -c));
-        self.motion(
-            false,
-            Pose {
-                r: from.r,
-                t: retreat,
-            },
-            point,
-        );
+        let retreat = self.retreat(from, point, travel_v);
         let h = (self.z_top + c).max(retreat[2]);
         self.motion(
             false,
