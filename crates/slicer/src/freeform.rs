@@ -27,10 +27,12 @@
 use crate::fill::{regions_from_loops, Point2, Region};
 use crate::geodesic::{clip_above, LayerMesh};
 use crate::params::{LayerParams, PathMode};
-use crate::planar::{filament_length, Bead, FeatureFigures, PlanError};
+use crate::planar::{
+    feature_mesh, filament_length, slicing_tolerance, Bead, FeatureFigures, PlanError,
+};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{any_perpendicular, P3, V3};
-use brep::mesh::{mesh_faces, Mesh, MeshOptions};
+use brep::mesh::Mesh;
 use brep::section::{section, Plane};
 use brep::surface::Surface;
 use features::{Feature, FeatureKind, FeatureTree};
@@ -476,18 +478,24 @@ fn fold_check(
         }
     }
     if lambda < -1e-9 {
-        let radius = -1.0 / lambda;
-        let mut z = 0.0;
-        for (layer, dl) in params.layer_heights(height).iter().enumerate() {
-            z += dl;
-            if z >= radius {
-                return Err(PlanError::OffsetFolds {
-                    id,
-                    layer: layer + 1,
-                    offset: z,
-                    radius,
-                });
-            }
+        check_folds(id, &params.layer_heights(height), -1.0 / lambda)?;
+    }
+    Ok(())
+}
+
+/// `Err(OffsetFolds)` at the first of the layers (thicknesses `heights`) whose top reaches
+/// `radius`, the radius of a concave valley of the reference (infinite: none).
+fn check_folds(id: usize, heights: &[f64], radius: f64) -> Result<(), PlanError> {
+    let mut z = 0.0;
+    for (layer, dl) in heights.iter().enumerate() {
+        z += dl;
+        if z >= radius {
+            return Err(PlanError::OffsetFolds {
+                id,
+                layer: layer + 1,
+                offset: z,
+                radius,
+            });
         }
     }
     Ok(())
@@ -996,18 +1004,8 @@ pub fn plan_freeform(
     let surf = b.face_surface(rf);
     // N into the feature: the host face's outward normal (the parent's outside).
     let mut sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
-    let mut faces = f.faces.clone();
-    for v in &f.voids {
-        faces.extend(v.iter().copied());
-    }
-    let tol = (params.tolerance * 0.25)
-        .min(0.25 * params.uniform_layer_height)
-        .max(1e-3);
-    let mesh =
-        mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
-            id,
-            msg: e.to_string(),
-        })?;
+    let tol = slicing_tolerance(params);
+    let mesh = feature_mesh(tree, f, tol)?;
     if mesh.positions.is_empty() {
         return Err(err("its mesh is empty".into()));
     }
@@ -1057,20 +1055,14 @@ pub fn plan_freeform(
     let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
+    // Checked before any layer is planned: nothing is laid down for a feature that folds.
+    check_folds(id, &heights, concave_radius)?;
     let fixed = params
         .fixed_tool_axis
         .map(|a| V3::new(a[0], a[1], a[2]).normalize());
     for (layer, &dl) in heights.iter().enumerate() {
         let mid = z + 0.5 * dl;
         z += dl;
-        if z >= concave_radius {
-            return Err(PlanError::OffsetFolds {
-                id,
-                layer: layer + 1,
-                offset: z,
-                radius: concave_radius,
-            });
-        }
         let loops: Vec<Vec<Point2>> = section(&mapped, &up.offset(mid))
             .iter()
             .map(|l| l.iter().map(|p| [p.x, p.y]).collect())

@@ -118,6 +118,30 @@ pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
     Some(Plane::new(p, n))
 }
 
+/// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
+/// chords are what the sections see.
+pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
+    (params.tolerance * 0.25)
+        .min(0.25 * params.uniform_layer_height)
+        .max(1e-3)
+}
+
+/// The mesh of a feature's shell and its voids, at chord tolerance `tol`.
+pub(crate) fn feature_mesh(
+    tree: &FeatureTree,
+    f: &Feature,
+    tol: f64,
+) -> Result<brep::mesh::Mesh, PlanError> {
+    let mut faces = f.faces.clone();
+    for v in &f.voids {
+        faces.extend(v.iter().copied());
+    }
+    mesh_faces(&tree.brep, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
+        id: f.id,
+        msg: e.to_string(),
+    })
+}
+
 /// Plans one two5d feature, appending its points to `out` (travel from `cursor`, which is left at
 /// the last point).
 pub fn plan_two5d(
@@ -135,20 +159,7 @@ pub fn plan_two5d(
         .validate()
         .map_err(|msg| PlanError::Params { id: f.id, msg })?;
     let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
-    let b = &tree.brep;
-    let mut faces = f.faces.clone();
-    for v in &f.voids {
-        faces.extend(v.iter().copied());
-    }
-    // A mesh much finer than a layer: its chords are what the sections see.
-    let tol = (params.tolerance * 0.25)
-        .min(0.25 * params.uniform_layer_height)
-        .max(1e-3);
-    let mesh =
-        mesh_faces(b, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
-            id: f.id,
-            msg: e.to_string(),
-        })?;
+    let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
     let top = mesh
         .positions
         .iter()
