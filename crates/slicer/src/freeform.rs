@@ -744,6 +744,162 @@ fn fill_region(
     out
 }
 
+/// A corner spur is laid only at a convex corner of the layer region sharper than this
+/// (radians, measured on the layer surface).
+const SPUR_MAX_ANGLE: f64 = 1.75;
+/// Shortest corner spur, mm.
+const SPUR_MIN_LENGTH: f64 = 0.1;
+
+/// Corner spurs: the outermost paths (rings, or lines without rings) run half a bead inside
+/// the boundary, so at a convex corner of angle θ their beads stop `(w/2)(1/sin(θ/2) − 1)`
+/// short of it along the bisector, and the tip of the wedge stays empty: at the sharp corners
+/// where curved layers cut a blade's end obliquely, a millimetre and more. Each such corner
+/// gets a short path along its bisector (on the layer surface) from where the outer beads stop
+/// towards the tip, each point as wide as the wedge there (`2ρ·sin(θ/2)` at distance ρ from the
+/// corner, capped by twice the distance to the boundary), down to 0.3 of a bead; the
+/// extrusion follows that width by Eq. 1, so the wedge is filled rather than over-filled.
+fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -> Vec<FillPath> {
+    let mut out = vec![];
+    let rings: Vec<&Vec<Point2>> = std::iter::once(&region.outer)
+        .chain(region.holes.iter())
+        .filter(|r| r.len() >= 3)
+        .collect();
+    let lifted: Option<Vec<Vec<P3>>> = rings
+        .iter()
+        .map(|r| r.iter().map(|q| chart.at(*q, z).map(|x| x.0)).collect())
+        .collect();
+    let Some(lifted) = lifted else { return out };
+    let to_boundary = |p: &P3| -> f64 {
+        let mut best = f64::INFINITY;
+        for ring in &lifted {
+            for i in 0..ring.len() {
+                let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+                let d = b - a;
+                let l2 = d.norm_squared();
+                let t = if l2 > 0.0 {
+                    ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                best = best.min((p - (a + d * t)).norm());
+            }
+        }
+        best
+    };
+    for (ring, lp) in rings.iter().zip(&lifted) {
+        let n = ring.len();
+        // The point `reach` away on the surface along the ring from vertex i, walking `dir`.
+        let side = |i: usize, dir: isize, reach: f64| -> Option<(Point2, P3)> {
+            let pc = lp[i];
+            let mut prev = (ring[i], pc);
+            for k in 1..n {
+                let j = (i as isize + dir * k as isize).rem_euclid(n as isize) as usize;
+                let (q, p) = (ring[j], lp[j]);
+                let d = (p - pc).norm();
+                if d >= reach {
+                    let dp = (prev.1 - pc).norm();
+                    let t = if d > dp {
+                        ((reach - dp) / (d - dp)).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    let qq = [
+                        prev.0[0] + (q[0] - prev.0[0]) * t,
+                        prev.0[1] + (q[1] - prev.0[1]) * t,
+                    ];
+                    return Some((qq, prev.1 + (p - prev.1) * t));
+                }
+                prev = (q, p);
+            }
+            None
+        };
+        // The angle at each vertex between the ring's points half a bead either side, on the
+        // surface; NaN where the ring turns away from the region there.
+        let angle: Vec<f64> = (0..n)
+            .map(|i| {
+                let (Some((qa, pa)), Some((qb, pb))) =
+                    (side(i, -1, 0.5 * width), side(i, 1, 0.5 * width))
+                else {
+                    return f64::NAN;
+                };
+                let (u, v) = (
+                    [ring[i][0] - qa[0], ring[i][1] - qa[1]],
+                    [qb[0] - ring[i][0], qb[1] - ring[i][1]],
+                );
+                if u[0] * v[1] - u[1] * v[0] <= 0.0 {
+                    return f64::NAN;
+                }
+                let (a, b) = ((pa - lp[i]).normalize(), (pb - lp[i]).normalize());
+                a.dot(&b).clamp(-1.0, 1.0).acos()
+            })
+            .collect();
+        for i in 0..n {
+            let theta = angle[i];
+            if !(theta > 1e-3 && theta < SPUR_MAX_ANGLE) {
+                continue;
+            }
+            // One spur a corner: the sharpest vertex within half a bead along the ring.
+            let sharpest = [-1isize, 1].iter().all(|&dir| {
+                (1..n)
+                    .map_while(|k| {
+                        let j = (i as isize + dir * k as isize).rem_euclid(n as isize) as usize;
+                        ((lp[j] - lp[i]).norm() < 0.5 * width).then_some(j)
+                    })
+                    .all(|j| !(angle[j] < theta || (angle[j] == theta && j < i)))
+            });
+            if !sharpest {
+                continue;
+            }
+            let (Some((q1, p1)), Some((q2, p2))) = (side(i, -1, width), side(i, 1, width)) else {
+                continue;
+            };
+            let (qc, pc) = (ring[i], lp[i]);
+            let (l1, l2) = ((p1 - pc).norm(), (p2 - pc).norm());
+            if l1 < 1e-9 || l2 < 1e-9 {
+                continue;
+            }
+            // The bisector in the chart: the chart is linear over the corner's neighbourhood,
+            // so the chart steps to the unit surface steps along both sides add up to a step
+            // of length 2·cos(θ/2) along the bisector on the surface.
+            let b = [
+                (q1[0] - qc[0]) / l1 + (q2[0] - qc[0]) / l2,
+                (q1[1] - qc[1]) / l1 + (q2[1] - qc[1]) / l2,
+            ];
+            let (sn, cs) = ((0.5 * theta).sin(), (0.5 * theta).cos());
+            let rho_s = 0.5 * width * (1.0 / sn - 1.0);
+            // The tip ends where the wedge is 0.3 bead wide: its middle stays 0.15 bead off
+            // the sides, clear of the region's sampling error.
+            let rho_e = 0.15 * width / sn;
+            if rho_s - rho_e < SPUR_MIN_LENGTH {
+                continue;
+            }
+            let steps = ((rho_s - rho_e) / (0.25 * width)).ceil().clamp(1.0, 1e3) as usize;
+            let mut spur = FillPath::default();
+            for k in 0..=steps {
+                let rho = rho_e + (rho_s - rho_e) * k as f64 / steps as f64;
+                let f = rho / (2.0 * cs);
+                let q = [qc[0] + b[0] * f, qc[1] + b[1] * f];
+                if !crate::geodesic::region_contains(region, q) {
+                    break;
+                }
+                let Some((p, _)) = chart.at(q, z) else { break };
+                let db = to_boundary(&p);
+                // Another side of the region comes nearer than the wedge's: stop.
+                if db < 0.8 * rho * sn {
+                    break;
+                }
+                spur.points.push(q);
+                spur.widths.push((2.0 * db.min(rho * sn)).min(width));
+            }
+            if spur.points.len() >= 2 {
+                spur.reverse();
+                out.push(spur);
+            }
+        }
+    }
+    out
+}
+
 /// The infill boundary's rings, to run zig-zag connectors along.
 struct Border<'a> {
     rings: &'a [crate::geodesic::IsoLine],
@@ -1075,8 +1231,10 @@ pub fn plan_freeform(
         let mut paths = vec![];
         let below = std::mem::replace(&mut prev_regions, regions.clone());
         for r in &regions {
-            let got = fill_region(&chart, r, z, params, layer, bead.width, spacing);
-            paths.extend(got);
+            paths.extend(fill_region(
+                &chart, r, z, params, layer, bead.width, spacing,
+            ));
+            paths.extend(corner_spurs(&chart, r, z, bead.width));
         }
         let start = cursor
             .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -1317,5 +1475,119 @@ mod tests {
                 "rings {gap} mm apart on the surface"
             );
         }
+    }
+
+    /// The path points of `paths` lifted onto the layer at `z`.
+    fn lifted(chart: &Chart, paths: &[FillPath], z: f64) -> Vec<P3> {
+        paths
+            .iter()
+            .flat_map(|p| p.points.iter())
+            .map(|q| chart.at(*q, z).expect("on the layer").0)
+            .collect()
+    }
+
+    #[test]
+    fn ring_corners_keep_their_offset_on_a_stretched_chart() {
+        // The cylinder layer of the test above: one chart unit across the axis is 3 mm on
+        // the layer, so the rectangle's right-angled corners look sharp in the chart and the
+        // lattice triangles there are long. The outer ring's corner must still be the inward
+        // offset's: (w/2)·√2 = 0.318 mm from each corner of the region, not cut off by a chord.
+        let surf = Surface::Cylinder {
+            frame: Frame::world(P3::origin()),
+            radius: 4.0,
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 4.0,
+                sv: 1.0,
+            },
+        };
+        let outer = vec![[-0.5, -3.0], [0.5, -3.0], [0.5, 3.0], [-0.5, 3.0]];
+        let region = Region {
+            outer: outer.clone(),
+            holes: vec![],
+        };
+        let params = LayerParams {
+            path_mode: PathMode::ContourZigzag,
+            ..LayerParams::default()
+        };
+        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let pts = lifted(&chart, &paths, 8.0);
+        for c in &outer {
+            let pc = chart.at(*c, 8.0).expect("corner").0;
+            let nearest = pts
+                .iter()
+                .map(|p| (p - pc).norm())
+                .fold(f64::INFINITY, f64::min);
+            let ideal = 0.225 * std::f64::consts::SQRT_2;
+            assert!(
+                (nearest - ideal).abs() < 0.03,
+                "corner {c:?}: nearest path point {nearest:.3} mm away, the offset's is {ideal:.3}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_sharp_wedge_gets_a_spur_into_its_tip() {
+        // A 30° wedge on a plane: rings stop (w/2)/sin 15° = 0.87 mm short of the tip; the
+        // spur runs on along the bisector, as wide as the wedge, to where it is 0.3 bead wide.
+        let surf = Surface::Plane {
+            frame: Frame::world(P3::origin()),
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 1.0,
+                sv: 1.0,
+            },
+        };
+        let half = 15f64.to_radians();
+        let (l, w) = (10.0, 0.45);
+        let outer = vec![
+            [0.0, 0.0],
+            [l * half.cos(), -l * half.sin()],
+            [l * half.cos(), l * half.sin()],
+        ];
+        let region = Region {
+            outer: outer.clone(),
+            holes: vec![],
+        };
+        let spurs = corner_spurs(&chart, &region, 0.2, w);
+        // The tip; the two base corners are 75°, too blunt for a spur.
+        assert_eq!(spurs.len(), 1, "{spurs:?}");
+        let spur = &spurs[0];
+        let to_side = |q: &Point2| q[1].abs().mul_add(-half.cos(), q[0] * half.sin()).abs();
+        for (q, bw) in spur.points.iter().zip(&spur.widths) {
+            assert!(q[1].abs() < 1e-9, "off the bisector: {q:?}");
+            assert!(
+                (bw - 2.0 * to_side(q)).abs() < 1e-6 && *bw <= w,
+                "width {bw} at {q:?}, the wedge is {}",
+                2.0 * to_side(q)
+            );
+        }
+        let tip = spur.points.last().expect("spur")[0];
+        let start = spur.points[0][0];
+        assert!((tip - 0.15 * w / half.sin()).abs() < 0.02, "tip {tip}");
+        let rho_s = 0.5 * w * (1.0 / half.sin() - 1.0);
+        assert!((start - rho_s).abs() < 0.02, "start {start}");
+        // With the rings, the nearest path point to the tip moves from 0.87 mm to the spur's.
+        let params = LayerParams::default();
+        let rings = fill_region(&chart, &region, 0.2, &params, 0, w, w);
+        let nearest = |paths: &[FillPath]| {
+            paths
+                .iter()
+                .flat_map(|p| p.points.iter())
+                .map(|q| q[0].hypot(q[1]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        assert!(nearest(&rings) > 0.8, "rings reach {}", nearest(&rings));
+        assert!(nearest(&spurs) < 0.3, "spur reaches {}", nearest(&spurs));
     }
 }

@@ -66,13 +66,15 @@ pub fn region_contains(region: &Region, q: Point2) -> bool {
     inside
 }
 
-/// Resamples a closed ring so no segment is longer than `step`.
-fn resample(ring: &[Point2], step: f64) -> Vec<Point2> {
+/// Resamples a closed ring so no segment is longer than `step`, or `fine` where `near` holds
+/// at either end of the segment.
+fn resample(ring: &[Point2], step: f64, fine: f64, near: &dyn Fn(Point2) -> bool) -> Vec<Point2> {
     let n = ring.len();
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
         let (a, b) = (ring[i], ring[(i + 1) % n]);
-        let k = (dist2(a, b).sqrt() / step).ceil().clamp(1.0, 1e4) as usize;
+        let s = if near(a) || near(b) { fine } else { step };
+        let k = (dist2(a, b).sqrt() / s).ceil().clamp(1.0, 1e4) as usize;
         for j in 0..k {
             let t = j as f64 / k as f64;
             out.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
@@ -80,6 +82,33 @@ fn resample(ring: &[Point2], step: f64) -> Vec<Point2> {
     }
     out
 }
+
+/// The points where a ring turns towards the region (left: outer rings run counter-clockwise,
+/// holes clockwise) by more than `min_turn` radians: the convex corners, around which the
+/// iso-lines of the distance to the boundary are circular arcs.
+fn convex_corners(ring: &[Point2], min_turn: f64) -> Vec<Point2> {
+    let n = ring.len();
+    let mut out = vec![];
+    if n < 3 {
+        return out;
+    }
+    for i in 0..n {
+        let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+        let u = [b[0] - a[0], b[1] - a[1]];
+        let v = [c[0] - b[0], c[1] - b[1]];
+        let cross = u[0] * v[1] - u[1] * v[0];
+        let dot = u[0] * v[0] + u[1] * v[1];
+        if cross > 0.0 && cross.atan2(dot) > min_turn {
+            out.push(b);
+        }
+    }
+    out
+}
+
+/// A ring vertex turning by more than this (radians) towards the region is a convex corner.
+const CORNER_TURN: f64 = 0.4;
+/// Around a convex corner the lattice is refined within this many lattice steps.
+const CORNER_REACH: f64 = 4.0;
 
 /// Min-heap entry for marching.
 #[derive(PartialEq)]
@@ -136,10 +165,20 @@ impl LayerMesh {
         if !(step.is_finite() && step > 0.0) {
             return m;
         }
+        // Convex corners get a lattice a third as fine within `CORNER_REACH` steps, so the
+        // iso-lines' arcs round them (linear interpolation over a coarse triangle spanning a
+        // corner would cut it off by a chord).
+        let corners: Vec<Point2> = std::iter::once(&region.outer)
+            .chain(region.holes.iter())
+            .flat_map(|r| convex_corners(r, CORNER_TURN))
+            .collect();
+        let reach2 = (CORNER_REACH * step).powi(2);
+        let near_corner = |q: Point2| corners.iter().any(|c| dist2(*c, q) <= reach2);
+        let fine = step / 3.0;
         let rings: Vec<Vec<Point2>> = std::iter::once(&region.outer)
             .chain(region.holes.iter())
             .filter(|r| r.len() >= 3)
-            .map(|r| resample(r, step))
+            .map(|r| resample(r, step, fine, &near_corner))
             .collect();
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for q in rings.iter().flatten() {
@@ -166,13 +205,12 @@ impl LayerMesh {
         for q in rings.iter().flatten() {
             grid.entry(cell(*q)).or_default().push(*q);
         }
-        let near_boundary = |q: Point2| {
+        let near_boundary = |q: Point2, s: f64| {
             let (i, j) = cell(q);
             (i - 1..=i + 1).any(|a| {
                 (j - 1..=j + 1).any(|b| {
-                    grid.get(&(a, b)).is_some_and(|v| {
-                        v.iter().any(|p| dist2(*p, q) < (0.6 * step) * (0.6 * step))
-                    })
+                    grid.get(&(a, b))
+                        .is_some_and(|v| v.iter().any(|p| dist2(*p, q) < (0.6 * s) * (0.6 * s)))
                 })
             })
         };
@@ -213,8 +251,31 @@ impl LayerMesh {
             let shift = if r % 2 == 1 { 0.5 * step } else { 0.0 };
             for c in 0..=cols {
                 let q = [lo[0] + shift + c as f64 * step, y];
-                if region_contains(region, q) && !near_boundary(q) {
+                if region_contains(region, q) && !near_boundary(q, step) {
                     add(&mut cdt, &mut m, q, false);
+                }
+            }
+        }
+        // The fine lattice around each convex corner: the coarse one's rows and columns split
+        // in three (so the coarse points are among its points), within reach of the corner.
+        let fdy = dy / 3.0;
+        let span = CORNER_REACH * step;
+        for c in &corners {
+            let r0 = ((c[1] - span - lo[1]) / fdy).floor().max(0.0) as usize;
+            let r1 = ((c[1] + span - lo[1]) / fdy).ceil().max(0.0) as usize;
+            for r in r0..=r1 {
+                let y = lo[1] + r as f64 * fdy;
+                let shift = if r % 2 == 1 { 0.5 * fine } else { 0.0 };
+                let c0 = ((c[0] - span - lo[0] - shift) / fine).floor().max(0.0) as usize;
+                let c1 = ((c[0] + span - lo[0] - shift) / fine).ceil().max(0.0) as usize;
+                for k in c0..=c1 {
+                    let q = [lo[0] + shift + k as f64 * fine, y];
+                    if dist2(*c, q) <= reach2
+                        && region_contains(region, q)
+                        && !near_boundary(q, fine)
+                    {
+                        add(&mut cdt, &mut m, q, false);
+                    }
                 }
             }
         }
@@ -338,9 +399,14 @@ impl LayerMesh {
         let mut d = vec![f64::INFINITY; n];
         let mut known = vec![false; n];
         let mut heap = BinaryHeap::new();
+        // Seeds are exact: the front may not lower them. A triangle with a seed on each side
+        // of a convex corner of the boundary would otherwise give the distance to the chord
+        // across the corner, and the iso-lines would cut the corner off.
+        let mut seeded = vec![false; n];
         for &(v, s) in seeds {
             if (v as usize) < n && s < d[v as usize] {
                 d[v as usize] = s;
+                seeded[v as usize] = true;
                 heap.push(Entry(s, v));
             }
         }
@@ -354,7 +420,7 @@ impl LayerMesh {
                 let tri = self.tris[t as usize];
                 for k in 0..3 {
                     let c = tri[k] as usize;
-                    if known[c] {
+                    if known[c] || seeded[c] {
                         continue;
                     }
                     let (a, b) = (tri[(k + 1) % 3] as usize, tri[(k + 2) % 3] as usize);
