@@ -474,7 +474,9 @@ fn figures(points: &[PathPoint], runs: &[Range<usize>]) -> BTreeMap<usize, (f64,
 /// its [`orientation_step_rate`] figures before and after (after == before when disabled).
 ///
 /// Only axes change: positions, kinds, extrusion, thickness and width stay as they are, and so
-/// do travel points that start no bead and paths of fewer than 3 points. Every smoothed axis is
+/// do travel points that start no bead, paths of fewer than 3 points and paths that smoothing
+/// would make rougher (a larger step or rate than planned), so the figures after never exceed
+/// those before. Every smoothed axis is
 /// unit and within `cone_angle_deg / 2` of its planned axis. Parameters that fail
 /// [`SmoothParams::validate`] leave the path unchanged (the caller validates and reports).
 pub fn smooth(path: &mut ToolPath, params: &SmoothParams) -> BTreeMap<usize, OrientationFigures> {
@@ -482,7 +484,19 @@ pub fn smooth(path: &mut ToolPath, params: &SmoothParams) -> BTreeMap<usize, Ori
     let before = figures(&path.points, &runs);
     let after = if params.enabled && params.validate().is_ok() {
         for r in &runs {
-            smooth_run(&mut path.points[r.clone()], params);
+            let run = &mut path.points[r.clone()];
+            let (step_b, rate_b) = orientation_step_rate(run);
+            let planned: Vec<[f64; 3]> = run.iter().map(|q| q.axis).collect();
+            smooth_run(run, params);
+            // A low-pass filter cut off at a path's ends can still turn its first or last
+            // step a little more than planned (uneven spacing there): a path that smoothing
+            // would make rougher keeps its planned axes.
+            let (step_a, rate_a) = orientation_step_rate(run);
+            if step_a > step_b + 1e-9 || rate_a > rate_b + 1e-9 {
+                for (q, a) in run.iter_mut().zip(planned) {
+                    q.axis = a;
+                }
+            }
         }
         figures(&path.points, &runs)
     } else {
