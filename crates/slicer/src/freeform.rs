@@ -156,6 +156,33 @@ impl<'a> Chart<'a> {
         }
     }
 
+    /// The first fundamental form of the offset surface at `d` in the chart, at the centre of
+    /// `region`'s box: `[[p_s·p_s, p_s·p_t], [p_s·p_t, p_t·p_t]]` by central differences.
+    /// The identity where the chart cannot be evaluated there.
+    fn metric(&self, region: &Region, d: f64) -> [[f64; 2]; 2] {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for q in &region.outer {
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        let e = 1e-3;
+        let diff = |k: usize| -> Option<V3> {
+            let (mut a, mut b) = (c, c);
+            a[k] -= e;
+            b[k] += e;
+            Some((self.at(b, d)?.0 - self.at(a, d)?.0) / (2.0 * e))
+        };
+        match (diff(0), diff(1)) {
+            (Some(ps), Some(pt)) if c[0].is_finite() && c[1].is_finite() => {
+                [[ps.dot(&ps), ps.dot(&pt)], [ps.dot(&pt), pt.dot(&pt)]]
+            }
+            _ => [[1.0, 0.0], [0.0, 1.0]],
+        }
+    }
+
     /// The point at chart `q` and distance `d` from the reference, and the unit normal there
     /// (the offset surface's normal is the reference's).
     pub fn at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
@@ -548,7 +575,7 @@ fn fill_region(
     spacing: f64,
 ) -> Vec<FillPath> {
     let mut out = vec![];
-    let mut lm = LayerMesh::build(region, spacing / 3.0);
+    let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
     if lm.tris.is_empty() {
         return out;
     }
@@ -560,7 +587,10 @@ fn fill_region(
         }
     }
     lm.p = pts;
-    let db = lm.march(&lm.boundary_seeds(spacing));
+    // Exact distances (to the lifted boundary) three spacings deep: the rings of the default
+    // contour-zig-zag, the infill's edge and a thin blade's ridge all lie there, so they do
+    // not depend on how well the front is marched over the lattice.
+    let db = lm.march(&lm.boundary_seeds(SEED_DEPTH * spacing));
     let (deep, dmax) = db.iter().enumerate().filter(|(_, d)| d.is_finite()).fold(
         (0usize, 0.0f64),
         |a, (i, &d)| if d > a.1 { (i, d) } else { a },
@@ -592,44 +622,36 @@ fn fill_region(
     let inner = match last_ring {
         Some(c) if dmax > c + 1.5 * spacing => c + spacing,
         Some(c) => {
-            // Gap fill: the strip along the ridge that the last ring's bead leaves gets one
-            // more ring just inside its edge, each side as wide as the strip's local half
-            // width β (the ridge's local height above the edge), extruded for that width by
-            // Eq. 1, so the two sides together fill the strip.
+            // The strip along the ridge that the last ring's bead leaves.
             let edge = c + 0.5 * width;
-            if dmax > edge + 0.05 * width {
-                let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
-                let ridge = lm.local_max(&db, 1.5 * spacing, &mask);
-                for line in lm.iso_lines(&db, edge + 0.02 * width, &ridge) {
-                    let widths: Vec<f64> = line
-                        .other
-                        .iter()
-                        .map(|r| (r - edge).clamp(0.0, width))
-                        .collect();
-                    // Drop the stretches where the strip pinches out.
-                    let mut cur = FillPath::default();
-                    for (q, w) in line.q.iter().zip(&widths) {
-                        if *w >= 0.1 * width {
-                            cur.points.push(*q);
-                            cur.widths.push(*w);
-                        } else if cur.points.len() >= 2 {
-                            out.push(std::mem::take(&mut cur));
-                        } else {
-                            cur = FillPath::default();
-                        }
-                    }
-                    if cur.points.len() >= 2 {
-                        out.push(cur);
-                    }
-                }
-            }
+            out.extend(gap_fill(
+                &lm,
+                &db,
+                edge,
+                0.02 * width,
+                0.1 * width,
+                width,
+                spacing,
+            ));
+            return out;
+        }
+        // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
+        // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
+        // inside it, down to a fifth of a bead wide.
+        None if rings > 0 || dmax <= 0.5 * width => {
+            out.extend(gap_fill(
+                &lm,
+                &db,
+                0.0,
+                0.1 * width,
+                0.2 * width,
+                width,
+                spacing,
+            ));
             return out;
         }
         None => 0.5 * width,
     };
-    if dmax <= inner {
-        return out;
-    }
     let zig = params.path_mode != PathMode::Raster;
     let angle = if zig && layer % 2 == 1 {
         params.raster_angle_deg + 90.0
@@ -743,6 +765,55 @@ fn fill_region(
     }
     out
 }
+
+/// Gap fill: the strip of a region farther than `edge` from its boundary (`db`, the distance
+/// to the boundary) but too narrow for a bead: its local half width β is the ridge height of
+/// `db` above `edge` (seen from the strip's flanks). The fill is one loop round the ridge,
+/// `inset` inside the strip's edge (an iso-line of `db`), each point β wide and extruded for
+/// that width by Eq. 1: the two flanks together put down the strip's volume. Stretches
+/// narrower than `min_width` are dropped where the strip pinches out.
+fn gap_fill(
+    lm: &LayerMesh,
+    db: &[f64],
+    edge: f64,
+    inset: f64,
+    min_width: f64,
+    width: f64,
+    spacing: f64,
+) -> Vec<FillPath> {
+    let mut out = vec![];
+    let dmax = db
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .fold(0.0f64, f64::max);
+    if dmax <= edge + inset.max(0.05 * width) {
+        return out;
+    }
+    let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
+    let ridge = lm.local_max(db, 1.5 * spacing, &mask);
+    for line in lm.iso_lines(db, edge + inset, &ridge) {
+        let mut cur = FillPath::default();
+        for (q, r) in line.q.iter().zip(&line.other) {
+            let w = (r - edge).clamp(0.0, width);
+            if w >= min_width {
+                cur.points.push(*q);
+                cur.widths.push(w);
+            } else if cur.points.len() >= 2 {
+                out.push(std::mem::take(&mut cur));
+            } else {
+                cur = FillPath::default();
+            }
+        }
+        if cur.points.len() >= 2 {
+            out.push(cur);
+        }
+    }
+    out
+}
+
+/// Distances to a layer region's boundary are exact (not marched) this many spacings deep.
+const SEED_DEPTH: f64 = 3.0;
 
 /// A corner spur is laid only at a convex corner of the layer region sharper than this
 /// (radians, measured on the layer surface).
@@ -1589,5 +1660,77 @@ mod tests {
         };
         assert!(nearest(&rings) > 0.8, "rings reach {}", nearest(&rings));
         assert!(nearest(&spurs) < 0.3, "spur reaches {}", nearest(&spurs));
+    }
+
+    #[test]
+    fn rings_on_a_pitched_strip_of_a_stretched_layer_are_a_spacing_apart() {
+        // The cylinder layer of radius 12 again (3 mm on the layer per chart unit across the
+        // axis), now with a strip pitched 35° to the axis, 6 mm wide on the layer. Over a
+        // lattice laid in the chart the triangles would be long and obtuse on the layer, the
+        // marched distance too large, and the inner rings too near the boundary.
+        let surf = Surface::Cylinder {
+            frame: Frame::world(P3::origin()),
+            radius: 4.0,
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 4.0,
+                sv: 1.0,
+            },
+        };
+        // Unrolled layer coordinates (arc length across the axis, height) to the chart.
+        let pitch = 35f64.to_radians();
+        let (dir, nrm) = ([pitch.cos(), pitch.sin()], [-pitch.sin(), pitch.cos()]);
+        let corner = |l: f64, w: f64| -> Point2 {
+            let a = dir[0] * l + nrm[0] * w;
+            let z = dir[1] * l + nrm[1] * w;
+            [a / 3.0, z]
+        };
+        let region = Region {
+            outer: vec![
+                corner(-8.0, -3.0),
+                corner(8.0, -3.0),
+                corner(8.0, 3.0),
+                corner(-8.0, 3.0),
+            ],
+            holes: vec![],
+        };
+        let params = LayerParams {
+            path_mode: PathMode::Contour,
+            ..LayerParams::default()
+        };
+        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        // Each path point's distance (on the unrolled layer) to the strip's near long side,
+        // away from the strip's ends.
+        let mut by_ring: Vec<Vec<f64>> = vec![];
+        for p in paths.iter().filter(|p| p.points.len() > 2) {
+            let d: Vec<f64> = p
+                .points
+                .iter()
+                .map(|q| chart.at(*q, 8.0).expect("on the layer").0)
+                .map(|x| [x.y.atan2(x.x) * 12.0, x.z])
+                .filter(|u| (u[0] * dir[0] + u[1] * dir[1]).abs() < 3.0)
+                .map(|u| 3.0 - (u[0] * nrm[0] + u[1] * nrm[1]).abs())
+                .collect();
+            if !d.is_empty() {
+                by_ring.push(d);
+            }
+        }
+        by_ring.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        assert!(by_ring.len() >= 6, "{} rings", by_ring.len());
+        // Rings 3 to 5 lie deeper than the exact seeds: their distance is marched.
+        for (j, d) in by_ring.iter().take(6).enumerate() {
+            let want = 0.225 + 0.45 * j as f64;
+            for x in d {
+                assert!(
+                    (x - want).abs() < 0.02,
+                    "ring {j}: {x:.3} mm from the side, want {want:.3}"
+                );
+            }
+        }
     }
 }

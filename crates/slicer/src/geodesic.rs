@@ -31,6 +31,9 @@ pub struct LayerMesh {
     pub rings: Vec<Vec<u32>>,
     /// Triangles around each vertex.
     around: Vec<Vec<u32>>,
+    /// The upper-triangular map `(m00, m01, m11)` from chart to the surface-isotropic frame
+    /// of [`LayerMesh::build_with_metric`]; `None`: the chart itself.
+    frame: Option<[f64; 3]>,
 }
 
 /// One iso-line: chart points, and the value of a second field at each.
@@ -311,12 +314,56 @@ impl LayerMesh {
         m
     }
 
+    /// [`LayerMesh::build`] in the frame `y = M·q` of the chart metric at the region: `M` is
+    /// upper triangular with `|M·dq|² = dqᵀ·G·dq`, G the first fundamental form of the layer
+    /// surface in the chart (`g[0][0] = |p_s|²`, `g[0][1] = p_s·p_t`, `g[1][1] = |p_t|²`). The
+    /// lattice is then equilateral on the surface, not in the chart, so `step` is in mm and
+    /// the triangles stay acute where the chart stretches the layer (an offset far from a
+    /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
+    /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
+    /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
+    pub fn build_with_metric(region: &Region, step: f64, g: [[f64; 2]; 2]) -> LayerMesh {
+        let a = g[0][0];
+        let m = if a > 1e-12 {
+            let (m00, m01) = (a.sqrt(), g[0][1] / a.sqrt());
+            let c = g[1][1] - m01 * m01;
+            (c > 1e-12 * g[1][1].max(1e-12)).then(|| [m00, m01, c.sqrt()])
+        } else {
+            None
+        };
+        let Some([m00, m01, m11]) = m else {
+            return LayerMesh::build(region, step);
+        };
+        let fwd = |q: &Point2| [m00 * q[0] + m01 * q[1], m11 * q[1]];
+        let ry = Region {
+            outer: region.outer.iter().map(fwd).collect(),
+            holes: region
+                .holes
+                .iter()
+                .map(|h| h.iter().map(fwd).collect())
+                .collect(),
+        };
+        let mut mesh = LayerMesh::build(&ry, step);
+        for q in &mut mesh.q {
+            let t = q[1] / m11;
+            *q = [(q[0] - m01 * t) / m00, t];
+        }
+        mesh.frame = Some([m00, m01, m11]);
+        mesh
+    }
+
     /// Exact 3-D distances to the boundary (the lifted ring polylines) of every vertex within
     /// `reach` (chart units) of it, as seeds for [`LayerMesh::march`]: a front started from
     /// exact values a few triangles deep is far more accurate than one started at the ring.
     pub fn boundary_seeds(&self, reach: f64) -> Vec<(u32, f64)> {
-        let cell = reach.max(1e-9);
-        let key = |q: Point2| ((q[0] / cell).floor() as i64, (q[1] / cell).floor() as i64);
+        // A grid of half-reach cells in the surface-isotropic frame (about mm): the boundary
+        // segments within `reach` of a vertex lie in the 5 × 5 cells around it.
+        let cell = (0.5 * reach).max(1e-9);
+        let frame = self.frame.unwrap_or([1.0, 0.0, 1.0]);
+        let key = |q: Point2| {
+            let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
+            ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
+        };
         let mut grid: HashMap<(i64, i64), Vec<(u32, u32)>> = HashMap::new();
         for ring in &self.rings {
             let n = ring.len();
@@ -363,14 +410,17 @@ impl LayerMesh {
     /// of a ridge of `f` seen from its flanks.
     pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
         let mut out = f.to_vec();
-        let mut seen: HashMap<u32, ()> = HashMap::new();
+        // `seen[x] == v + 1`: x was reached from v (no clearing between vertices).
+        let mut seen = vec![0u32; self.q.len()];
+        let mut stack = vec![];
         for v in 0..self.q.len() {
             if !mask[v] {
                 continue;
             }
-            seen.clear();
-            let mut stack = vec![v as u32];
-            seen.insert(v as u32, ());
+            let stamp = v as u32 + 1;
+            stack.clear();
+            stack.push(v as u32);
+            seen[v] = stamp;
             let mut best = f[v];
             while let Some(u) = stack.pop() {
                 if f[u as usize].is_finite() {
@@ -378,10 +428,10 @@ impl LayerMesh {
                 }
                 for &t in &self.around[u as usize] {
                     for &x in &self.tris[t as usize] {
-                        if !seen.contains_key(&x)
+                        if seen[x as usize] != stamp
                             && (self.p[x as usize] - self.p[v]).norm() <= radius
                         {
-                            seen.insert(x, ());
+                            seen[x as usize] = stamp;
                             stack.push(x);
                         }
                     }
