@@ -18,11 +18,16 @@
 //! - **Spatial slicing.** The feature's exact-surface mesh is mapped into `(s, t, d)`; its
 //!   section by the plane `d = z_k − h_k/2` (the middle of layer k) gives the layer's region
 //!   in the chart, boundaries sampled within the mesh tolerance.
-//! - **Paths.** [`crate::geodesic`] triangulates each region, lifts it onto `S_k`, and fills it
-//!   by the feature's `path_mode` with iso-lines of geodesic distances (spacing measured on the
-//!   surface). Each path is lifted onto `S_k` with points inserted until every chord is within
-//!   the feature's `tolerance` of the surface; the tool axis is N (or `fixed_tool_axis`);
-//!   extrusion follows Isa & Lazoglu 2019, Eq. 1 with the layer's thickness.
+//! - **Paths.** [`crate::geodesic`] triangulates each region with a lattice equilateral on
+//!   `S_k` (the chart's metric there), lifts it onto `S_k`, and fills it by the feature's
+//!   `path_mode` with iso-lines of geodesic distances (spacing measured on the surface):
+//!   rings are iso-lines of the distance to the boundary (exact three spacings deep), lines
+//!   iso-lines of the signed distance to a seed curve. Strips too narrow for a bead (between
+//!   the rings, or a whole sliver of a layer) get a variable-width gap fill, and sharp convex
+//!   corners a spur into the tip (`corner_spurs`). Each path is lifted onto `S_k` with points
+//!   inserted until every chord is within the feature's `tolerance` of the surface; the tool
+//!   axis is N (or `fixed_tool_axis`); extrusion follows Isa & Lazoglu 2019, Eq. 1 with the
+//!   layer's thickness and each point's bead width.
 
 use crate::fill::{regions_from_loops, Point2, Region};
 use crate::geodesic::{clip_above, LayerMesh};

@@ -5,7 +5,11 @@
 //! region, given in a 2-D chart of its surface, is triangulated ([`LayerMesh::build`]); each
 //! vertex is then placed on the layer surface in 3-D, and distances are marched over the
 //! triangles in 3-D ([`LayerMesh::march`], the fast marching method of Kimmel & Sethian 1998
-//! with the planar-wavefront triangle update). Paths are the iso-lines of such distance fields
+//! with the planar-wavefront triangle update). That update is only right on acute triangles,
+//! so the lattice is laid equilateral on the surface, not in the chart
+//! ([`LayerMesh::build_with_metric`]), and refined around convex corners of the boundary;
+//! near the boundary the distances are exact seeds ([`LayerMesh::boundary_seeds`]) that the
+//! front never lowers. Paths are the iso-lines of such distance fields
 //! ([`LayerMesh::iso_lines`]): contour rings are iso-lines of the distance to the region's
 //! boundary; raster and zig-zag lines are iso-lines of the signed distance to a seed curve, so
 //! neighbouring lines are one spacing apart measured on the surface, not in the chart.
