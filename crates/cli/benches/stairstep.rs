@@ -852,6 +852,17 @@ fn print_table(rows: &[Row]) {
         "stair-step in mm; ratio = ours max / PrusaSlicer max (goal <= 0.10); feature volumes are \
          ours only (PrusaSlicer's planar paths do not split by feature)"
     );
+    // Where a layer cuts a convex edge of the part, its region has a corner of some angle θ;
+    // a bead that stays inside the part has its middle at least w/2 from both sides, so at
+    // least (w/2)/sin(θ/2) from the corner: the measure there is at least
+    // (w/2)(1/sin(θ/2) − 1), whatever the plan.
+    let floor = |deg: f64| 0.5 * W * (1.0 / (0.5 * deg.to_radians()).sin() - 1.0);
+    println!(
+        "floor of this measure where a layer cuts a convex edge, for any plan whose beads stay \
+         inside the part: {:.3} mm at a 90 deg corner of the layer, {:.3} mm at 60 deg",
+        floor(90.0),
+        floor(60.0)
+    );
 }
 
 fn print_envelope_table(rows: &[Row]) {
