@@ -41,6 +41,7 @@ use brep::mesh::Mesh;
 use brep::section::{section, Plane};
 use brep::surface::Surface;
 use features::{Feature, FeatureKind, FeatureTree};
+use rayon::prelude::*;
 
 /// Longest edge of the feature mesh mapped into `(s, t, d)`, mm: over 1 mm the distance to a
 /// reference of curvature 1/R strays from linear by at most 1/(8R) mm (3 µm for R = 40 mm).
@@ -1292,26 +1293,40 @@ pub fn plan_freeform(
     let fixed = params
         .fixed_tool_axis
         .map(|a| V3::new(a[0], a[1], a[2]).normalize());
-    for (layer, &dl) in heights.iter().enumerate() {
-        let mid = z + 0.5 * dl;
+    // Each layer's regions and fill depend on that layer alone: computed in parallel, then
+    // ordered, lifted and joined by travel one layer after the other.
+    let mut tops = Vec::with_capacity(heights.len());
+    for &dl in &heights {
+        tops.push((z + 0.5 * dl, z + dl));
         z += dl;
-        let loops: Vec<Vec<Point2>> = section(&mapped, &up.offset(mid))
-            .iter()
-            .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
-            .collect();
-        let regions = regions_from_loops(&loops);
-        let spacing = params
-            .spacing_for_layer(bead.width, layer)
-            .max(1e-3)
-            .min(spacing.max(1e-3) * 1e3);
-        let mut paths = vec![];
-        let below = std::mem::replace(&mut prev_regions, regions.clone());
-        for r in &regions {
-            paths.extend(fill_region(
-                &chart, r, z, params, layer, bead.width, spacing,
-            ));
-            paths.extend(corner_spurs(&chart, r, z, bead.width));
-        }
+    }
+    let filled: Vec<(Vec<Region>, Vec<FillPath>)> = tops
+        .par_iter()
+        .enumerate()
+        .map(|(layer, &(mid, z))| {
+            let loops: Vec<Vec<Point2>> = section(&mapped, &up.offset(mid))
+                .iter()
+                .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
+                .collect();
+            let regions = regions_from_loops(&loops);
+            let spacing = params
+                .spacing_for_layer(bead.width, layer)
+                .max(1e-3)
+                .min(spacing.max(1e-3) * 1e3);
+            let mut paths = vec![];
+            for r in &regions {
+                paths.extend(fill_region(
+                    &chart, r, z, params, layer, bead.width, spacing,
+                ));
+                paths.extend(corner_spurs(&chart, r, z, bead.width));
+            }
+            (regions, paths)
+        })
+        .collect();
+    for (layer, ((&dl, &(_, z)), (regions, paths))) in
+        heights.iter().zip(&tops).zip(filled).enumerate()
+    {
+        let below = std::mem::replace(&mut prev_regions, regions);
         let start = cursor
             .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
             .unwrap_or([0.0, 0.0]);
