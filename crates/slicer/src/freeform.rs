@@ -675,14 +675,21 @@ fn fill_region(
             .map(|q| (q[0] - q0[0]) * nrm[0] + (q[1] - q0[1]) * nrm[1])
             .collect();
     // Vertices within a spacing of the seed line start at their distance across it: the
-    // chart offset times the surface's stretch across the line there.
+    // chart offset times the surface's stretch across the line there, i.e. the part of the
+    // surface step along the chart normal that is square to the line's own surface direction
+    // (a sheared chart does not map the chart normal to the surface normal of the line).
     let stretch = {
         let e = 1e-3;
-        match (
-            chart.at([q0[0] + e * nrm[0], q0[1] + e * nrm[1]], z),
-            chart.at([q0[0] - e * nrm[0], q0[1] - e * nrm[1]], z),
-        ) {
-            (Some(a), Some(b)) => (a.0 - b.0).norm() / (2.0 * e),
+        let step = |d: [f64; 2]| -> Option<V3> {
+            let a = chart.at([q0[0] + e * d[0], q0[1] + e * d[1]], z)?.0;
+            let b = chart.at([q0[0] - e * d[0], q0[1] - e * d[1]], z)?.0;
+            Some((a - b) / (2.0 * e))
+        };
+        match (step(dir), step(nrm)) {
+            (Some(t), Some(n)) if t.norm() > 1e-12 => {
+                let t = t / t.norm();
+                (n - t * n.dot(&t)).norm()
+            }
             _ => 1.0,
         }
     };
@@ -1751,6 +1758,63 @@ mod tests {
                     "ring {j}: {x:.3} mm from the side, want {want:.3}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn raster_lines_on_a_stretched_layer_are_a_spacing_apart_on_the_surface() {
+        // Raster lines at 45° in the chart of the radius-12 cylinder layer (3 mm per chart
+        // unit across the axis): on the surface they run at about 18° to the axis, and
+        // neighbouring lines are one spacing apart measured there, across the lines.
+        let surf = Surface::Cylinder {
+            frame: Frame::world(P3::origin()),
+            radius: 4.0,
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 4.0,
+                sv: 1.0,
+            },
+        };
+        let region = Region {
+            outer: vec![[-2.0, -6.0], [2.0, -6.0], [2.0, 6.0], [-2.0, 6.0]],
+            holes: vec![],
+        };
+        let params = LayerParams {
+            path_mode: PathMode::Raster,
+            ..LayerParams::default()
+        };
+        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        // Unrolled: a = 12·angle, z. A chart step (1, 1) is (3, 1) unrolled.
+        let dir = V3::new(3.0, 1.0, 0.0).normalize();
+        let across = V3::new(-dir.y, dir.x, 0.0);
+        // Each line's offset across the lines, from its points near the middle.
+        let mut offsets: Vec<f64> = paths
+            .iter()
+            .filter_map(|p| {
+                let o: Vec<f64> = p
+                    .points
+                    .iter()
+                    .map(|q| chart.at(*q, 8.0).expect("on the layer").0)
+                    .map(|x| V3::new(x.y.atan2(x.x) * 12.0, x.z, 0.0))
+                    .filter(|u| u.norm() < 3.0)
+                    .map(|u| u.dot(&across))
+                    .collect();
+                (!o.is_empty()).then(|| o.iter().sum::<f64>() / o.len() as f64)
+            })
+            .collect();
+        offsets.sort_by(f64::total_cmp);
+        assert!(offsets.len() >= 8, "{} lines", offsets.len());
+        for w in offsets.windows(2) {
+            let gap = w[1] - w[0];
+            assert!(
+                (gap - 0.45).abs() < 0.03,
+                "neighbouring lines {gap:.3} mm apart on the surface"
+            );
         }
     }
 }
