@@ -858,14 +858,7 @@ fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -> Vec<FillP
         for ring in &lifted {
             for i in 0..ring.len() {
                 let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
-                let d = b - a;
-                let l2 = d.norm_squared();
-                let t = if l2 > 0.0 {
-                    ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                best = best.min((p - (a + d * t)).norm());
+                best = best.min(crate::geodesic::segment_distance(p, &a, &b));
             }
         }
         best
@@ -1526,30 +1519,14 @@ mod tests {
     fn rings_on_a_cylinder_layer_are_a_spacing_apart_on_the_surface_not_in_the_chart() {
         // A cylinder of radius 4 offset by 8: the layer has radius 12, three times the
         // reference, so one chart unit across the axis spans 3 mm there.
-        let surf = Surface::Cylinder {
-            frame: Frame::world(P3::origin()),
-            radius: 4.0,
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 4.0,
-                sv: 1.0,
-            },
-        };
+        let surf = radius_4_cylinder();
+        let chart = stretched_chart(&surf);
         // 3 chart units (9 mm on the layer) around, 8 mm along the axis.
-        let region = Region {
-            outer: vec![[-1.5, -4.0], [1.5, -4.0], [1.5, 4.0], [-1.5, 4.0]],
-            holes: vec![],
-        };
-        let params = LayerParams {
-            path_mode: PathMode::Contour,
-            ..LayerParams::default()
-        };
-        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let paths = fill_on_layer(
+            &chart,
+            vec![[-1.5, -4.0], [1.5, -4.0], [1.5, 4.0], [-1.5, 4.0]],
+            PathMode::Contour,
+        );
         let lift = |q: Point2| chart.at(q, 8.0).expect("on the layer").0;
         let rings: Vec<Vec<P3>> = paths
             .iter()
@@ -1575,6 +1552,42 @@ mod tests {
         }
     }
 
+    /// A cylinder of radius 4 about the z axis.
+    fn radius_4_cylinder() -> Surface {
+        Surface::Cylinder {
+            frame: Frame::world(P3::origin()),
+            radius: 4.0,
+        }
+    }
+
+    /// The chart of `surf` (a radius-4 cylinder) with one chart unit a radian × 4 mm across
+    /// the axis and 1 mm along it: on the layer 8 mm out (radius 12) a unit across is 3 mm.
+    fn stretched_chart(surf: &Surface) -> Chart<'_> {
+        Chart {
+            surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 4.0,
+                sv: 1.0,
+            },
+        }
+    }
+
+    /// The fill of the region `outer` on the layer 8 mm off the reference, 0.45 mm beads.
+    fn fill_on_layer(chart: &Chart, outer: Vec<Point2>, mode: PathMode) -> Vec<FillPath> {
+        let region = Region {
+            outer,
+            holes: vec![],
+        };
+        let params = LayerParams {
+            path_mode: mode,
+            ..LayerParams::default()
+        };
+        fill_region(chart, &region, 8.0, &params, 0, 0.45, 0.45)
+    }
+
     /// The path points of `paths` lifted onto the layer at `z`.
     fn lifted(chart: &Chart, paths: &[FillPath], z: f64) -> Vec<P3> {
         paths
@@ -1590,20 +1603,8 @@ mod tests {
         // the layer, so the rectangle's right-angled corners look sharp in the chart and the
         // lattice triangles there are long. The outer ring's corner must still be the inward
         // offset's: (w/2)·√2 = 0.318 mm from each corner of the region, not cut off by a chord.
-        let surf = Surface::Cylinder {
-            frame: Frame::world(P3::origin()),
-            radius: 4.0,
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 4.0,
-                sv: 1.0,
-            },
-        };
+        let surf = radius_4_cylinder();
+        let chart = stretched_chart(&surf);
         let outer = vec![[-0.5, -3.0], [0.5, -3.0], [0.5, 3.0], [-0.5, 3.0]];
         let region = Region {
             outer: outer.clone(),
@@ -1695,20 +1696,8 @@ mod tests {
         // axis), now with a strip pitched 35° to the axis, 6 mm wide on the layer. Over a
         // lattice laid in the chart the triangles would be long and obtuse on the layer, the
         // marched distance too large, and the inner rings too near the boundary.
-        let surf = Surface::Cylinder {
-            frame: Frame::world(P3::origin()),
-            radius: 4.0,
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 4.0,
-                sv: 1.0,
-            },
-        };
+        let surf = radius_4_cylinder();
+        let chart = stretched_chart(&surf);
         // Unrolled layer coordinates (arc length across the axis, height) to the chart.
         let pitch = 35f64.to_radians();
         let (dir, nrm) = ([pitch.cos(), pitch.sin()], [-pitch.sin(), pitch.cos()]);
@@ -1766,29 +1755,13 @@ mod tests {
         // Raster lines at 45° in the chart of the radius-12 cylinder layer (3 mm per chart
         // unit across the axis): on the surface they run at about 18° to the axis, and
         // neighbouring lines are one spacing apart measured there, across the lines.
-        let surf = Surface::Cylinder {
-            frame: Frame::world(P3::origin()),
-            radius: 4.0,
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 4.0,
-                sv: 1.0,
-            },
-        };
-        let region = Region {
-            outer: vec![[-2.0, -6.0], [2.0, -6.0], [2.0, 6.0], [-2.0, 6.0]],
-            holes: vec![],
-        };
-        let params = LayerParams {
-            path_mode: PathMode::Raster,
-            ..LayerParams::default()
-        };
-        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let surf = radius_4_cylinder();
+        let chart = stretched_chart(&surf);
+        let paths = fill_on_layer(
+            &chart,
+            vec![[-2.0, -6.0], [2.0, -6.0], [2.0, 6.0], [-2.0, 6.0]],
+            PathMode::Raster,
+        );
         // Unrolled: a = 12·angle, z. A chart step (1, 1) is (3, 1) unrolled.
         let dir = V3::new(3.0, 1.0, 0.0).normalize();
         let across = V3::new(-dir.y, dir.x, 0.0);

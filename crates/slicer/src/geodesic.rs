@@ -73,6 +73,18 @@ pub fn region_contains(region: &Region, q: Point2) -> bool {
     inside
 }
 
+/// Distance from `p` to the segment `a`–`b` in 3-D.
+pub(crate) fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * t)).norm()
+}
+
 /// Resamples a closed ring so no segment is longer than `step`, or `fine` where `near` holds
 /// at either end of the segment.
 fn resample(ring: &[Point2], step: f64, fine: f64, near: &dyn Fn(Point2) -> bool) -> Vec<Point2> {
@@ -388,14 +400,7 @@ impl LayerMesh {
                 for b in j - 2..=j + 2 {
                     for &(s, e) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
                         let (ps, pe) = (self.p[s as usize], self.p[e as usize]);
-                        let d = pe - ps;
-                        let l2 = d.norm_squared();
-                        let t = if l2 > 0.0 {
-                            ((p - ps).dot(&d) / l2).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        best = best.min((p - (ps + d * t)).norm());
+                        best = best.min(segment_distance(&p, &ps, &pe));
                     }
                 }
             }
