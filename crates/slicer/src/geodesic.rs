@@ -124,6 +124,28 @@ fn convex_corners(ring: &[Point2], min_turn: f64) -> Vec<Point2> {
     out
 }
 
+/// The most lattice cells (of the region's box) a layer mesh is built with.
+const MAX_CELLS: f64 = 4e6;
+
+/// The lattice step for a region whose outer ring is `outer`: `step`, or coarser where the
+/// region's box would hold more than [`MAX_CELLS`] cells of it (a curved layer some 300 mm
+/// across at 0.15 mm), so a large region is filled rather than left empty.
+fn lattice_step(outer: &[Point2], step: f64) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for q in outer {
+        for k in 0..2 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let cells = ((hi[0] - lo[0]) / step) * ((hi[1] - lo[1]) / step);
+    if cells.is_finite() && cells > MAX_CELLS {
+        step * (cells / MAX_CELLS).sqrt()
+    } else {
+        step
+    }
+}
+
 /// A ring vertex turning by more than this (radians) towards the region is a convex corner.
 const CORNER_TURN: f64 = 0.4;
 /// Around a convex corner the lattice is refined within this many lattice steps.
@@ -184,6 +206,7 @@ impl LayerMesh {
         if !(step.is_finite() && step > 0.0) {
             return m;
         }
+        let step = lattice_step(&region.outer, step);
         // Convex corners get a lattice a third as fine within `CORNER_REACH` steps, so the
         // iso-lines' arcs round them (linear interpolation over a coarse triangle spanning a
         // corner would cut it off by a chord).
@@ -207,10 +230,6 @@ impl LayerMesh {
             }
         }
         if !(lo[0].is_finite() && hi[0].is_finite() && lo[1].is_finite() && hi[1].is_finite()) {
-            return m;
-        }
-        let cells = ((hi[0] - lo[0]) / step) * ((hi[1] - lo[1]) / step);
-        if cells > 4e6 {
             return m;
         }
         // Boundary points in a bucket grid, to keep lattice points off the boundary.
@@ -687,5 +706,18 @@ mod tests {
         assert_eq!(pieces.len(), 1);
         assert_eq!(pieces[0].first(), Some(&[0.5, 0.0]));
         assert_eq!(pieces[0].last(), Some(&[2.5, 0.0]));
+    }
+
+    #[test]
+    fn a_large_region_gets_a_coarser_lattice_not_none() {
+        let big = square(400.0);
+        let s = lattice_step(&big.outer, 0.15);
+        let cells = (400.0 / s) * (400.0 / s);
+        assert!(
+            s > 0.15 && (cells - MAX_CELLS).abs() < 1.0,
+            "step {s}, {cells} cells"
+        );
+        let small = square(5.0);
+        assert_eq!(lattice_step(&small.outer, 0.15), 0.15);
     }
 }
