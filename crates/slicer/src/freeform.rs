@@ -1790,4 +1790,47 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn a_sliver_thinner_than_a_bead_is_filled_not_dropped() {
+        // A strip 0.3 mm wide and 6 mm long on a plane: no ring of a 0.45 mm bead fits, so
+        // the gap fill lays it down, as wide as the strip, with about the strip's area.
+        let surf = Surface::Plane {
+            frame: Frame::world(P3::origin()),
+        };
+        let chart = Chart {
+            surf: &surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 1.0,
+                sv: 1.0,
+            },
+        };
+        let outer = vec![[0.0, 0.0], [6.0, 0.0], [6.0, 0.3], [0.0, 0.3]];
+        for mode in [PathMode::ContourZigzag, PathMode::Contour, PathMode::Zigzag] {
+            let paths = fill_on_layer(&chart, outer.clone(), mode);
+            let covered: f64 = paths
+                .iter()
+                .map(|p| {
+                    p.points
+                        .windows(2)
+                        .zip(p.widths.windows(2))
+                        .map(|(q, w)| {
+                            (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1])
+                        })
+                        .sum::<f64>()
+                })
+                .sum();
+            let r = covered / (6.0 * 0.3);
+            assert!(r > 0.8 && r < 1.05, "{mode:?}: {r} of the sliver's area");
+            for p in &paths {
+                for (q, w) in p.points.iter().zip(&p.widths) {
+                    assert!(*w <= 0.3 + 1e-6, "{mode:?}: {w} mm wide in a 0.3 mm strip");
+                    assert!(q[1] > 0.0 && q[1] < 0.3, "{mode:?}: {q:?} outside");
+                }
+            }
+        }
+    }
 }
