@@ -47,6 +47,7 @@
 use std::collections::BTreeMap;
 
 use slicer::toolpath::fixed;
+use slicer::vec3::{norm, sub, unit};
 
 use crate::{MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
 
@@ -383,19 +384,6 @@ fn machine_to_bed(v: [f64; 3], b: f64, c: f64) -> [f64; 3] {
 /// `theta` plus the whole turns that bring it nearest `previous` (degrees).
 fn unwrap_near(theta: f64, previous: f64) -> f64 {
     theta + 360.0 * ((previous - theta) / 360.0).round()
-}
-
-fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
-    let n = norm(v);
-    (n.is_finite() && n > 1e-12).then(|| [v[0] / n, v[1] / n, v[2] / n])
-}
-
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 fn lerp(a: [f64; 3], b: [f64; 3], f: f64) -> [f64; 3] {

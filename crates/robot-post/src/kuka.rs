@@ -58,6 +58,7 @@ use std::f64::consts::PI;
 use crate::marlin::bed_offset;
 use crate::{MachineKind, MachineProfile, MoveKind, PostError, ToolPath};
 use slicer::toolpath::fixed;
+use slicer::vec3::{add, cross, dot, norm, scale, sub, V3};
 
 /// Largest orientation change of one LIN of a travel (degrees): a travel that turns the tool
 /// further is split into several LINs.
@@ -489,7 +490,6 @@ impl ArmModel {
 /// A rotation matrix, rows: `r[i][j]` is row i, column j; column j is the rotated frame's
 /// j-th axis.
 pub type Mat3 = [[f64; 3]; 3];
-type V3 = [f64; 3];
 
 const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
@@ -511,34 +511,6 @@ fn col(a: &Mat3, j: usize) -> V3 {
 
 fn from_cols(x: V3, y: V3, z: V3) -> Mat3 {
     [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
 }
 
 fn rot_x(t: f64) -> Mat3 {

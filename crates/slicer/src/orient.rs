@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-type V3 = [f64; 3];
+use crate::vec3::{cross, dot, norm, scale, sub, unit, V3};
 
 /// Which filter smooths the axes (the paper's two variants, §3.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
@@ -104,36 +104,6 @@ pub struct OrientationFigures {
 
 /// Segments shorter than this (mm) are left out of the rate (an angle over no length).
 pub const MIN_RATE_SEGMENT_MM: f64 = 1e-6;
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn scale(a: V3, k: f64) -> V3 {
-    [a[0] * k, a[1] * k, a[2] * k]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// `a / |a|`, or `None` for a zero, tiny or non-finite vector.
-fn unit(a: V3) -> Option<V3> {
-    let n = norm(a);
-    (n.is_finite() && n > 1e-12).then(|| scale(a, 1.0 / n))
-}
 
 /// Angle between two directions, radians in [0, π]. This is Eq. 4's
 /// `arccos(a·b / (|a||b|))`, computed as `atan2(|a×b|, a·b)`, which is the same angle but stays
