@@ -49,7 +49,7 @@ use std::collections::BTreeMap;
 use slicer::toolpath::fixed;
 use slicer::vec3::{norm, sub, unit};
 
-use crate::{MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
+use crate::{MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
 
 /// Most sub-moves one planned segment is split into.
 pub const MAX_SUBDIVISION: usize = 1024;
@@ -657,12 +657,7 @@ pub fn delta5(
     m: &MachineProfile,
     source: &str,
 ) -> Result<Delta5Program, PostError> {
-    m.check_for(MachineKind::Delta5)?;
-    let g = m.delta5.as_ref().ok_or_else(|| PostError::ProfileValue {
-        name: m.name.clone(),
-        field: "[delta5]",
-        reason: "table is required for kind = \"delta5\"".into(),
-    })?;
+    let g = m.delta5_table()?;
     if g.z_min >= m.bed_size[2] {
         return Err(PostError::ProfileValue {
             name: m.name.clone(),
@@ -1415,6 +1410,7 @@ fn tick_label(v: f64, step: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MachineKind;
 
     fn geometry() -> Delta5Geometry {
         MachineProfile::builtin(MachineKind::Delta5)

@@ -56,7 +56,7 @@ use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
 use crate::marlin::bed_offset;
-use crate::{MachineKind, MachineProfile, MoveKind, PostError, ToolPath};
+use crate::{MachineProfile, MoveKind, PostError, ToolPath};
 use slicer::toolpath::fixed;
 use slicer::vec3::{add, cross, dot, norm, scale, sub, V3};
 
@@ -814,12 +814,7 @@ pub fn kuka(
     program_name: &str,
     source: &str,
 ) -> Result<KrlProgram, PostError> {
-    m.check_for(MachineKind::Kuka)?;
-    let cell = m.kuka.as_ref().ok_or_else(|| PostError::ProfileValue {
-        name: m.name.clone(),
-        field: "[kuka]",
-        reason: "table is required for kind = \"kuka\"".into(),
-    })?;
+    let cell = m.kuka_table()?;
     path.check_finite()?;
     let mut axes = Vec::with_capacity(path.points.len());
     for (index, q) in path.points.iter().enumerate() {

@@ -203,18 +203,8 @@ impl MachineProfile {
             }
         }
         match (self.kind, &self.delta5, &self.kuka) {
-            (MachineKind::Delta5, None, _) => {
-                return Err(bad(
-                    "[delta5]",
-                    "table is required for kind = \"delta5\"".into(),
-                ))
-            }
-            (MachineKind::Kuka, _, None) => {
-                return Err(bad(
-                    "[kuka]",
-                    "table is required for kind = \"kuka\"".into(),
-                ))
-            }
+            (MachineKind::Delta5, None, _) => return Err(self.missing_table("[delta5]", "delta5")),
+            (MachineKind::Kuka, _, None) => return Err(self.missing_table("[kuka]", "kuka")),
             _ => {}
         }
         if let Some(d) = &self.delta5 {
@@ -237,6 +227,31 @@ impl MachineProfile {
             });
         }
         self.validate()
+    }
+
+    /// The error for a profile of `kind` without its `table`.
+    fn missing_table(&self, table: &'static str, kind: &str) -> PostError {
+        PostError::ProfileValue {
+            name: self.name.clone(),
+            field: table,
+            reason: format!("table is required for kind = \"{kind}\""),
+        }
+    }
+
+    /// [`MachineProfile::check_for`] a `delta5` profile, and its `[delta5]` table.
+    pub fn delta5_table(&self) -> Result<&crate::delta5::Delta5Geometry, PostError> {
+        self.check_for(MachineKind::Delta5)?;
+        self.delta5
+            .as_ref()
+            .ok_or_else(|| self.missing_table("[delta5]", "delta5"))
+    }
+
+    /// [`MachineProfile::check_for`] a `kuka` profile, and its `[kuka]` table.
+    pub fn kuka_table(&self) -> Result<&crate::kuka::KukaCell, PostError> {
+        self.check_for(MachineKind::Kuka)?;
+        self.kuka
+            .as_ref()
+            .ok_or_else(|| self.missing_table("[kuka]", "kuka"))
     }
 
     /// Filament length (mm) fed for a bead of width `w`, thickness `dl` and length `len`:
