@@ -865,8 +865,7 @@ struct Writer<'a> {
     retracted: bool,
     printing: bool,
     hopped: bool,
-    layer: Option<usize>,
-    feature: Option<usize>,
+    marks: crate::marlin::LayerMarks,
     /// The feature being written, for envelope errors.
     current: usize,
     safe_z: f64,
@@ -905,8 +904,7 @@ impl<'a> Writer<'a> {
             retracted: false,
             printing: false,
             hopped: false,
-            layer: None,
-            feature: None,
+            marks: crate::marlin::LayerMarks::default(),
             current: 0,
             safe_z,
             lo: [x0, y0, g.z_min],
@@ -929,14 +927,7 @@ impl<'a> Writer<'a> {
     /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
     fn comments(&mut self, q: &PathPoint) {
         self.current = q.feature;
-        if self.layer != Some(q.layer) {
-            self.layer = Some(q.layer);
-            self.line(&format!(";LAYER:{}", q.layer));
-        }
-        if self.feature != Some(q.feature) {
-            self.feature = Some(q.feature);
-            self.line(&format!(";FEATURE:{}", q.feature));
-        }
+        self.marks.write(q, &mut self.out);
     }
 
     /// Refuses a nozzle position outside the work envelope.

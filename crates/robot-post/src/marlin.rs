@@ -162,6 +162,28 @@ fn comment_text(s: &str) -> String {
 }
 
 /// The program being written and the machine state it leaves.
+/// The `;LAYER:` and `;FEATURE:` comments of a G-code program: written where the point's
+/// layer or feature changes (shared by the Marlin and delta5 posts).
+#[derive(Debug, Default)]
+pub(crate) struct LayerMarks {
+    layer: Option<usize>,
+    feature: Option<usize>,
+}
+
+impl LayerMarks {
+    /// Appends the comment lines `q` starts to `out`.
+    pub(crate) fn write(&mut self, q: &PathPoint, out: &mut String) {
+        if self.layer != Some(q.layer) {
+            self.layer = Some(q.layer);
+            out.push_str(&format!(";LAYER:{}\n", q.layer));
+        }
+        if self.feature != Some(q.feature) {
+            self.feature = Some(q.feature);
+            out.push_str(&format!(";FEATURE:{}\n", q.feature));
+        }
+    }
+}
+
 struct Writer {
     out: String,
     /// Nozzle position (machine coordinates) the last move ended at, the hop excluded.
@@ -172,8 +194,7 @@ struct Writer {
     printing: bool,
     /// The nozzle is lifted by the z-hop.
     hopped: bool,
-    layer: Option<usize>,
-    feature: Option<usize>,
+    marks: LayerMarks,
     retraction: f64,
     retraction_f: String,
     travel_f: String,
@@ -192,8 +213,7 @@ impl Writer {
             retracted: false,
             printing: false,
             hopped: false,
-            layer: None,
-            feature: None,
+            marks: LayerMarks::default(),
             retraction: m.retraction_length,
             retraction_f: f(m.retraction_speed),
             travel_f: f(m.travel_speed),
@@ -250,14 +270,7 @@ impl Writer {
 
     /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
     fn comments(&mut self, q: &PathPoint) {
-        if self.layer != Some(q.layer) {
-            self.layer = Some(q.layer);
-            self.line(&format!(";LAYER:{}", q.layer));
-        }
-        if self.feature != Some(q.feature) {
-            self.feature = Some(q.feature);
-            self.line(&format!(";FEATURE:{}", q.feature));
-        }
+        self.marks.write(q, &mut self.out);
     }
 
     fn retract(&mut self) {
