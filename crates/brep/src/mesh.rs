@@ -386,13 +386,7 @@ fn refine(c: &Curve, a: f64, b: f64, opts: &MeshOptions, depth: u32, out: &mut V
         let pa = c.eval(a);
         let pb = c.eval(b);
         let pm = c.eval(m);
-        let chord = pb - pa;
-        let l = chord.norm();
-        let dev = if l > 1e-300 {
-            (pm - pa).cross(&chord).norm() / l
-        } else {
-            (pm - pa).norm()
-        };
+        let dev = chord_deviation(&pa, &pm, &pb);
         let ta = c.deriv(a);
         let tb = c.deriv(b);
         let turn = if ta.norm() > 1e-300 && tb.norm() > 1e-300 {
@@ -407,6 +401,18 @@ fn refine(c: &Curve, a: f64, b: f64, opts: &MeshOptions, depth: u32, out: &mut V
         }
     }
     out.push(b);
+}
+
+/// Distance from `pm` (a curve's point between `pa` and `pb`) to the chord `pa`–`pb`; to `pa`
+/// when the chord has no length.
+fn chord_deviation(pa: &P3, pm: &P3, pb: &P3) -> f64 {
+    let chord = pb - pa;
+    let l = chord.norm();
+    if l > 1e-300 {
+        (pm - pa).cross(&chord).norm() / l
+    } else {
+        (pm - pa).norm()
+    }
 }
 
 fn face_err(brep: &Brep, f: FaceId, msg: impl Into<String>) -> MeshError {
@@ -810,13 +816,7 @@ fn cut_refine(
     let m = 0.5 * (a + b);
     if depth < 12 {
         let (pa, pm, pb) = (eval(a), eval(m), eval(b));
-        let chord = pb - pa;
-        let l = chord.norm();
-        let dev = if l > 1e-300 {
-            (pm - pa).cross(&chord).norm() / l
-        } else {
-            (pm - pa).norm()
-        };
+        let dev = chord_deviation(&pa, &pm, &pb);
         let (d0, d1) = (pm - pa, pb - pm);
         let turn = if d0.norm() > 1e-300 && d1.norm() > 1e-300 {
             2.0 * d0.angle(&d1)
