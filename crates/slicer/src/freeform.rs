@@ -1285,7 +1285,7 @@ pub fn plan_freeform(
         overhang_layers: None,
     };
     let mut prev_regions: Vec<Region> = vec![];
-    let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
+    let mut printed_layers = vec![];
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -1421,23 +1421,10 @@ pub fn plan_freeform(
             *cursor = pts.last().map(|x| x.p);
         }
         if printed {
-            fig.layers += 1;
-            tmin = tmin.min(dl);
-            tmax = tmax.max(dl);
-            tsum += dl;
+            printed_layers.push(dl);
         }
     }
-    fig.points = out.iter().filter(|p| p.feature == id).count();
-    fig.thickness = if fig.layers > 0 {
-        (tmin, tsum / fig.layers as f64, tmax)
-    } else {
-        (0.0, 0.0, 0.0)
-    };
-    if fig.layers == 0 {
-        fig.warnings.push(format!(
-            "feature {id} has no printable layer (thinner than a bead?)"
-        ));
-    }
+    fig.finish(id, out, &printed_layers);
     if let Some((a, b)) = ff.overhang_layers {
         fig.warnings.push(format!(
             "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",

@@ -96,6 +96,30 @@ pub struct FeatureFigures {
     pub warnings: Vec<String>,
 }
 
+impl FeatureFigures {
+    /// Closes feature `id`'s figures: its points in `out`, and its layers from the thicknesses
+    /// of the layers that printed (thinnest, mean, thickest; zeros and a warning when none did).
+    pub(crate) fn finish(&mut self, id: usize, out: &[PathPoint], printed: &[f64]) {
+        self.points = out.iter().filter(|p| p.feature == id).count();
+        self.layers = printed.len();
+        self.thickness = if printed.is_empty() {
+            (0.0, 0.0, 0.0)
+        } else {
+            let (lo, hi, sum) = printed
+                .iter()
+                .fold((f64::INFINITY, 0.0f64, 0.0), |(lo, hi, sum), &t| {
+                    (lo.min(t), hi.max(t), sum + t)
+                });
+            (lo, sum / printed.len() as f64, hi)
+        };
+        if printed.is_empty() {
+            self.warnings.push(format!(
+                "feature {id} has no printable layer (thinner than a bead?)"
+            ));
+        }
+    }
+}
+
 /// The reference plane of a two5d feature: through its healing faces (or build-plate face),
 /// normal pointing into the feature.
 pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
@@ -169,7 +193,7 @@ pub fn plan_two5d(
     let spacing = params.spacing(bead.width);
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
     let mut fig = FeatureFigures::default();
-    let (mut tmin, mut tmax, mut tsum) = (f64::INFINITY, 0.0f64, 0.0);
+    let mut printed = vec![];
     let mut z = 0.0;
     for (layer, &dl) in heights.iter().enumerate() {
         let mid = z + 0.5 * dl;
@@ -191,10 +215,7 @@ pub fn plan_two5d(
         if paths.is_empty() {
             continue;
         }
-        fig.layers += 1;
-        tmin = tmin.min(dl);
-        tmax = tmax.max(dl);
-        tsum += dl;
+        printed.push(dl);
         for path in paths {
             let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
             let Some(first) = pts.first() else { continue };
@@ -231,17 +252,6 @@ pub fn plan_two5d(
             *cursor = pts.last().copied();
         }
     }
-    fig.points = out.iter().filter(|p| p.feature == f.id).count();
-    fig.thickness = if fig.layers > 0 {
-        (tmin, tsum / fig.layers as f64, tmax)
-    } else {
-        (0.0, 0.0, 0.0)
-    };
-    if fig.layers == 0 {
-        fig.warnings.push(format!(
-            "feature {} has no printable layer (thinner than a bead?)",
-            f.id
-        ));
-    }
+    fig.finish(f.id, out, &printed);
     Ok(fig)
 }
