@@ -1442,19 +1442,8 @@ mod tests {
     #[test]
     fn a_flat_disc_is_covered_in_every_mode() {
         // On a plane the chart is exact: the fills must cover the disc like planar fills do.
-        let surf = Surface::Plane {
-            frame: Frame::world(P3::origin()),
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 1.0,
-                sv: 1.0,
-            },
-        };
+        let surf = world_plane();
+        let chart = unit_chart(&surf);
         let outer: Vec<Point2> = (0..64)
             .map(|i| {
                 let a = i as f64 / 64.0 * std::f64::consts::TAU;
@@ -1536,6 +1525,27 @@ mod tests {
                 (gap - 0.45).abs() < 0.02,
                 "rings {gap} mm apart on the surface"
             );
+        }
+    }
+
+    /// The plane z = 0.
+    fn world_plane() -> Surface {
+        Surface::Plane {
+            frame: Frame::world(P3::origin()),
+        }
+    }
+
+    /// The chart of `surf` in its own (u, v), unscaled: exact on a plane.
+    fn unit_chart(surf: &Surface) -> Chart<'_> {
+        Chart {
+            surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 1.0,
+                sv: 1.0,
+            },
         }
     }
 
@@ -1621,19 +1631,8 @@ mod tests {
     fn a_sharp_wedge_gets_a_spur_into_its_tip() {
         // A 30° wedge on a plane: rings stop (w/2)/sin 15° = 0.87 mm short of the tip; the
         // spur runs on along the bisector, as wide as the wedge, to where it is 0.3 bead wide.
-        let surf = Surface::Plane {
-            frame: Frame::world(P3::origin()),
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 1.0,
-                sv: 1.0,
-            },
-        };
+        let surf = world_plane();
+        let chart = unit_chart(&surf);
         let half = 15f64.to_radians();
         let (l, w) = (10.0, 0.45);
         let outer = vec![
@@ -1782,19 +1781,8 @@ mod tests {
     fn a_sliver_thinner_than_a_bead_is_filled_not_dropped() {
         // A strip 0.3 mm wide and 6 mm long on a plane: no ring of a 0.45 mm bead fits, so
         // the gap fill lays it down, as wide as the strip, with about the strip's area.
-        let surf = Surface::Plane {
-            frame: Frame::world(P3::origin()),
-        };
-        let chart = Chart {
-            surf: &surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 1.0,
-                sv: 1.0,
-            },
-        };
+        let surf = world_plane();
+        let chart = unit_chart(&surf);
         let outer = vec![[0.0, 0.0], [6.0, 0.0], [6.0, 0.3], [0.0, 0.3]];
         for mode in [PathMode::ContourZigzag, PathMode::Contour, PathMode::Zigzag] {
             let paths = fill_on_layer(&chart, outer.clone(), mode);

@@ -3,27 +3,20 @@
 
 use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, Mesh, MeshOptions};
-use features::{extract, ExtractOptions, FeatureKind, FeatureTree};
+mod support;
+
+use features::{FeatureKind, FeatureTree};
 use slicer::freeform::plan_freeform;
 use slicer::params::{LayerParams, PathMode};
 use slicer::planar::{Bead, PlanError};
 use slicer::toolpath::{MoveKind, PathPoint};
 use std::collections::HashMap;
-use std::path::PathBuf;
+use support::tree;
 
 const BEAD: Bead = Bead {
     width: 0.45,
     filament_diameter: 1.75,
 };
-
-fn tree(name: &str) -> FeatureTree {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(format!("{name}.step"));
-    let part = brep::read_step(&path).expect("fixture reads");
-    let s = part.brep.solid_ids().next().expect("a solid");
-    extract(&part.brep, s, &ExtractOptions::default()).expect("extracts")
-}
 
 fn mesh_of(t: &FeatureTree, id: usize) -> Mesh {
     let f = &t.features[id];

@@ -3,11 +3,13 @@
 //! offsets of the trough's cylinder face fold over themselves from 4 mm on, and the planner
 //! refuses the rib, naming it and the first layer that would fold.
 
-use features::{extract, ExtractOptions, FeatureKind, FeatureTree};
+mod support;
+
+use features::FeatureKind;
 use slicer::freeform::plan_freeform;
 use slicer::params::LayerParams;
 use slicer::planar::{Bead, PlanError};
-use std::path::PathBuf;
+use support::tree;
 
 const BEAD: Bead = Bead {
     width: 0.45,
@@ -16,15 +18,6 @@ const BEAD: Bead = Bead {
 
 /// Radius of the trough (fixtures/make_fixtures.py, `make_trough_rib`), mm.
 const TROUGH_RADIUS: f64 = 4.0;
-
-fn tree(name: &str) -> FeatureTree {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(format!("{name}.step"));
-    let part = brep::read_step(&path).expect("fixture reads");
-    let s = part.brep.solid_ids().next().expect("a solid");
-    extract(&part.brep, s, &ExtractOptions::default()).expect("extracts")
-}
 
 #[test]
 fn a_rib_taller_than_its_trough_radius_is_refused_at_the_first_folding_layer() {
