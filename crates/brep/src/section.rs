@@ -83,15 +83,10 @@ pub fn section(mesh: &Mesh, plane: &Plane) -> Vec<Vec<P3>> {
     let mut point: HashMap<(u32, u32), P3> = HashMap::new();
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     for t in mesh.triangles() {
-        let up = [above(t[0]), above(t[1]), above(t[2])];
-        let n_up = up.iter().filter(|x| **x).count();
-        if n_up == 0 || n_up == 3 {
-            continue;
-        }
         // The lone vertex on its side, then the other two in triangle order.
-        let lone = (0..3)
-            .find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3])
-            .unwrap_or(0);
+        let Some(lone) = lone_vertex([above(t[0]), above(t[1]), above(t[2])]) else {
+            continue;
+        };
         let (a, b, c) = (t[lone], t[(lone + 1) % 3], t[(lone + 2) % 3]);
         let (e1, e2) = (key(a, b), key(a, c));
         let (p1, p2) = (cross(a, b), cross(a, c));
@@ -144,6 +139,13 @@ pub fn signed_area(poly: &[[f64; 2]]) -> f64 {
         })
         .sum::<f64>()
         * 0.5
+}
+
+/// The vertex of a triangle alone on its side of a level (`up`: each vertex at or above
+/// it), or `None` when all three are on one side and the level misses the triangle: the
+/// level crosses the two edges at that vertex.
+pub fn lone_vertex(up: [bool; 3]) -> Option<usize> {
+    (0..3).find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3])
 }
 
 #[cfg(test)]

@@ -545,13 +545,9 @@ impl LayerMesh {
                 continue;
             }
             let up = [0, 1, 2].map(|k| f[tri[k] as usize] >= level);
-            let n_up = up.iter().filter(|x| **x).count();
-            if n_up == 0 || n_up == 3 {
+            let Some(lone) = brep::section::lone_vertex(up) else {
                 continue;
-            }
-            let lone = (0..3)
-                .find(|&k| up[k] != up[(k + 1) % 3] && up[k] != up[(k + 2) % 3])
-                .unwrap_or(0);
+            };
             let (a, b, c) = (tri[lone], tri[(lone + 1) % 3], tri[(lone + 2) % 3]);
             let (e1, e2) = (key(a, b), key(a, c));
             point.entry(e1).or_insert_with(|| at(a, b));
