@@ -262,14 +262,8 @@ fn read_src(file: &str, stem: &str, text: &str) -> Result<Module, KrlError> {
         match state {
             0 if stmt.starts_with('&') => {}
             0 => {
-                let Some(rest) = upper.strip_prefix("DEF ") else {
-                    return Err(err(
-                        file,
-                        line,
-                        format!("expected `DEF {stem}( )`, got `{stmt}`"),
-                    ));
-                };
-                if call_name(rest).as_deref() != Some(stem) {
+                let name = upper.strip_prefix("DEF ").and_then(call_name);
+                if name.as_deref() != Some(stem) {
                     return Err(err(
                         file,
                         line,
