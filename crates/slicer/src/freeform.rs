@@ -1466,18 +1466,7 @@ mod tests {
                 ..LayerParams::default()
             };
             let paths = fill_region(&chart, &region, 0.2, &params, 1, 0.45, 0.45);
-            let covered: f64 = paths
-                .iter()
-                .map(|p| {
-                    p.points
-                        .windows(2)
-                        .zip(p.widths.windows(2))
-                        .map(|(q, w)| {
-                            (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1])
-                        })
-                        .sum::<f64>()
-                })
-                .sum();
+            let covered = covered_area(&paths);
             let r = covered / area;
             assert!(r > lo && r < 1.02, "{mode:?}: {r}");
             for p in &paths {
@@ -1526,6 +1515,22 @@ mod tests {
                 "rings {gap} mm apart on the surface"
             );
         }
+    }
+
+    /// The area the beads of `paths` cover in the chart: length × width, segment by segment.
+    fn covered_area(paths: &[FillPath]) -> f64 {
+        paths
+            .iter()
+            .map(|p| {
+                p.points
+                    .windows(2)
+                    .zip(p.widths.windows(2))
+                    .map(|(q, w)| {
+                        (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1])
+                    })
+                    .sum::<f64>()
+            })
+            .sum()
     }
 
     /// The plane z = 0.
@@ -1786,18 +1791,7 @@ mod tests {
         let outer = vec![[0.0, 0.0], [6.0, 0.0], [6.0, 0.3], [0.0, 0.3]];
         for mode in [PathMode::ContourZigzag, PathMode::Contour, PathMode::Zigzag] {
             let paths = fill_on_layer(&chart, outer.clone(), mode);
-            let covered: f64 = paths
-                .iter()
-                .map(|p| {
-                    p.points
-                        .windows(2)
-                        .zip(p.widths.windows(2))
-                        .map(|(q, w)| {
-                            (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1])
-                        })
-                        .sum::<f64>()
-                })
-                .sum();
+            let covered = covered_area(&paths);
             let r = covered / (6.0 * 0.3);
             assert!(r > 0.8 && r < 1.05, "{mode:?}: {r} of the sliver's area");
             for p in &paths {
