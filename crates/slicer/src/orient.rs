@@ -427,18 +427,6 @@ fn smooth_run(points: &mut [PathPoint], params: &SmoothParams) {
     }
 }
 
-/// Per feature, the largest (step, rate) over its continuous paths.
-fn figures(points: &[PathPoint], runs: &[Range<usize>]) -> BTreeMap<usize, (f64, f64)> {
-    let mut out: BTreeMap<usize, (f64, f64)> = BTreeMap::new();
-    for r in runs {
-        let (step, rate) = orientation_step_rate(&points[r.clone()]);
-        let e = out.entry(points[r.start].feature).or_insert((0.0, 0.0));
-        e.0 = e.0.max(step);
-        e.1 = e.1.max(rate);
-    }
-    out
-}
-
 /// Smooths every continuous path ([`continuous_paths`]) of `path` in place, each on its own,
 /// when `params.enabled`, and returns, for every feature in the path (key = `PathPoint.feature`),
 /// its [`orientation_step_rate`] figures before and after (after == before when disabled).
@@ -450,43 +438,38 @@ fn figures(points: &[PathPoint], runs: &[Range<usize>]) -> BTreeMap<usize, (f64,
 /// unit and within `cone_angle_deg / 2` of its planned axis. Parameters that fail
 /// [`SmoothParams::validate`] leave the path unchanged (the caller validates and reports).
 pub fn smooth(path: &mut ToolPath, params: &SmoothParams) -> BTreeMap<usize, OrientationFigures> {
-    let runs = continuous_paths(&path.points);
-    let before = figures(&path.points, &runs);
-    let after = if params.enabled && params.validate().is_ok() {
-        for r in &runs {
-            let run = &mut path.points[r.clone()];
-            let (step_b, rate_b) = orientation_step_rate(run);
+    let active = params.enabled && params.validate().is_ok();
+    let mut out: BTreeMap<usize, OrientationFigures> = BTreeMap::new();
+    for r in continuous_paths(&path.points) {
+        let feature = path.points[r.start].feature;
+        let run = &mut path.points[r];
+        let before = orientation_step_rate(run);
+        let after = if active {
             let planned: Vec<[f64; 3]> = run.iter().map(|q| q.axis).collect();
             smooth_run(run, params);
             // A low-pass filter cut off at a path's ends can still turn its first or last
             // step a little more than planned (uneven spacing there): a path that smoothing
             // would make rougher keeps its planned axes.
-            let (step_a, rate_a) = orientation_step_rate(run);
-            if step_a > step_b + 1e-9 || rate_a > rate_b + 1e-9 {
+            let after = orientation_step_rate(run);
+            if after.0 > before.0 + 1e-9 || after.1 > before.1 + 1e-9 {
                 for (q, a) in run.iter_mut().zip(planned) {
                     q.axis = a;
                 }
+                before
+            } else {
+                after
             }
-        }
-        figures(&path.points, &runs)
-    } else {
-        before.clone()
-    };
-    before
-        .into_iter()
-        .map(|(f, (step_b, rate_b))| {
-            let (step_a, rate_a) = after.get(&f).copied().unwrap_or((step_b, rate_b));
-            (
-                f,
-                OrientationFigures {
-                    step_max_deg_before: step_b,
-                    step_max_deg_after: step_a,
-                    rate_max_deg_per_mm_before: rate_b,
-                    rate_max_deg_per_mm_after: rate_a,
-                },
-            )
-        })
-        .collect()
+        } else {
+            before
+        };
+        // Per feature, the largest figures over its paths.
+        let e = out.entry(feature).or_default();
+        e.step_max_deg_before = e.step_max_deg_before.max(before.0);
+        e.rate_max_deg_per_mm_before = e.rate_max_deg_per_mm_before.max(before.1);
+        e.step_max_deg_after = e.step_max_deg_after.max(after.0);
+        e.rate_max_deg_per_mm_after = e.rate_max_deg_per_mm_after.max(after.1);
+    }
+    out
 }
 
 #[cfg(test)]
