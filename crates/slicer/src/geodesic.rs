@@ -14,7 +14,7 @@
 //! boundary; raster and zig-zag lines are iso-lines of the signed distance to a seed curve, so
 //! neighbouring lines are one spacing apart measured on the surface, not in the chart.
 
-use crate::fill::{Point2, Region};
+use crate::fill::{bead_end_reach, Point2, Region, MAX_END_REACH};
 use brep::math::P3;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 use std::cmp::Ordering;
@@ -601,30 +601,154 @@ impl LayerMesh {
     }
 }
 
-/// The pieces of `line` where its `other` value is at least `min`, cut exactly at the crossings.
-pub fn clip_above(line: &IsoLine, min: f64) -> Vec<Vec<Point2>> {
+/// A piece of an iso-line where the distance to the region's boundary is at least the
+/// infill area's, and the ways on from its cut ends towards the boundary.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Piece {
+    /// The line from cut to cut (or to the line's end), cut exactly at the crossings.
+    pub body: Vec<Point2>,
+    /// The way on before the body's first point, in the line's order (empty at a line end).
+    pub head: Vec<Point2>,
+    /// The way on after the body's last point.
+    pub tail: Vec<Point2>,
+}
+
+impl Piece {
+    /// The same piece run the other way.
+    pub fn reversed(self) -> Piece {
+        let rev = |mut v: Vec<Point2>| {
+            v.reverse();
+            v
+        };
+        Piece {
+            body: rev(self.body),
+            head: rev(self.tail),
+            tail: rev(self.head),
+        }
+    }
+
+    /// The body with both ways on: a raster line run on to the boundary.
+    pub fn reaching(self) -> Vec<Point2> {
+        let mut pts = self.head;
+        pts.extend(self.body);
+        pts.extend(self.tail);
+        pts
+    }
+}
+
+/// The pieces of `line` where its `other` value (the distance to the region's boundary) is
+/// at least `min`, cut exactly at the crossings, each with the ways on from its cut ends
+/// along the line by [`bead_end_reach`] for beads `width` wide: the boundary lies where
+/// `other` falls to zero (or the line ends), the room is half the way to where `other`
+/// climbs back to `min` (the next piece). `len` is the length on the surface between two
+/// chart points.
+pub fn clip_reaching(
+    line: &IsoLine,
+    min: f64,
+    width: f64,
+    len: impl Fn(Point2, Point2) -> f64,
+) -> Vec<Piece> {
+    let n = line.q.len();
+    let lerp = |a: Point2, b: Point2, t: f64| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+    // The way on from a cut in segment `i` (between points i and i+1) at the cut point `x`,
+    // forwards or backwards: the line's points beyond it up to the reach, not `x` itself.
+    let run_on = |i: usize, x: Point2, forward: bool| -> Vec<Point2> {
+        let mut pts = vec![];
+        let (mut at, mut walked, mut prev_d) = (x, 0.0, min);
+        let mut k = if forward { i + 1 } else { i };
+        let (mut boundary, mut room) = (f64::INFINITY, f64::INFINITY);
+        let mut steps: Vec<(Point2, f64)> = vec![];
+        while k < n && walked < 2.0 * MAX_END_REACH * width {
+            let (q, d) = (line.q[k], line.other[k]);
+            let l = len(at, q);
+            if !l.is_finite() {
+                break;
+            }
+            if d <= 0.0 {
+                let t = if prev_d > d {
+                    prev_d / (prev_d - d)
+                } else {
+                    1.0
+                };
+                boundary = walked + t * l;
+                break;
+            }
+            if d >= min {
+                let t = if d > prev_d {
+                    (min - prev_d) / (d - prev_d)
+                } else {
+                    0.0
+                };
+                room = 0.5 * (walked + t.clamp(0.0, 1.0) * l);
+                break;
+            }
+            walked += l;
+            steps.push((q, walked));
+            at = q;
+            prev_d = d;
+            if forward {
+                k += 1;
+            } else if k == 0 {
+                break;
+            } else {
+                k -= 1;
+            }
+        }
+        if boundary.is_infinite() && room.is_infinite() && walked < 2.0 * MAX_END_REACH * width {
+            // The line ends (on the mesh's edge) before either.
+            boundary = walked;
+        }
+        let r = bead_end_reach(width, boundary, room);
+        let (mut from, mut done) = (x, 0.0);
+        for &(q, w) in &steps {
+            if w >= r {
+                let seg = w - done;
+                let t = if seg > 0.0 { (r - done) / seg } else { 1.0 };
+                pts.push(lerp(from, q, t.clamp(0.0, 1.0)));
+                return pts;
+            }
+            pts.push(q);
+            from = q;
+            done = w;
+        }
+        if r > done {
+            // The reach ends inside the step the walk stopped in (towards point `k`).
+            if let Some(&q) = line.q.get(k) {
+                let l = len(from, q);
+                if l > 0.0 && l.is_finite() {
+                    pts.push(lerp(from, q, ((r - done) / l).clamp(0.0, 1.0)));
+                }
+            }
+        }
+        pts
+    };
     let mut out = vec![];
-    let mut cur: Vec<Point2> = vec![];
-    for i in 0..line.q.len() {
+    let mut cur = Piece::default();
+    for i in 0..n {
         let inside = line.other[i] >= min;
         if i > 0 {
             let (a, b) = (line.other[i - 1], line.other[i]);
             if (a >= min) != inside {
                 let t = ((min - a) / (b - a)).clamp(0.0, 1.0);
-                let (qa, qb) = (line.q[i - 1], line.q[i]);
-                let x = [qa[0] + (qb[0] - qa[0]) * t, qa[1] + (qb[1] - qa[1]) * t];
-                cur.push(x);
-                if !inside {
+                let x = lerp(line.q[i - 1], line.q[i], t);
+                cur.body.push(x);
+                if inside {
+                    // Entering: the way back out, reversed, leads up to the cut.
+                    let mut back = run_on(i - 1, x, false);
+                    back.reverse();
+                    cur.head = back;
+                } else {
+                    cur.tail = run_on(i - 1, x, true);
                     out.push(std::mem::take(&mut cur));
                 }
             }
         }
         if inside {
-            cur.push(line.q[i]);
+            cur.body.push(line.q[i]);
         }
     }
     out.push(cur);
-    out.retain(|p| p.len() >= 2);
+    out.retain(|p| p.body.len() >= 2);
     out
 }
 
@@ -692,16 +816,38 @@ mod tests {
     }
 
     #[test]
-    fn clipping_cuts_at_the_crossings() {
+    fn clipping_cuts_at_the_crossings_and_runs_on_to_the_boundary() {
+        let flat = |a: Point2, b: Point2| (a[0] - b[0]).hypot(a[1] - b[1]);
+        // `other` falls to 0 (the boundary) at both ends of the line.
         let line = IsoLine {
             q: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]],
             other: vec![0.0, 1.0, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_above(&line, 0.5);
+        let pieces = clip_reaching(&line, 0.5, 0.45, flat);
         assert_eq!(pieces.len(), 1);
-        assert_eq!(pieces[0].first(), Some(&[0.5, 0.0]));
-        assert_eq!(pieces[0].last(), Some(&[2.5, 0.0]));
+        let p = &pieces[0];
+        assert_eq!(p.body, vec![[0.5, 0.0], [1.0, 0.0], [2.0, 0.0], [2.5, 0.0]]);
+        // On to a hundredth of a bead before the boundary.
+        let m = crate::fill::END_MARGIN * 0.45;
+        assert_eq!(p.head.len(), 1);
+        assert!((p.head[0][0] - m).abs() < 1e-12, "{:?}", p.head);
+        assert!((p.tail[0][0] - (3.0 - m)).abs() < 1e-12, "{:?}", p.tail);
+        let reversed = p.clone().reversed();
+        assert_eq!(reversed.head, p.tail);
+        assert_eq!(reversed.clone().reaching().len(), 6);
+        // A dip that does not reach the boundary: the two pieces run on to meet halfway.
+        let line = IsoLine {
+            q: (0..5).map(|i| [i as f64, 0.0]).collect(),
+            other: vec![0.0, 1.0, 0.2, 1.0, 0.0],
+            closed: false,
+        };
+        let pieces = clip_reaching(&line, 0.5, 0.45, flat);
+        assert_eq!(pieces.len(), 2);
+        let (a, b) = (&pieces[0], &pieces[1]);
+        assert!((a.body[a.body.len() - 1][0] - 1.625).abs() < 1e-12);
+        assert_eq!(a.tail.last(), Some(&[2.0, 0.0]));
+        assert_eq!(b.head.first(), Some(&[2.0, 0.0]));
     }
 
     #[test]

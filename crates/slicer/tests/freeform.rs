@@ -72,6 +72,38 @@ impl Near {
     }
 }
 
+/// The distance from `p` to the nearest triangle of `mesh`.
+fn distance_to_mesh(mesh: &Mesh, p: &P3) -> f64 {
+    let seg = |a: &P3, b: &P3| {
+        let ab = b - a;
+        let t = ((p - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+        (p - (a + ab * t)).norm()
+    };
+    mesh.triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let nrm = (b - a).cross(&(c - a));
+            let edges = seg(&a, &b).min(seg(&b, &c)).min(seg(&c, &a));
+            if nrm.norm() < 1e-15 {
+                return edges;
+            }
+            let nu = nrm / nrm.norm();
+            let h = (p - a).dot(&nu);
+            let q = p - nu * h;
+            // Inside the triangle: the normal distance; else the nearest edge.
+            let inside = [(a, b), (b, c), (c, a)]
+                .iter()
+                .all(|(u, v)| (v - u).cross(&(q - u)).dot(&nrm) >= 0.0);
+            if inside {
+                h.abs()
+            } else {
+                edges
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 struct Checked {
     overhang_points: usize,
     layers: usize,
@@ -147,11 +179,26 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
                 ang < 1.0,
                 "{name} feature {k} point {i}: axis {ang}° off the normal"
             );
-            // The bead's middle is inside the feature.
+            // The bead's middle is inside the feature. Raster and zig-zag line ends with
+            // nothing to join run on to the layer region's boundary, which is sampled within
+            // the tolerance (issue: "exact boundary curves, sampled within tolerance"): there
+            // the middle may lie outside, but no farther than the chord tolerance of the mesh
+            // the planner cuts (a quarter of the tolerance; 6 µm seen on the capsule).
             let mid = x - n * (0.5 * p.thickness);
             if i % 7 == 0 {
                 let w = mesh.winding_number(&mid);
-                assert!(w > 0.5, "{name} feature {k} point {i} layer {} of {}: bead middle outside ({w}) at {:?}, prev {:?} {:?}", p.layer, fig.layers, p.p, pts[i-1].p, pts[i-1].kind);
+                let at = format!(
+                    "{name} feature {k} point {i} layer {} of {}: bead middle outside ({w}) at {:?}",
+                    p.layer, fig.layers, p.p
+                );
+                if matches!(params.path_mode, PathMode::Raster | PathMode::Zigzag) {
+                    if w <= 0.5 {
+                        let d = distance_to_mesh(&mesh, &mid);
+                        assert!(d <= 0.25 * params.tolerance, "{at}, {d} mm off the feature");
+                    }
+                } else {
+                    assert!(w > 0.5, "{at}");
+                }
             }
             if !check_support {
                 continue;
@@ -270,6 +317,9 @@ fn capsule_bosses_lie_on_cone_and_sphere_offsets_inside_supported_and_conserve_v
 
 #[test]
 fn every_path_mode_keeps_points_on_the_offsets_and_inside() {
+    // The default contour-zig-zag is checked above; each other mode also puts down each
+    // boss's volume within 2 % (raster and zig-zag line ends with nothing to join run on to
+    // the boundary).
     for mode in [PathMode::Raster, PathMode::Zigzag, PathMode::Contour] {
         let params = LayerParams {
             path_mode: mode,
@@ -278,9 +328,10 @@ fn every_path_mode_keeps_points_on_the_offsets_and_inside() {
         let c = check("capsule", &params, false);
         for x in &c {
             let r = x.extruded / x.volume;
-            // Raster leaves the half-bead band along the boundary by design.
-            let lo = if mode == PathMode::Raster { 0.85 } else { 0.97 };
-            assert!(r > lo && r < 1.03, "{mode:?}: extruded {r} of the volume");
+            assert!(
+                (r - 1.0).abs() < 0.02,
+                "{mode:?}: extruded {r} of the volume"
+            );
         }
     }
 }
