@@ -638,3 +638,129 @@ fn the_documented_process_file_is_accepted_and_smoothing_can_be_turned_off() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `features inspect --json` of `path`: each solid's bounding box.
+fn bboxes(path: &Path) -> Vec<[[f64; 3]; 2]> {
+    let out = Command::new(BIN)
+        .args(["inspect", "--json"])
+        .arg(path)
+        .output()
+        .expect("runs");
+    assert!(out.status.success());
+    let v: Value = serde_json::from_slice(&out.stdout).expect("json");
+    v["solids"]
+        .as_array()
+        .expect("solids")
+        .iter()
+        .map(|s| {
+            let c = |i: usize, k: usize| s["bbox"][i][k].as_f64().expect("bbox");
+            [[c(0, 0), c(0, 1), c(0, 2)], [c(1, 0), c(1, 1), c(1, 2)]]
+        })
+        .collect()
+}
+
+#[test]
+fn a_part_with_no_planar_face_down_rests_on_its_lowest_point() {
+    // The torus lies flat; its one vertex is on the outer equator, half way up. The build
+    // plate goes under its lowest point, not under that vertex: all of it is printed.
+    let [lo, hi] = bboxes(&fixture("torus.step"))[0];
+    let (_dir, plan, csv, _) = plan("torus", &[]);
+    let f = &plan["features"][0];
+    let r = f["extruded_volume_mm3"].as_f64().unwrap() / f["volume_mm3"].as_f64().unwrap();
+    assert!((r - 1.0).abs() < 0.02, "extruded {r} of the volume");
+    let h = 0.2;
+    let layers = f["layers"].as_u64().unwrap() as f64;
+    assert!(
+        (layers - ((hi[2] - lo[2]) / h).round()).abs() <= 1.0,
+        "{layers} layers for {} mm",
+        hi[2] - lo[2]
+    );
+    let z: Vec<f64> = rows(&csv)
+        .iter()
+        .filter(|r| r.print)
+        .map(|r| r.p[2])
+        .collect();
+    let zmin = z.iter().copied().fold(f64::INFINITY, f64::min);
+    let zmax = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        (zmin - (lo[2] + h)).abs() < 0.02,
+        "first layer top at {zmin}"
+    );
+    assert!(zmax > hi[2] - h - 0.02, "last layer top at {zmax}");
+    let warned = plan["warnings"].as_array().unwrap();
+    assert!(
+        !warned
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("below the build plate")),
+        "{warned:?}"
+    );
+}
+
+#[test]
+fn a_feature_reaching_below_the_build_plate_is_named_with_its_depth() {
+    // SolidWorks' leg fork: its lowest face pointing down is the build plate, but a rounded
+    // end reaches on below it, between that face's vertices' height and the part's lowest
+    // point. The warning names the feature and the depth: from the plate (the first layer's
+    // top less a layer) down to the part's bounding box.
+    let part =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/sw2017_leg_fork.step");
+    if !part.exists() {
+        eprintln!("skipped: {} is not there", part.display());
+        return;
+    }
+    let [lo, _] = bboxes(&part)[0];
+    let dir = std::env::temp_dir().join(format!("features-plan-below-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(&part)
+        .arg("-o")
+        .arg(&dir)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _cleanup = Out(dir.clone());
+    let plan: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"))
+            .expect("json");
+    let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("csv");
+    let first_top = rows(&csv)
+        .iter()
+        .filter(|r| r.print && r.layer == 0)
+        .map(|r| r.p[2])
+        .fold(f64::INFINITY, f64::min);
+    let plate = first_top - 0.2;
+    let expected = plate - lo[2];
+    assert!(
+        expected > 1.0,
+        "the part reaches {expected} mm below its plate"
+    );
+    let w: Vec<&str> = plan["features"][0]["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .filter(|w| w.contains("below the build plate"))
+        .collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    let depth: f64 = w[0]
+        .strip_prefix("feature 0 reaches ")
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{}", w[0]));
+    assert!(
+        (depth - expected).abs() < 0.02,
+        "{depth} mm, expected {expected}"
+    );
+    // Also among the plan's warnings and on stderr.
+    assert!(plan["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|x| x.as_str() == Some(w[0])));
+    assert!(String::from_utf8_lossy(&out.stderr).contains(w[0]));
+}

@@ -116,6 +116,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let mut warnings: Vec<String> = vec![];
     let mut offset = 0usize;
     for t in &trees {
+        let plate = t
+            .features
+            .first()
+            .and_then(|b| slicer::planar::reference_plane(t, b));
         for &k in &t.build_order {
             let f = &t.features[k];
             let id = offset + f.id;
@@ -188,16 +192,15 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
                 );
             }
             let mut fw = fig.warnings.clone();
-            // Below the build plate: the base feature's reference plane.
-            if let Some(plate) = t
-                .features
-                .first()
-                .and_then(|b| slicer::planar::reference_plane(t, b))
-            {
-                let depth = points[start..]
+            // Below the build plate (the base feature's reference plane): any point of the
+            // feature, planned or not (a planar layer starts at its reference plane, so what
+            // lies below that is not printed).
+            if let Some(plate) = &plate {
+                let planned = points[start..]
                     .iter()
                     .map(|q| -plate.height(&brep::math::P3::from(q.p)))
                     .fold(0.0f64, f64::max);
+                let depth = planned.max(slicer::planar::depth_below(t, f, plate));
                 if depth > 1e-3 {
                     let w = format!("feature {id} reaches {depth:.3} mm below the build plate");
                     fw.push(w.clone());
@@ -310,6 +313,11 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         .iter()
         .filter_map(|v| v["extruded_volume_mm3"].as_f64())
         .sum();
+    // The plan's warnings (a feature below the build plate, overhangs, ...) on stderr too,
+    // one line each, so a run in a terminal shows them, not only plan.json.
+    for w in &warnings {
+        eprintln!("features: {}: warning: {w}", path.display());
+    }
     emit(&format!(
         "{}: {} feature(s), {} points, {:.1} mm printed, {:.1} mm^3 extruded -> {}\n",
         path.display(),

@@ -125,21 +125,55 @@ impl FeatureFigures {
 pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
     let n = f.reference.normal.map(|n| V3::new(n[0], n[1], n[2]))?;
     let b = &tree.brep;
-    // A point of the reference: a vertex of the reference face; else the feature's lowest point.
+    // A point of the reference: a vertex of the reference face; else the feature's lowest
+    // point, on its surfaces (a torus or a cylinder lying on its side is lowest between its
+    // vertices, which may all lie at its middle height).
     let face = f.heal_faces.first().copied().or(f.reference.face);
-    let p = face
-        .and_then(|fc| {
-            b.vertices_of(&[fc])
-                .first()
-                .map(|v| b.vertices[v.idx()].point)
-        })
-        .or_else(|| {
-            b.vertices_of(&f.faces)
-                .iter()
-                .map(|v| b.vertices[v.idx()].point)
-                .min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
-        })?;
+    let lowest = |pts: &mut dyn Iterator<Item = P3>| {
+        pts.min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
+    };
+    let p = match face {
+        Some(fc) => b
+            .vertices_of(&[fc])
+            .first()
+            .map(|v| b.vertices[v.idx()].point),
+        None => lowest(&mut surface_points(tree, f).into_iter()).or_else(|| {
+            lowest(
+                &mut b
+                    .vertices_of(&f.faces)
+                    .into_iter()
+                    .map(|v| b.vertices[v.idx()].point),
+            )
+        }),
+    }?;
     Some(Plane::new(p, n))
+}
+
+/// Chord tolerance (mm) of the mesh that finds how low a feature reaches.
+const EXTREME_TOL: f64 = 0.01;
+
+/// Points of a feature's faces, on their exact surfaces, no farther apart than a chord
+/// tolerance of [`EXTREME_TOL`] allows: where a curved face reaches lowest between its
+/// vertices, one of them lies within that of the lowest point. Empty if the faces do not
+/// mesh.
+fn surface_points(tree: &FeatureTree, f: &Feature) -> Vec<P3> {
+    mesh_faces(
+        &tree.brep,
+        &f.faces,
+        &MeshOptions::with_tolerance(EXTREME_TOL),
+    )
+    .map(|m| m.positions)
+    .unwrap_or_default()
+}
+
+/// How far (mm) feature `f` reaches below `plane` (the build plate): 0 when it does not.
+/// Measured on its faces' surfaces, not its vertices, so a curved face dipping below the
+/// plate between its vertices counts; within [`EXTREME_TOL`].
+pub fn depth_below(tree: &FeatureTree, f: &Feature, plane: &Plane) -> f64 {
+    surface_points(tree, f)
+        .iter()
+        .map(|p| -plane.height(p))
+        .fold(0.0f64, f64::max)
 }
 
 /// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
