@@ -286,6 +286,13 @@ fn region_shapes(region: &Region) -> Shapes {
     }
 }
 
+/// True when no point of `region` lies `depth` or more inside its boundary (its inward offset
+/// by `depth` is empty): a region too thin for that many beads side by side.
+pub fn thinner_than(region: &Region, depth: f64) -> bool {
+    let base = region_shapes(region);
+    base.is_empty() || erode(&base, depth, &round_join(0.01 * depth, depth)).is_empty()
+}
+
 /// Join for inward offsets: reflex corners of the region become arcs, chorded within `tol` up
 /// to radius `radius` (the deepest offset the fill will make).
 fn round_join(tol: f64, radius: f64) -> LineJoin<f64> {

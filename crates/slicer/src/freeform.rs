@@ -550,23 +550,61 @@ fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, PlanError>
     Ok(m)
 }
 
-/// One path of a curved layer in chart coordinates, with the bead width at each point.
+/// One path of a curved layer in chart coordinates (or of a planar layer in its plane's),
+/// with the bead width at each point.
 #[derive(Debug, Clone, Default)]
-struct FillPath {
-    points: Vec<Point2>,
-    widths: Vec<f64>,
+pub struct FillPath {
+    /// Bead centre line.
+    pub points: Vec<Point2>,
+    /// Bead width at each point, mm.
+    pub widths: Vec<f64>,
 }
 
 impl FillPath {
-    fn uniform(points: Vec<Point2>, width: f64) -> Self {
+    /// A path of one bead width throughout.
+    pub fn uniform(points: Vec<Point2>, width: f64) -> Self {
         let widths = vec![width; points.len()];
         FillPath { points, widths }
     }
 
-    fn reverse(&mut self) {
+    /// The same path run the other way.
+    pub fn reverse(&mut self) {
         self.points.reverse();
         self.widths.reverse();
     }
+}
+
+/// Paths of a region of a planar layer (in its plane's 2-D coordinates) filled as the regions
+/// of curved layers are: rings and raster lines as iso-lines of the exact distance to the
+/// boundary, where rings leave a strip narrower than a bead a gap fill as wide as the strip
+/// at each point, and spurs into sharp corners. The planar planner fills its thin regions so
+/// (a blade's or a rib's section), where offsetting rings of one width would overlap their
+/// own beads or drop what is narrower than a bead.
+pub fn fill_flat_region(
+    region: &Region,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+) -> Vec<FillPath> {
+    let plane = Surface::Plane {
+        frame: brep::math::Frame::world(P3::origin()),
+    };
+    // The plane's own (u, v) at scale 1 is the identity on the layer's 2-D coordinates.
+    let chart = Chart {
+        surf: &plane,
+        sign: 1.0,
+        kind: ChartKind::Native {
+            u0: 0.0,
+            v0: 0.0,
+            su: 1.0,
+            sv: 1.0,
+        },
+    };
+    let mut paths = fill_region(&chart, region, 0.0, params, layer, width, spacing);
+    paths.extend(corner_spurs(&chart, region, 0.0, width));
+    paths.retain(|p| p.points.len() >= 2);
+    paths
 }
 
 /// Paths of one region of a curved layer at offset `z`, in chart coordinates.
@@ -601,22 +639,61 @@ fn fill_region(
         (0usize, 0.0f64),
         |a, (i, &d)| if d > a.1 { (i, d) } else { a },
     );
-    // Rings: iso-lines of the distance to the boundary, half a bead in, then a spacing apart;
-    // a ring whose two sides would pinch closer than half a bead at the ridge is left out.
+    // Rings: iso-lines of the distance to the boundary, half a bead in, then a spacing apart.
+    // Where the region is too narrow for a ring's bead and its mirror image from the other
+    // side (the ridge of the distance, the region's half width R there, is less than the
+    // ring's inner bead edge), the ring narrows to what is left between its outer bead edge
+    // and the ridge, `R − (c − w/2)`, extruded for that width by Eq. 1: the two sides then
+    // put down the strip's volume instead of overlapping (a blade section 0.8 mm wide took
+    // two full 0.45 mm beads). Where what is left is wider than a bead by less than the gap
+    // fill's narrowest bead, the ring widens to take it. A ring less than a tenth of a bead
+    // below the deepest point is left out.
     let rings = match params.path_mode {
         PathMode::Raster | PathMode::Zigzag => 0,
         PathMode::Contour => usize::MAX,
         PathMode::ContourZigzag => params.perimeters,
     };
+    let ridge = if rings > 0 && dmax > 0.5 * width {
+        lm.local_max(&db, 1.5 * spacing, &vec![true; db.len()])
+    } else {
+        vec![]
+    };
     let mut last_ring = None;
     let mut j = 0usize;
     while j < rings {
         let c = 0.5 * width + j as f64 * spacing;
-        if c > dmax - 0.25 * width {
+        if c > dmax - 0.1 * width {
             break;
         }
-        for line in lm.iso_lines(&db, c, &db) {
-            out.push(FillPath::uniform(line.q, width));
+        let edge = c - 0.5 * width;
+        if j > 0 {
+            // Where this ring does not reach (the region's half width is under `c` there),
+            // the strip the ring before leaves along the ridge gets its gap fill.
+            let gap = Gap {
+                edge,
+                inset: 0.02 * width,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: c,
+            };
+            out.extend(gap_fill(&lm, &db, &ridge, gap, width));
+        }
+        for line in lm.iso_lines(&db, c, &ridge) {
+            let widths = line
+                .other
+                .iter()
+                .map(|r| {
+                    let room = r - edge;
+                    if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
+                        room.max(0.2 * width)
+                    } else {
+                        width
+                    }
+                })
+                .collect();
+            out.push(FillPath {
+                points: line.q,
+                widths,
+            });
         }
         last_ring = Some(c);
         j += 1;
@@ -630,30 +707,28 @@ fn fill_region(
         Some(c) => {
             // The strip along the ridge that the last ring's bead leaves.
             let edge = c + 0.5 * width;
-            out.extend(gap_fill(
-                &lm,
-                &db,
+            let gap = Gap {
                 edge,
-                0.02 * width,
-                0.1 * width,
-                width,
-                spacing,
-            ));
+                inset: 0.02 * width,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: f64::INFINITY,
+            };
+            let ridge = ridge_beyond(&lm, &db, edge, spacing);
+            out.extend(gap_fill(&lm, &db, &ridge, gap, width));
             return out;
         }
         // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
         // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
         // inside it, down to a fifth of a bead wide.
         None if rings > 0 || dmax <= 0.5 * width => {
-            out.extend(gap_fill(
-                &lm,
-                &db,
-                0.0,
-                0.1 * width,
-                0.2 * width,
-                width,
-                spacing,
-            ));
+            let gap = Gap {
+                edge: 0.0,
+                inset: 0.1 * width,
+                min_width: 0.2 * width,
+                below: f64::INFINITY,
+            };
+            let ridge = ridge_beyond(&lm, &db, 0.0, spacing);
+            out.extend(gap_fill(&lm, &db, &ridge, gap, width));
             return out;
         }
         None => 0.5 * width,
@@ -809,37 +884,49 @@ fn surface_length(chart: &Chart, d: f64, a: Point2, b: Point2) -> f64 {
     }
 }
 
-/// Gap fill: the strip of a region farther than `edge` from its boundary (`db`, the distance
-/// to the boundary) but too narrow for a bead: its local half width β is the ridge height of
-/// `db` above `edge` (seen from the strip's flanks). The fill is one loop round the ridge,
-/// `inset` inside the strip's edge (an iso-line of `db`), each point β wide and extruded for
-/// that width by Eq. 1: the two flanks together put down the strip's volume. Stretches
-/// narrower than `min_width` are dropped where the strip pinches out.
-fn gap_fill(
-    lm: &LayerMesh,
-    db: &[f64],
+/// Where a gap fill runs: from `edge` (the distance to the region's boundary where the beads
+/// outside it stop), its beads' middles `inset` further in, no narrower than `min_width`, and
+/// only where the ridge of the distance is below `below` (deeper, the next ring takes over).
+#[derive(Debug, Clone, Copy)]
+struct Gap {
     edge: f64,
     inset: f64,
     min_width: f64,
-    width: f64,
-    spacing: f64,
-) -> Vec<FillPath> {
+    below: f64,
+}
+
+/// The local ridge height of `db` seen from the flanks of the strip beyond `edge`.
+fn ridge_beyond(lm: &LayerMesh, db: &[f64], edge: f64, spacing: f64) -> Vec<f64> {
+    let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
+    lm.local_max(db, 1.5 * spacing, &mask)
+}
+
+/// Gap fill: the strip of a region farther than `gap.edge` from its boundary (`db`, the
+/// distance to the boundary) but too narrow for a bead: its local half width β is the ridge
+/// height (`ridge`, [`ridge_beyond`]) of `db` above the edge. The fill is one loop round the
+/// ridge, `gap.inset` inside the strip's edge (an iso-line of `db`), each point β wide and
+/// extruded for that width by Eq. 1: the two flanks together put down the strip's volume.
+/// Stretches narrower than `gap.min_width`, or where the ridge reaches `gap.below`, are left
+/// out.
+fn gap_fill(lm: &LayerMesh, db: &[f64], ridge: &[f64], gap: Gap, width: f64) -> Vec<FillPath> {
     let mut out = vec![];
     let dmax = db
         .iter()
         .copied()
         .filter(|d| d.is_finite())
         .fold(0.0f64, f64::max);
-    if dmax <= edge + inset.max(0.05 * width) {
+    if dmax <= gap.edge + gap.inset.max(0.05 * width) {
         return out;
     }
-    let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
-    let ridge = lm.local_max(db, 1.5 * spacing, &mask);
-    for line in lm.iso_lines(db, edge + inset, &ridge) {
+    for line in lm.iso_lines(db, gap.edge + gap.inset, ridge) {
         let mut cur = FillPath::default();
         for (q, r) in line.q.iter().zip(&line.other) {
-            let w = (r - edge).clamp(0.0, width);
-            if w >= min_width {
+            let w = if *r < gap.below {
+                (r - gap.edge).clamp(0.0, width)
+            } else {
+                0.0
+            };
+            if w >= gap.min_width {
                 cur.points.push(*q);
                 cur.widths.push(w);
             } else if cur.points.len() >= 2 {
@@ -854,6 +941,10 @@ fn gap_fill(
     }
     out
 }
+
+/// The narrowest gap fill between rings, in bead widths: a ring with less than this left
+/// beyond its bead widens to take it.
+const GAP_MIN_WIDTH_SHARE: f64 = 0.1;
 
 /// Distances to a layer region's boundary are exact (not marched) this many spacings deep.
 const SEED_DEPTH: f64 = 3.0;
@@ -1509,6 +1600,40 @@ mod tests {
                         assert!(r < 6.0 - 0.004 * 0.45, "{mode:?}: {q:?} outside");
                     } else {
                         assert!(r < 6.0 - 0.2, "{mode:?}: {q:?} outside the bead inset");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn thin_strips_of_a_planar_layer_are_filled_to_their_width() {
+        // Strips from under half a bead to a few beads wide, slanted to the lattice. Offsets
+        // of one bead width overlapped their own beads in a strip 0.6 mm wide (148 % of its
+        // area) and left the middle of one 1.35 mm wide (68 %); the rings now narrow to the
+        // room the strip has and gap fill takes what is left along the ridge.
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let rot = |x: f64, y: f64| [x * c - y * s, x * s + y * c];
+        for wd in [0.3, 0.45, 0.6, 0.8, 1.0, 1.24, 1.35, 1.6, 2.0, 2.4, 3.0] {
+            let region = Region {
+                outer: vec![rot(0.0, 0.0), rot(30.0, 0.0), rot(30.0, wd), rot(0.0, wd)],
+                holes: vec![],
+            };
+            for mode in [PathMode::ContourZigzag, PathMode::Contour] {
+                let params = LayerParams {
+                    path_mode: mode,
+                    ..LayerParams::default()
+                };
+                let paths = fill_flat_region(&region, &params, 0, 0.45, 0.45);
+                let r = covered_area(&paths) / (30.0 * wd);
+                assert!((0.95..1.06).contains(&r), "{wd} mm, {mode:?}: {r:.4}");
+                for p in &paths {
+                    assert_eq!(p.points.len(), p.widths.len());
+                    for (q, w) in p.points.iter().zip(&p.widths) {
+                        // Back in the strip's frame: the bead's middle inside the strip.
+                        let y = -q[0] * s + q[1] * c;
+                        assert!(y > 0.0 && y < wd, "{wd} mm: {q:?} outside");
+                        assert!(*w > 0.0 && *w <= 0.45 * 1.1 + 1e-12, "{wd} mm: width {w}");
                     }
                 }
             }

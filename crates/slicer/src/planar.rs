@@ -6,7 +6,8 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
-use crate::fill::{fill_layer, order_paths, regions_from_loops};
+use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
+use crate::freeform::{fill_flat_region, FillPath};
 use crate::params::LayerParams;
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
@@ -176,6 +177,14 @@ pub fn depth_below(tree: &FeatureTree, f: &Feature, plane: &Plane) -> f64 {
         .fold(0.0f64, f64::max)
 }
 
+/// How deep (mm) a planar region must reach inside its boundary to be filled by offsets of
+/// one bead width (`fill::fill_layer`): room for the first ring's half bead, the perimeters
+/// (at least one) and one more spacing for the infill or the next ring. Thinner regions get
+/// `freeform::fill_flat_region`.
+fn thin_depth(params: &LayerParams, width: f64, spacing: f64) -> f64 {
+    0.5 * width + (params.perimeters.max(1) as f64) * spacing
+}
+
 /// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
 /// chords are what the sections see.
 pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
@@ -242,10 +251,21 @@ pub fn plan_two5d(
             continue;
         }
         let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-        let paths = order_paths(
-            fill_layer(&regions, params, layer, bead.width, spacing),
-            start,
-        );
+        // Regions too thin for the rings (and infill) of offsets of one bead width, where
+        // those would overlap or drop beads, are filled by the exact distance to their
+        // boundary with beads as wide as the region there (`freeform::fill_flat_region`);
+        // the others by `fill::fill_layer`.
+        let (thin, thick): (Vec<Region>, Vec<Region>) = regions
+            .into_iter()
+            .partition(|r| thinner_than(r, thin_depth(params, bead.width, spacing)));
+        let mut paths: Vec<FillPath> = fill_layer(&thick, params, layer, bead.width, spacing)
+            .into_iter()
+            .map(|p| FillPath::uniform(p.points, bead.width))
+            .collect();
+        for r in &thin {
+            paths.extend(fill_flat_region(r, params, layer, bead.width, spacing));
+        }
+        let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
         if paths.is_empty() {
             continue;
         }
@@ -265,11 +285,13 @@ pub fn plan_two5d(
                 axis,
                 e: 0.0,
                 thickness: dl,
-                width: bead.width,
+                width: path.widths[0],
             });
-            for w in pts.windows(2) {
+            for (i, w) in pts.windows(2).enumerate() {
                 let l = (w[1] - w[0]).norm();
-                let e = filament_length(bead.width, dl, l, bead.filament_diameter);
+                // Eq. 1 with the bead's width along the segment.
+                let width = 0.5 * (path.widths[i] + path.widths[i + 1]);
+                let e = filament_length(width, dl, l, bead.filament_diameter);
                 fig.print_length += l;
                 fig.filament += e;
                 out.push(PathPoint {
@@ -280,7 +302,7 @@ pub fn plan_two5d(
                     axis,
                     e,
                     thickness: dl,
-                    width: bead.width,
+                    width: path.widths[i + 1],
                 });
             }
             *cursor = pts.last().copied();
