@@ -653,25 +653,33 @@ fn fill_region(
         PathMode::Contour => usize::MAX,
         PathMode::ContourZigzag => params.perimeters,
     };
-    let ridge = if rings > 0 && dmax > 0.5 * width {
-        lm.local_max(&db, 1.5 * spacing, &vec![true; db.len()])
-    } else {
+    let levels: Vec<f64> = (0..rings)
+        .map(|j| 0.5 * width + j as f64 * spacing)
+        .take_while(|c| *c <= dmax - 0.1 * width)
+        .collect();
+    let gap_inset = 0.02 * width;
+    // The ridge is needed only where the rings' iso-lines and the gap fills between them run:
+    // at both ends of each lattice edge those levels cross.
+    let ridge = if levels.is_empty() {
         vec![]
+    } else {
+        let wanted: Vec<f64> = levels
+            .iter()
+            .copied()
+            .chain(levels.iter().skip(1).map(|c| c - 0.5 * width + gap_inset))
+            .collect();
+        let mask = crossing_vertices(&lm, &db, &wanted);
+        lm.local_max(&db, 1.5 * spacing, &mask)
     };
     let mut last_ring = None;
-    let mut j = 0usize;
-    while j < rings {
-        let c = 0.5 * width + j as f64 * spacing;
-        if c > dmax - 0.1 * width {
-            break;
-        }
+    for (j, &c) in levels.iter().enumerate() {
         let edge = c - 0.5 * width;
         if j > 0 {
             // Where this ring does not reach (the region's half width is under `c` there),
             // the strip the ring before leaves along the ridge gets its gap fill.
             let gap = Gap {
                 edge,
-                inset: 0.02 * width,
+                inset: gap_inset,
                 min_width: GAP_MIN_WIDTH_SHARE * width,
                 below: c,
             };
@@ -696,7 +704,6 @@ fn fill_region(
             });
         }
         last_ring = Some(c);
-        j += 1;
     }
     // Infill where the rings stop: lines end a spacing past the last ring, joined along that
     // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
@@ -713,7 +720,7 @@ fn fill_region(
                 min_width: GAP_MIN_WIDTH_SHARE * width,
                 below: f64::INFINITY,
             };
-            let ridge = ridge_beyond(&lm, &db, edge, spacing);
+            let ridge = ridge_for(&lm, &db, gap, spacing);
             out.extend(gap_fill(&lm, &db, &ridge, gap, width));
             return out;
         }
@@ -727,7 +734,7 @@ fn fill_region(
                 min_width: 0.2 * width,
                 below: f64::INFINITY,
             };
-            let ridge = ridge_beyond(&lm, &db, 0.0, spacing);
+            let ridge = ridge_for(&lm, &db, gap, spacing);
             out.extend(gap_fill(&lm, &db, &ridge, gap, width));
             return out;
         }
@@ -895,15 +902,33 @@ struct Gap {
     below: f64,
 }
 
-/// The local ridge height of `db` seen from the flanks of the strip beyond `edge`.
-fn ridge_beyond(lm: &LayerMesh, db: &[f64], edge: f64, spacing: f64) -> Vec<f64> {
-    let mask: Vec<bool> = db.iter().map(|d| *d >= edge - 0.5 * spacing).collect();
+/// Marks both ends of every lattice edge that one of `levels` of `db` crosses: the vertices
+/// an iso-line at those levels interpolates between.
+fn crossing_vertices(lm: &LayerMesh, db: &[f64], levels: &[f64]) -> Vec<bool> {
+    let mut mask = vec![false; db.len()];
+    for t in &lm.tris {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            if levels.iter().any(|l| (db[a] - l) * (db[b] - l) <= 0.0) {
+                mask[a] = true;
+                mask[b] = true;
+            }
+        }
+    }
+    mask
+}
+
+/// The local ridge height of `db` (within one and a half spacings) seen from the flanks of
+/// the strip beyond `gap.edge`, where the gap fill's iso-line needs it: at the vertices it
+/// interpolates between.
+fn ridge_for(lm: &LayerMesh, db: &[f64], gap: Gap, spacing: f64) -> Vec<f64> {
+    let mask = crossing_vertices(lm, db, &[gap.edge + gap.inset]);
     lm.local_max(db, 1.5 * spacing, &mask)
 }
 
 /// Gap fill: the strip of a region farther than `gap.edge` from its boundary (`db`, the
 /// distance to the boundary) but too narrow for a bead: its local half width β is the ridge
-/// height (`ridge`, [`ridge_beyond`]) of `db` above the edge. The fill is one loop round the
+/// height (`ridge`, [`ridge_for`]) of `db` above the edge. The fill is one loop round the
 /// ridge, `gap.inset` inside the strip's edge (an iso-line of `db`), each point β wide and
 /// extruded for that width by Eq. 1: the two flanks together put down the strip's volume.
 /// Stretches narrower than `gap.min_width`, or where the ridge reaches `gap.below`, are left
