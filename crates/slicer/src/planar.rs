@@ -8,7 +8,7 @@
 
 use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
 use crate::freeform::{fill_flat_region, FillPath};
-use crate::params::LayerParams;
+use crate::params::{LayerParams, PathMode};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
@@ -255,9 +255,15 @@ pub fn plan_two5d(
         // those would overlap or drop beads, are filled by the exact distance to their
         // boundary with beads as wide as the region there (`freeform::fill_flat_region`);
         // the others by `fill::fill_layer`.
+        // (Raster and zig-zag lines run boundary to boundary whatever the width: only the
+        // modes with rings need this.)
+        let rings = matches!(
+            params.path_mode,
+            PathMode::Contour | PathMode::ContourZigzag
+        );
         let (thin, thick): (Vec<Region>, Vec<Region>) = regions
             .into_iter()
-            .partition(|r| thinner_than(r, thin_depth(params, bead.width, spacing)));
+            .partition(|r| rings && thinner_than(r, thin_depth(params, bead.width, spacing)));
         let mut paths: Vec<FillPath> = fill_layer(&thick, params, layer, bead.width, spacing)
             .into_iter()
             .map(|p| FillPath::uniform(p.points, bead.width))
