@@ -799,11 +799,17 @@ fn fill_region(
     // Levels half a spacing off the seed curve, then a spacing apart.
     let j0 = (lo / spacing - 0.5).floor() as i64;
     let j1 = (hi / spacing - 0.5).ceil() as i64;
+    // A line end with no connector or ring to meet runs on to the boundary, so the line's
+    // strip of the region is filled up to it (`fill::bead_end_reach`, as on planar layers):
+    // every raster end, and the two free ends of each zig-zag chain. Contour-zig-zag's lines
+    // end on the infill boundary, a spacing inside the last ring, as on planar layers: their
+    // ways on are not walked.
+    let reach = (rings == 0).then_some(width);
     let mut pieces: Vec<(i64, Piece)> = vec![];
     for j in j0..=j1 {
         let level = (j as f64 + 0.5) * spacing;
         for line in lm.iso_lines(&phi, level, &db) {
-            for piece in clip_reaching(&line, inner, width, |a, b| surface_length(chart, z, a, b)) {
+            for piece in clip_reaching(&line, inner, reach, |a, b| surface_length(chart, z, a, b)) {
                 let (a, b) = (piece.body[0], piece.body[piece.body.len() - 1]);
                 let piece = if (b[0] - a[0]) * dir[0] + (b[1] - a[1]) * dir[1] < 0.0 {
                     piece.reversed()
@@ -814,10 +820,6 @@ fn fill_region(
             }
         }
     }
-    // A line end with no connector or ring to meet runs on to the boundary, so the line's
-    // strip of the region is filled up to it (`fill::bead_end_reach`, as on planar layers):
-    // every raster end, and the two free ends of each zig-zag chain. Contour-zig-zag's lines
-    // end on the infill boundary, a spacing inside the last ring, as on planar layers.
     if !zig {
         out.extend(
             pieces
@@ -826,7 +828,6 @@ fn fill_region(
         );
         return out;
     }
-    let free_ends_reach = rings == 0;
     // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
     // infill boundary (the iso-line where the lines were cut), when that way is short.
     let border = lm.iso_lines(&db, inner, &db);
@@ -839,7 +840,7 @@ fn fill_region(
         used[s] = true;
         let first = &pieces[s].1;
         let (mut level, mut pts) = (pieces[s].0, first.body.clone());
-        if free_ends_reach {
+        if reach.is_some() {
             pts.splice(0..0, first.head.iter().copied());
         }
         let mut tail = first.tail.clone();
@@ -875,7 +876,7 @@ fn fill_region(
                 None => break,
             }
         }
-        if free_ends_reach {
+        if reach.is_some() {
             pts.extend(tail);
         }
         out.push(FillPath::uniform(pts, width));

@@ -641,11 +641,12 @@ impl Piece {
 /// along the line by [`bead_end_reach`] for beads `width` wide: the boundary lies where
 /// `other` falls to zero (or the line ends), the room is half the way to where `other`
 /// climbs back to `min` (the next piece). `len` is the length on the surface between two
-/// chart points.
+/// chart points. With `width` `None` (lines whose ends a connector or ring meets) the ways
+/// on are left empty and not walked.
 pub fn clip_reaching(
     line: &IsoLine,
     min: f64,
-    width: f64,
+    width: Option<f64>,
     len: impl Fn(Point2, Point2) -> f64,
 ) -> Vec<Piece> {
     let n = line.q.len();
@@ -653,6 +654,9 @@ pub fn clip_reaching(
     // The way on from a cut in segment `i` (between points i and i+1) at the cut point `x`,
     // forwards or backwards: the line's points beyond it up to the reach, not `x` itself.
     let run_on = |i: usize, x: Point2, forward: bool| -> Vec<Point2> {
+        let Some(width) = width else {
+            return vec![];
+        };
         let mut pts = vec![];
         let (mut at, mut walked, mut prev_d) = (x, 0.0, min);
         let mut k = if forward { i + 1 } else { i };
@@ -824,7 +828,7 @@ mod tests {
             other: vec![0.0, 1.0, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(&line, 0.5, 0.45, flat);
+        let pieces = clip_reaching(&line, 0.5, Some(0.45), flat);
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];
         assert_eq!(p.body, vec![[0.5, 0.0], [1.0, 0.0], [2.0, 0.0], [2.5, 0.0]]);
@@ -836,13 +840,18 @@ mod tests {
         let reversed = p.clone().reversed();
         assert_eq!(reversed.head, p.tail);
         assert_eq!(reversed.clone().reaching().len(), 6);
+        // Without a width, the same cut and no ways on.
+        let bare = clip_reaching(&line, 0.5, None, flat);
+        assert_eq!(bare.len(), 1);
+        assert_eq!(bare[0].body, p.body);
+        assert!(bare[0].head.is_empty() && bare[0].tail.is_empty());
         // A dip that does not reach the boundary: the two pieces run on to meet halfway.
         let line = IsoLine {
             q: (0..5).map(|i| [i as f64, 0.0]).collect(),
             other: vec![0.0, 1.0, 0.2, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(&line, 0.5, 0.45, flat);
+        let pieces = clip_reaching(&line, 0.5, Some(0.45), flat);
         assert_eq!(pieces.len(), 2);
         let (a, b) = (&pieces[0], &pieces[1]);
         assert!((a.body[a.body.len() - 1][0] - 1.625).abs() < 1e-12);
