@@ -24,31 +24,42 @@ impl Drop for Out {
 static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 fn plan(name: &str, extra: &[&str]) -> (Out, Value, String, String) {
+    let (dir, plan, csv, gcode, _) = plan_part(&fixture(&format!("{name}.step")), extra);
+    (dir, plan, csv, gcode)
+}
+
+/// Plans `part` (any STEP file) with `extra` arguments into a directory of its own, which is
+/// removed when the returned `Out` drops: `plan.json`, `toolpath.csv`, the G-code (empty for
+/// the KUKA post) and what the run printed on stderr.
+fn plan_part(part: &Path, extra: &[&str]) -> (Out, Value, String, String, String) {
     // One directory per call: tests run in parallel and may plan the same part.
     let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = part.file_stem().and_then(|s| s.to_str()).unwrap_or("part");
     let dir =
         std::env::temp_dir().join(format!("features-plan-{}-{run}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let out = Command::new(BIN)
         .arg("plan")
-        .arg(fixture(&format!("{name}.step")))
+        .arg(part)
         .args(extra)
         .arg("-o")
         .arg(&dir)
         .output()
         .expect("runs");
+    let dir = Out(dir);
     assert!(
         out.status.success(),
         "{name}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     let plan: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"))
+        serde_json::from_str(&std::fs::read_to_string(dir.0.join("plan.json")).expect("plan.json"))
             .expect("json");
-    let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("csv");
+    let csv = std::fs::read_to_string(dir.0.join("toolpath.csv")).expect("csv");
     // The KUKA post writes KRL instead of G-code.
-    let gcode = std::fs::read_to_string(dir.join("program.gcode")).unwrap_or_default();
-    (Out(dir), plan, csv, gcode)
+    let gcode = std::fs::read_to_string(dir.0.join("program.gcode")).unwrap_or_default();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (dir, plan, csv, gcode, stderr)
 }
 
 #[derive(Debug, Clone)]
@@ -709,25 +720,7 @@ fn a_feature_reaching_below_the_build_plate_is_named_with_its_depth() {
         return;
     }
     let [lo, _] = bboxes(&part)[0];
-    let dir = std::env::temp_dir().join(format!("features-plan-below-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = Command::new(BIN)
-        .arg("plan")
-        .arg(&part)
-        .arg("-o")
-        .arg(&dir)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let _cleanup = Out(dir.clone());
-    let plan: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"))
-            .expect("json");
-    let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("csv");
+    let (_dir, plan, csv, _, stderr) = plan_part(&part, &[]);
     let first_top = rows(&csv)
         .iter()
         .filter(|r| r.print && r.layer == 0)
@@ -762,7 +755,7 @@ fn a_feature_reaching_below_the_build_plate_is_named_with_its_depth() {
         .unwrap()
         .iter()
         .any(|x| x.as_str() == Some(w[0])));
-    assert!(String::from_utf8_lossy(&out.stderr).contains(w[0]));
+    assert!(stderr.contains(w[0]));
 }
 
 #[test]
@@ -781,25 +774,7 @@ fn real_parts_put_down_each_features_volume() {
         "fusion_two_concave_closed_edge",
         "sw2017_foot_structure",
     ] {
-        let dir = std::env::temp_dir().join(format!("features-plan-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        let out = Command::new(BIN)
-            .arg("plan")
-            .arg(corpus.join(format!("{name}.step")))
-            .arg("-o")
-            .arg(&dir)
-            .output()
-            .expect("runs");
-        let _cleanup = Out(dir.clone());
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let plan: Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join("plan.json")).expect("plan.json"),
-        )
-        .expect("json");
+        let (_dir, plan, _, _, _) = plan_part(&corpus.join(format!("{name}.step")), &[]);
         for f in plan["features"].as_array().unwrap() {
             let v = f["volume_mm3"].as_f64().unwrap();
             let r = f["extruded_volume_mm3"].as_f64().unwrap() / v;

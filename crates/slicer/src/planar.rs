@@ -130,22 +130,23 @@ pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
     // point, on its surfaces (a torus or a cylinder lying on its side is lowest between its
     // vertices, which may all lie at its middle height).
     let face = f.heal_faces.first().copied().or(f.reference.face);
-    let lowest = |pts: &mut dyn Iterator<Item = P3>| {
-        pts.min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
-    };
     let p = match face {
         Some(fc) => b
             .vertices_of(&[fc])
             .first()
             .map(|v| b.vertices[v.idx()].point),
-        None => lowest(&mut surface_points(tree, f).into_iter()).or_else(|| {
-            lowest(
-                &mut b
+        None => {
+            let mut pts = surface_points(tree, f);
+            if pts.is_empty() {
+                pts = b
                     .vertices_of(&f.faces)
-                    .into_iter()
-                    .map(|v| b.vertices[v.idx()].point),
-            )
-        }),
+                    .iter()
+                    .map(|v| b.vertices[v.idx()].point)
+                    .collect();
+            }
+            pts.into_iter()
+                .min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
+        }
     }?;
     Some(Plane::new(p, n))
 }
