@@ -2,7 +2,7 @@
 
 use crate::mesh::{solid_mesh, write_stl, TempFile};
 use crate::{emit, ExtractArgs, Failure};
-use features::{extract, ExtractOptions, FeatureTree};
+use features::{extract_all, solid_name, ExtractOptions, FeatureTree};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -18,11 +18,12 @@ struct Solid {
 pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     let path = &args.part;
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    let assembly =
+        extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
+    let warnings = assembly.all_warnings();
     let mut solids = vec![];
     let mut offset = 0;
-    for s in part.brep.solid_ids() {
-        let tree = extract(&part.brep, s, &ExtractOptions::default())
-            .map_err(|e| Failure::new(path, e))?;
+    for tree in assembly.trees {
         let n = tree.features.len();
         solids.push(Solid { tree, offset });
         offset += n;
@@ -32,12 +33,12 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     }
     let source = path.display().to_string();
     let text = if args.json {
-        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids))
+        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids, warnings))
             .map_err(|e| Failure::new(path, e))?;
         t.push('\n');
         t
     } else {
-        to_text(&source, &solids)
+        to_text(&source, &solids, &assembly.warnings)
     };
     emit(&text)
 }
@@ -46,26 +47,19 @@ fn round(x: f64, scale: f64) -> f64 {
     (x * scale).round() / scale + 0.0
 }
 
-fn to_json(source: &str, solids: &[Solid]) -> Value {
+fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
     let volume: f64 = solids.iter().map(|s| s.tree.part_volume).sum();
     let area: f64 = solids.iter().map(|s| s.tree.part_area).sum();
     let faces: usize = solids.iter().map(|s| s.tree.part_faces).sum();
     let genus: Option<i64> = solids.iter().map(|s| s.tree.genus).sum();
     let mut features = vec![];
     let mut order = vec![];
-    let mut warnings = vec![];
     for s in solids {
         let t = &s.tree;
         for f in &t.features {
             features.push(feature_json_fields(t, f, s.offset));
         }
         order.extend(t.build_order.iter().map(|k| s.offset + k));
-        let prefix = if solids.len() > 1 {
-            format!("solid #{}: ", t.brep.solids[t.solid.idx()].step_id)
-        } else {
-            String::new()
-        };
-        warnings.extend(t.warnings.iter().map(|w| format!("{prefix}{w}")));
     }
     json!({
         "schema": "features.extract/1",
@@ -98,7 +92,9 @@ pub fn feature_json_fields(t: &FeatureTree, f: &features::Feature, offset: usize
     })
 }
 
-fn to_text(source: &str, solids: &[Solid]) -> String {
+/// The trees as text, each solid's warnings under it and those about the solids together
+/// (`together`) last.
+fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
     let mut out = String::new();
     for s in solids {
         let t = &s.tree;
@@ -106,7 +102,7 @@ fn to_text(source: &str, solids: &[Solid]) -> String {
             out,
             "{source}{}: {} feature(s), depth {}, part {:.3} mm^3",
             if solids.len() > 1 {
-                format!(" solid #{}", t.brep.solids[t.solid.idx()].step_id)
+                format!(" {}", solid_name(t))
             } else {
                 String::new()
             },
@@ -158,6 +154,9 @@ fn to_text(source: &str, solids: &[Solid]) -> String {
         for w in &t.warnings {
             let _ = writeln!(out, "warning: {w}");
         }
+    }
+    for w in together {
+        let _ = writeln!(out, "warning: {w}");
     }
     out
 }

@@ -3,7 +3,7 @@
 use crate::extract::feature_json_fields;
 use crate::mesh::TempFile;
 use crate::{emit, Failure, PlanArgs};
-use features::{extract, ExtractOptions};
+use features::{extract_all, ExtractOptions};
 use robot_post::machine::{MachineKind, MachineProfile};
 use serde_json::json;
 use slicer::freeform::plan_freeform;
@@ -90,13 +90,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let filament_area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
 
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
-    let mut trees = vec![];
-    for s in part.brep.solid_ids() {
-        trees.push(
-            extract(&part.brep, s, &ExtractOptions::default())
-                .map_err(|e| Failure::new(path, e))?,
-        );
-    }
+    let assembly =
+        extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
+    let trees = &assembly.trees;
     let total: u64 = trees.iter().map(|t| t.features.len() as u64).sum();
     let bar = indicatif::ProgressBar::with_draw_target(
         Some(total),
@@ -115,7 +111,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let mut feature_values = vec![];
     let mut warnings: Vec<String> = vec![];
     let mut offset = 0usize;
-    for t in &trees {
+    for t in trees {
         let plate = t
             .features
             .first()
@@ -211,9 +207,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             feature_values.push(v);
             bar.inc(1);
         }
-        warnings.extend(t.warnings.iter().cloned());
         offset += t.features.len();
     }
+    warnings.extend(assembly.all_warnings());
     bar.finish_and_clear();
     let mut toolpath = ToolPath { points };
     // Orientation smoothing between planning and posting.

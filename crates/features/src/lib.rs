@@ -1,12 +1,14 @@
 //! `features`: what a part is built from. AM feature recognition after the feature-based
 //! five-axis AM paper: an attributed adjacency graph with edge convexity ([`aag`]), concave
 //! loops, shell splitting and healing, classification into `two5d` and `freeform` features and
-//! their dependency graph ([`extract`]).
+//! their dependency graph ([`extract`]); the solids of a file together ([`assembly`]).
 #![warn(missing_docs)]
 
 pub mod aag;
+pub mod assembly;
 pub mod extract;
 
+pub use assembly::{extract_all, solid_name, Assembly};
 pub use extract::{
     extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference,
 };
