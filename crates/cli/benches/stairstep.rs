@@ -863,6 +863,15 @@ fn print_table(rows: &[Row]) {
         floor(90.0),
         floor(60.0)
     );
+    // On a face between two neighbouring beads (a wall between layers h apart, or a top between
+    // lines w apart, each bead's side or top on the face) the surface point halfway is
+    // √((w/2)² + (h/2)²) from both centres: that much minus w/2 wherever beads tile a face.
+    println!(
+        "floor of this measure on a face where beads w x h meet, layers or lines side by side: \
+         {:.3} mm (a tenth of PrusaSlicer's max is below it wherever that max is under {:.3})",
+        (0.25 * W * W + 0.25 * H * H).sqrt() - 0.5 * W,
+        10.0 * ((0.25 * W * W + 0.25 * H * H).sqrt() - 0.5 * W)
+    );
 }
 
 fn print_envelope_table(rows: &[Row]) {
