@@ -786,3 +786,43 @@ fn real_parts_put_down_each_features_volume() {
         }
     }
 }
+
+#[test]
+fn several_solids_are_printed_lowest_first_and_their_overlap_and_gap_warned() {
+    // stacked_solids: written highest first (floating box, resting box, sunk cylinder, base).
+    let part = fixture("stacked_solids.step");
+    let (_dir, plan, csv, _, stderr) = plan_part(&part, &[]);
+    // The toolpath runs feature by feature, each starting no lower than the one before.
+    let rows = rows(&csv);
+    let mut starts: Vec<(usize, f64)> = vec![];
+    for r in rows.iter().filter(|r| r.print) {
+        match starts.last() {
+            Some((f, _)) if *f == r.feature => {}
+            _ => starts.push((r.feature, r.p[2])),
+        }
+    }
+    assert_eq!(
+        starts.iter().map(|s| s.0).collect::<Vec<_>>(),
+        vec![0, 1, 2, 3],
+        "each feature printed once, in order"
+    );
+    assert!(
+        starts.windows(2).all(|w| w[0].1 <= w[1].1),
+        "first layers at {starts:?}"
+    );
+    // The base (on the plate) first, the floating box (20 mm up) last.
+    assert!(starts[0].1 < 0.5 && starts[3].1 > 20.0, "{starts:?}");
+    let warned: Vec<&str> = plan["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .collect();
+    let overlap: Vec<&&str> = warned.iter().filter(|w| w.contains("overlap")).collect();
+    let air: Vec<&&str> = warned.iter().filter(|w| w.contains("in the air")).collect();
+    assert_eq!((overlap.len(), air.len()), (1, 1), "{warned:?}");
+    for w in overlap.iter().chain(&air) {
+        assert!(w.starts_with("solid #"), "{w}");
+        assert!(stderr.contains(**w), "{w} not on stderr");
+    }
+}
