@@ -628,7 +628,12 @@ pub fn fill_layer(
                     false,
                     &mut out,
                 );
-                scan_fill(&area, zigzag_angle, spacing, true, None, &mut out);
+                // Free chain ends run on to the inner edge of the last ring's bead: the
+                // infill area grown back by half a spacing (not the ring itself eroded, which
+                // would take in the strips its gap fill has filled).
+                let edge = offset(&area, 0.5 * spacing, &ctx.join, 1.0);
+                let reach = Some(Reach { base: &edge, width });
+                scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
             }
         }
     }

@@ -30,7 +30,7 @@
 //!   layer's thickness and each point's bead width.
 
 use crate::fill::{regions_from_loops, Point2, Region};
-use crate::geodesic::{clip_reaching, LayerMesh, Piece};
+use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
 use crate::params::{LayerParams, PathMode};
 use crate::planar::{
     feature_mesh, filament_length, slicing_tolerance, Bead, FeatureFigures, PlanError,
@@ -799,12 +799,18 @@ fn fill_region(
     // Levels half a spacing off the seed curve, then a spacing apart.
     let j0 = (lo / spacing - 0.5).floor() as i64;
     let j1 = (hi / spacing - 0.5).ceil() as i64;
-    // A line end with no connector or ring to meet runs on to the boundary, so the line's
-    // strip of the region is filled up to it (`fill::bead_end_reach`, as on planar layers):
-    // every raster end, and the two free ends of each zig-zag chain. Contour-zig-zag's lines
-    // end on the infill boundary, a spacing inside the last ring, as on planar layers: their
-    // ways on are not walked.
-    let reach = (rings == 0).then_some(width);
+    // A line end with no connector to meet runs on to the boundary, or inside rings to the
+    // inner edge of the last ring's bead (half a spacing short of the infill boundary), so
+    // the line's strip of the region is filled up to it (`fill::bead_end_reach`, as on
+    // planar layers): every raster end, and the two free ends of each zig-zag chain.
+    let reach = RunOn {
+        width,
+        edge: if last_ring.is_some() {
+            inner - 0.5 * spacing
+        } else {
+            0.0
+        },
+    };
     let mut pieces: Vec<(i64, Piece)> = vec![];
     for j in j0..=j1 {
         let level = (j as f64 + 0.5) * spacing;
@@ -840,9 +846,7 @@ fn fill_region(
         used[s] = true;
         let first = &pieces[s].1;
         let (mut level, mut pts) = (pieces[s].0, first.body.clone());
-        if reach.is_some() {
-            pts.splice(0..0, first.head.iter().copied());
-        }
+        pts.splice(0..0, first.head.iter().copied());
         let mut tail = first.tail.clone();
         loop {
             let end = pts[pts.len() - 1];
@@ -876,9 +880,7 @@ fn fill_region(
                 None => break,
             }
         }
-        if reach.is_some() {
-            pts.extend(tail);
-        }
+        pts.extend(tail);
         out.push(FillPath::uniform(pts, width));
     }
     out

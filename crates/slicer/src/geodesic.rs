@@ -636,17 +636,26 @@ impl Piece {
     }
 }
 
+/// Where the free ends of [`clip_reaching`]'s pieces run on to, for beads `width` wide: the
+/// level `edge` of the line's `other` value (the distance to the region's boundary): 0 for
+/// the boundary itself, the inner edge of the last ring's bead inside rings.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOn {
+    /// Bead width, mm.
+    pub width: f64,
+    /// The `other` value the ends run on to.
+    pub edge: f64,
+}
+
 /// The pieces of `line` where its `other` value (the distance to the region's boundary) is
 /// at least `min`, cut exactly at the crossings, each with the ways on from its cut ends
-/// along the line by [`bead_end_reach`] for beads `width` wide: the boundary lies where
-/// `other` falls to zero (or the line ends), the room is half the way to where `other`
-/// climbs back to `min` (the next piece). `len` is the length on the surface between two
-/// chart points. With `width` `None` (lines whose ends a connector or ring meets) the ways
-/// on are left empty and not walked.
+/// along the line by [`bead_end_reach`]: the edge lies where `other` falls to `run_on.edge`
+/// (or the line ends), the room is half the way to where `other` climbs back to `min` (the
+/// next piece). `len` is the length on the surface between two chart points.
 pub fn clip_reaching(
     line: &IsoLine,
     min: f64,
-    width: Option<f64>,
+    run_on: RunOn,
     len: impl Fn(Point2, Point2) -> f64,
 ) -> Vec<Piece> {
     let n = line.q.len();
@@ -654,9 +663,7 @@ pub fn clip_reaching(
     // The way on from a cut in segment `i` (between points i and i+1) at the cut point `x`,
     // forwards or backwards: the line's points beyond it up to the reach, not `x` itself.
     let run_on = |i: usize, x: Point2, forward: bool| -> Vec<Point2> {
-        let Some(width) = width else {
-            return vec![];
-        };
+        let RunOn { width, edge } = run_on;
         let mut pts = vec![];
         let (mut at, mut walked, mut prev_d) = (x, 0.0, min);
         let mut k = if forward { i + 1 } else { i };
@@ -668,9 +675,9 @@ pub fn clip_reaching(
             if !l.is_finite() {
                 break;
             }
-            if d <= 0.0 {
+            if d <= edge {
                 let t = if prev_d > d {
-                    prev_d / (prev_d - d)
+                    (prev_d - edge) / (prev_d - d)
                 } else {
                     1.0
                 };
@@ -820,7 +827,7 @@ mod tests {
     }
 
     #[test]
-    fn clipping_cuts_at_the_crossings_and_runs_on_to_the_boundary() {
+    fn clipping_cuts_at_the_crossings_and_runs_on_to_the_edge() {
         let flat = |a: Point2, b: Point2| (a[0] - b[0]).hypot(a[1] - b[1]);
         // `other` falls to 0 (the boundary) at both ends of the line.
         let line = IsoLine {
@@ -828,7 +835,15 @@ mod tests {
             other: vec![0.0, 1.0, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(&line, 0.5, Some(0.45), flat);
+        let pieces = clip_reaching(
+            &line,
+            0.5,
+            RunOn {
+                width: 0.45,
+                edge: 0.0,
+            },
+            flat,
+        );
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];
         assert_eq!(p.body, vec![[0.5, 0.0], [1.0, 0.0], [2.0, 0.0], [2.5, 0.0]]);
@@ -840,18 +855,41 @@ mod tests {
         let reversed = p.clone().reversed();
         assert_eq!(reversed.head, p.tail);
         assert_eq!(reversed.clone().reaching().len(), 6);
-        // Without a width, the same cut and no ways on.
-        let bare = clip_reaching(&line, 0.5, None, flat);
-        assert_eq!(bare.len(), 1);
-        assert_eq!(bare[0].body, p.body);
-        assert!(bare[0].head.is_empty() && bare[0].tail.is_empty());
+        // Inside rings, on only to the level of the last ring's bead edge.
+        let ringed = clip_reaching(
+            &line,
+            0.5,
+            RunOn {
+                width: 0.45,
+                edge: 0.25,
+            },
+            flat,
+        );
+        assert!(
+            (ringed[0].head[0][0] - (0.25 + m)).abs() < 1e-12,
+            "{:?}",
+            ringed[0].head
+        );
+        assert!(
+            (ringed[0].tail[0][0] - (2.75 - m)).abs() < 1e-12,
+            "{:?}",
+            ringed[0].tail
+        );
         // A dip that does not reach the boundary: the two pieces run on to meet halfway.
         let line = IsoLine {
             q: (0..5).map(|i| [i as f64, 0.0]).collect(),
             other: vec![0.0, 1.0, 0.2, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(&line, 0.5, Some(0.45), flat);
+        let pieces = clip_reaching(
+            &line,
+            0.5,
+            RunOn {
+                width: 0.45,
+                edge: 0.0,
+            },
+            flat,
+        );
         assert_eq!(pieces.len(), 2);
         let (a, b) = (&pieces[0], &pieces[1]);
         assert!((a.body[a.body.len() - 1][0] - 1.625).abs() < 1e-12);
