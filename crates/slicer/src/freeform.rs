@@ -580,12 +580,17 @@ impl FillPath {
 /// at each point, and spurs into sharp corners. The planar planner fills its thin regions so
 /// (a blade's or a rib's section), where offsetting rings of one width would overlap their
 /// own beads or drop what is narrower than a bead.
+///
+/// `boundary` says what the region's boundary is: the part's surface, which a bead's middle
+/// stays a tenth of a bead inside in a region too thin for a ring, or the edge of beads laid
+/// around it (a strip rings leave), which the beads may reach within a fiftieth.
 pub fn fill_flat_region(
     region: &Region,
     params: &LayerParams,
     layer: usize,
     width: f64,
     spacing: f64,
+    boundary: Boundary,
 ) -> Vec<FillPath> {
     let plane = Surface::Plane {
         frame: brep::math::Frame::world(P3::origin()),
@@ -601,13 +606,42 @@ pub fn fill_flat_region(
             sv: 1.0,
         },
     };
-    let mut paths = fill_region(&chart, region, 0.0, params, layer, width, spacing);
+    let sliver_inset = match boundary {
+        Boundary::Part => SLIVER_INSET,
+        Boundary::Beads => GAP_INSET,
+    } * width;
+    let mut paths = fill_region(
+        &chart,
+        region,
+        0.0,
+        params,
+        layer,
+        width,
+        spacing,
+        sliver_inset,
+    );
     paths.extend(corner_spurs(&chart, region, 0.0, width));
     paths.retain(|p| p.points.len() >= 2);
     paths
 }
 
-/// Paths of one region of a curved layer at offset `z`, in chart coordinates.
+/// What bounds a region filled by [`fill_flat_region`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Boundary {
+    /// The part's surface (a layer's section).
+    Part,
+    /// The edges of beads laid around it (a strip the rings of `fill::fill_layer` leave).
+    Beads,
+}
+
+/// How far inside a region too thin for a ring its gap fill's bead middles stay, in bead
+/// widths, where the boundary is the part's: clear of the region's sampling error.
+const SLIVER_INSET: f64 = 0.1;
+/// The same where the boundary is a bead's edge (or the strip the last ring leaves).
+const GAP_INSET: f64 = 0.02;
+
+/// Paths of one region of a curved layer at offset `z`, in chart coordinates. Where the region
+/// is too thin for a ring, the gap fill's bead middles stay `sliver_inset` inside it.
 #[allow(clippy::too_many_arguments)]
 fn fill_region(
     chart: &Chart,
@@ -617,6 +651,7 @@ fn fill_region(
     layer: usize,
     width: f64,
     spacing: f64,
+    sliver_inset: f64,
 ) -> Vec<FillPath> {
     let mut out = vec![];
     let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
@@ -716,7 +751,7 @@ fn fill_region(
             let edge = c + 0.5 * width;
             let gap = Gap {
                 edge,
-                inset: 0.02 * width,
+                inset: GAP_INSET * width,
                 min_width: GAP_MIN_WIDTH_SHARE * width,
                 below: f64::INFINITY,
             };
@@ -730,7 +765,7 @@ fn fill_region(
         None if rings > 0 || dmax <= 0.5 * width => {
             let gap = Gap {
                 edge: 0.0,
-                inset: 0.1 * width,
+                inset: sliver_inset,
                 min_width: 0.2 * width,
                 below: f64::INFINITY,
             };
@@ -1465,7 +1500,14 @@ pub fn plan_freeform(
             let mut paths = vec![];
             for r in &regions {
                 paths.extend(fill_region(
-                    &chart, r, z, params, layer, bead.width, spacing,
+                    &chart,
+                    r,
+                    z,
+                    params,
+                    layer,
+                    bead.width,
+                    spacing,
+                    SLIVER_INSET * bead.width,
                 ));
                 paths.extend(corner_spurs(&chart, r, z, bead.width));
             }
@@ -1614,7 +1656,16 @@ mod tests {
                 path_mode: mode,
                 ..LayerParams::default()
             };
-            let paths = fill_region(&chart, &region, 0.2, &params, 1, 0.45, 0.45);
+            let paths = fill_region(
+                &chart,
+                &region,
+                0.2,
+                &params,
+                1,
+                0.45,
+                0.45,
+                SLIVER_INSET * 0.45,
+            );
             let covered = covered_area(&paths);
             let r = covered / area;
             assert!(r > lo && r < 1.02, "{mode:?}: {r}");
@@ -1652,7 +1703,7 @@ mod tests {
                     path_mode: mode,
                     ..LayerParams::default()
                 };
-                let paths = fill_flat_region(&region, &params, 0, 0.45, 0.45);
+                let paths = fill_flat_region(&region, &params, 0, 0.45, 0.45, Boundary::Part);
                 let r = covered_area(&paths) / (30.0 * wd);
                 assert!((0.95..1.06).contains(&r), "{wd} mm, {mode:?}: {r:.4}");
                 for p in &paths {
@@ -1775,7 +1826,16 @@ mod tests {
             path_mode: mode,
             ..LayerParams::default()
         };
-        fill_region(chart, &region, 8.0, &params, 0, 0.45, 0.45)
+        fill_region(
+            chart,
+            &region,
+            8.0,
+            &params,
+            0,
+            0.45,
+            0.45,
+            SLIVER_INSET * 0.45,
+        )
     }
 
     /// The path points of `paths` lifted onto the layer at `z`.
@@ -1804,7 +1864,16 @@ mod tests {
             path_mode: PathMode::ContourZigzag,
             ..LayerParams::default()
         };
-        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let paths = fill_region(
+            &chart,
+            &region,
+            8.0,
+            &params,
+            0,
+            0.45,
+            0.45,
+            SLIVER_INSET * 0.45,
+        );
         let pts = lifted(&chart, &paths, 8.0);
         for c in &outer {
             let pc = chart.at(*c, 8.0).expect("corner").0;
@@ -1857,7 +1926,7 @@ mod tests {
         assert!((start - rho_s).abs() < 0.02, "start {start}");
         // With the rings, the nearest path point to the tip moves from 0.87 mm to the spur's.
         let params = LayerParams::default();
-        let rings = fill_region(&chart, &region, 0.2, &params, 0, w, w);
+        let rings = fill_region(&chart, &region, 0.2, &params, 0, w, w, SLIVER_INSET * w);
         let nearest = |paths: &[FillPath]| {
             paths
                 .iter()
@@ -1898,7 +1967,16 @@ mod tests {
             path_mode: PathMode::Contour,
             ..LayerParams::default()
         };
-        let paths = fill_region(&chart, &region, 8.0, &params, 0, 0.45, 0.45);
+        let paths = fill_region(
+            &chart,
+            &region,
+            8.0,
+            &params,
+            0,
+            0.45,
+            0.45,
+            SLIVER_INSET * 0.45,
+        );
         // Each path point's distance (on the unrolled layer) to the strip's near long side,
         // away from the strip's ends.
         let mut by_ring: Vec<Vec<f64>> = vec![];

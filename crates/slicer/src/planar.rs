@@ -7,7 +7,7 @@
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
 use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
-use crate::freeform::{fill_flat_region, FillPath};
+use crate::freeform::{fill_flat_region, Boundary, FillPath};
 use crate::params::{LayerParams, PathMode};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
@@ -186,6 +186,55 @@ fn thin_depth(params: &LayerParams, width: f64, spacing: f64) -> f64 {
     0.5 * width + (params.perimeters.max(1) as f64) * spacing
 }
 
+/// The paths of a planar layer's regions, for layer number `layer`, beads `width` wide and
+/// `spacing` apart: `fill::fill_layer` where offsets of one bead width fit, and beads as wide
+/// as the region there (`freeform::fill_flat_region`) for regions too thin for those rings
+/// and infill, where they would overlap or drop beads, and for the strips the rings of the
+/// others leave (thin parts, the middle between rings). Raster and zig-zag lines run
+/// boundary to boundary whatever the width: only the modes with rings need this.
+pub fn fill_regions(
+    regions: Vec<Region>,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+) -> Vec<FillPath> {
+    let rings = matches!(
+        params.path_mode,
+        PathMode::Contour | PathMode::ContourZigzag
+    );
+    let (thin, thick): (Vec<Region>, Vec<Region>) = regions
+        .into_iter()
+        .partition(|r| rings && thinner_than(r, thin_depth(params, width, spacing)));
+    let filled = fill_layer(&thick, params, layer, width, spacing);
+    let mut paths: Vec<FillPath> = filled
+        .paths
+        .into_iter()
+        .map(|p| FillPath::uniform(p.points, width))
+        .collect();
+    for r in &thin {
+        paths.extend(fill_flat_region(
+            r,
+            params,
+            layer,
+            width,
+            spacing,
+            Boundary::Part,
+        ));
+    }
+    for r in &filled.gaps {
+        paths.extend(fill_flat_region(
+            r,
+            params,
+            layer,
+            width,
+            spacing,
+            Boundary::Beads,
+        ));
+    }
+    paths
+}
+
 /// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
 /// chords are what the sections see.
 pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
@@ -252,26 +301,7 @@ pub fn plan_two5d(
             continue;
         }
         let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-        // Regions too thin for the rings (and infill) of offsets of one bead width, where
-        // those would overlap or drop beads, are filled by the exact distance to their
-        // boundary with beads as wide as the region there (`freeform::fill_flat_region`);
-        // the others by `fill::fill_layer`.
-        // (Raster and zig-zag lines run boundary to boundary whatever the width: only the
-        // modes with rings need this.)
-        let rings = matches!(
-            params.path_mode,
-            PathMode::Contour | PathMode::ContourZigzag
-        );
-        let (thin, thick): (Vec<Region>, Vec<Region>) = regions
-            .into_iter()
-            .partition(|r| rings && thinner_than(r, thin_depth(params, bead.width, spacing)));
-        let mut paths: Vec<FillPath> = fill_layer(&thick, params, layer, bead.width, spacing)
-            .into_iter()
-            .map(|p| FillPath::uniform(p.points, bead.width))
-            .collect();
-        for r in &thin {
-            paths.extend(fill_flat_region(r, params, layer, bead.width, spacing));
-        }
+        let paths = fill_regions(regions, params, layer, bead.width, spacing);
         let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
         if paths.is_empty() {
             continue;

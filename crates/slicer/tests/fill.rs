@@ -3,7 +3,9 @@
 use slicer::fill::{
     fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region, END_MARGIN,
 };
+use slicer::freeform::FillPath;
 use slicer::params::{LayerParams, PathMode};
+use slicer::planar::fill_regions;
 use std::f64::consts::PI;
 
 /// Chord sag of offset arcs at reflex corners: 1 % of the 0.4 mm width.
@@ -154,9 +156,29 @@ fn region_boundary_dist(p: Point2, r: &Region) -> f64 {
         .fold(boundary_dist(p, &r.outer), f64::min)
 }
 
-/// Area of the region that no bead covers, beads being the paths stroked `width` wide
-/// (i_overlay's stroke and boolean difference), mm².
-fn uncovered_area(r: &Region, paths: &[Path2], width: f64) -> f64 {
+/// The whole fill of a planar layer of region `r` (`planar::fill_regions`: `fill_layer`'s
+/// paths of one bead width, and beads as wide as the strips its rings leave), 0.4 mm beads.
+fn fill_all(r: &Region, p: &LayerParams, layer: usize) -> Vec<FillPath> {
+    fill_regions(vec![r.clone()], p, layer, 0.4, 0.4)
+}
+
+/// Σ length × width over the segments of `paths` (Eq. 1's bead area), mm².
+fn bead_area(paths: &[FillPath]) -> f64 {
+    paths
+        .iter()
+        .flat_map(|p| {
+            p.points
+                .windows(2)
+                .zip(p.widths.windows(2))
+                .map(|(q, w)| (q[1][0] - q[0][0]).hypot(q[1][1] - q[0][1]) * 0.5 * (w[0] + w[1]))
+        })
+        .sum()
+}
+
+/// Area of the region that no bead covers, beads being the paths stroked as wide as they are
+/// (i_overlay's stroke and boolean difference), mm²: a path of one width whole, one of
+/// varying width segment by segment.
+fn uncovered_area(r: &Region, paths: &[FillPath]) -> f64 {
     use i_overlay::core::fill_rule::FillRule;
     use i_overlay::core::overlay_rule::OverlayRule;
     use i_overlay::float::single::SingleFloatOverlay;
@@ -164,11 +186,20 @@ fn uncovered_area(r: &Region, paths: &[Path2], width: f64) -> f64 {
     use i_overlay::mesh::float::style::{LineJoin, StrokeStyle};
     let mut beads: Vec<Vec<Vec<Point2>>> = Vec::new();
     for p in paths {
-        let style = StrokeStyle::new(width).line_join(LineJoin::Miter(0.1));
-        if p.is_closed() {
-            beads.extend(p.points[..p.points.len() - 1].to_vec().stroke(style, true));
+        let w0 = p.widths.first().copied().unwrap_or(0.0);
+        if p.widths.iter().all(|&w| (w - w0).abs() < 1e-9) {
+            let style = StrokeStyle::new(w0).line_join(LineJoin::Miter(0.1));
+            let closed = p.points.len() > 3 && p.points.first() == p.points.last();
+            if closed {
+                beads.extend(p.points[..p.points.len() - 1].to_vec().stroke(style, true));
+            } else {
+                beads.extend(p.points.stroke(style, false));
+            }
         } else {
-            beads.extend(p.points.stroke(style, false));
+            for (q, w) in p.points.windows(2).zip(p.widths.windows(2)) {
+                let style = StrokeStyle::new(0.5 * (w[0] + w[1])).line_join(LineJoin::Miter(0.1));
+                beads.extend(q.to_vec().stroke(style, false));
+            }
         }
     }
     let mut region = vec![r.outer.clone()];
@@ -184,8 +215,7 @@ fn length_times_width_matches_area() {
     for (name, r) in shapes() {
         for mode in MODES {
             for layer in 0..2 {
-                let paths = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4);
-                let ratio = total_length(&paths) * 0.4 / region_area(&r);
+                let ratio = bead_area(&fill_all(&r, &params(mode), layer)) / region_area(&r);
                 assert!(
                     (ratio - 1.0).abs() < 0.02,
                     "{name}, {mode:?}, layer {layer}: length x width / area = {ratio:.4}"
@@ -201,8 +231,7 @@ fn length_times_width_matches_area() {
 fn beads_cover_the_region() {
     for (name, r) in shapes() {
         for mode in MODES {
-            let paths = fill_layer(std::slice::from_ref(&r), &params(mode), 0, 0.4, 0.4);
-            let gap = uncovered_area(&r, &paths, 0.4) / region_area(&r);
+            let gap = uncovered_area(&r, &fill_all(&r, &params(mode), 0)) / region_area(&r);
             let limit = if mode == PathMode::Raster { 0.02 } else { 0.01 };
             assert!(
                 gap < limit,
@@ -222,7 +251,8 @@ fn paths_stay_inside_half_a_width_from_the_boundary() {
     for (name, r) in shapes() {
         for mode in MODES {
             for layer in 0..2 {
-                let paths = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4);
+                let paths =
+                    fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4).paths;
                 assert!(!paths.is_empty(), "{name}, {mode:?}");
                 for p in &paths {
                     for (i, &q) in p.points.iter().enumerate() {
@@ -252,7 +282,7 @@ fn paths_stay_inside_half_a_width_from_the_boundary() {
 fn perimeters_are_closed_rings() {
     for (name, r) in shapes() {
         for mode in MODES {
-            let paths = fill_layer(std::slice::from_ref(&r), &params(mode), 0, 0.4, 0.4);
+            let paths = fill_layer(std::slice::from_ref(&r), &params(mode), 0, 0.4, 0.4).paths;
             for p in paths.iter().filter(|p| p.kind == PathKind::Perimeter) {
                 assert!(p.points.len() >= 4, "{name}, {mode:?}");
                 assert_eq!(p.points.first(), p.points.last(), "{name}, {mode:?}");
@@ -273,7 +303,7 @@ fn perimeters_are_closed_rings() {
     }
     // The rectangle's perimeters: 19.6 x 9.6 and 18.8 x 8.8 rectangles.
     let (_, r) = shapes().remove(0);
-    let paths = fill_layer(&[r], &params(PathMode::ContourZigzag), 0, 0.4, 0.4);
+    let paths = fill_layer(&[r], &params(PathMode::ContourZigzag), 0, 0.4, 0.4).paths;
     let lens: Vec<f64> = paths
         .iter()
         .filter(|p| p.kind == PathKind::Perimeter)
@@ -290,7 +320,7 @@ fn no_infill_segment_crosses_a_hole() {
     let hole = &r.holes[0];
     for mode in MODES {
         for layer in 0..2 {
-            let paths = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4);
+            let paths = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4).paths;
             for p in &paths {
                 for w in p.points.windows(2) {
                     let n = hole.len();
@@ -333,7 +363,8 @@ fn raster_lines_are_parallel_and_run_on_to_the_boundary() {
                 layer,
                 0.4,
                 0.4,
-            );
+            )
+            .paths;
             let d = [45f64.to_radians().cos(), 45f64.to_radians().sin()];
             for p in &paths {
                 assert_eq!(p.kind, PathKind::Infill);
@@ -364,7 +395,7 @@ fn raster_lines_are_parallel_and_run_on_to_the_boundary() {
         raster_angle_deg: 0.0,
         ..params(PathMode::Raster)
     };
-    let paths = fill_layer(&[r], &p, 1, 0.4, 0.4);
+    let paths = fill_layer(&[r], &p, 1, 0.4, 0.4).paths;
     assert_eq!(paths.len(), 25);
     for p in &paths {
         assert!((p.points[0][1] - p.points[1][1]).abs() < 1e-9);
@@ -386,7 +417,8 @@ fn zigzag_alternates_and_joins_lines() {
                 layer,
                 0.4,
                 0.4,
-            );
+            )
+            .paths;
             assert_eq!(paths.len(), 1, "{name}, layer {layer}");
             let angle = (45.0 + 90.0 * layer as f64).to_radians();
             let d = [angle.cos(), angle.sin()];
@@ -423,7 +455,7 @@ fn zigzag_alternates_and_joins_lines() {
     }
     // Around a hole: a few pieces, each a single path.
     let (_, r) = shapes().remove(2);
-    let paths = fill_layer(&[r], &params(PathMode::Zigzag), 0, 0.4, 0.4);
+    let paths = fill_layer(&[r], &params(PathMode::Zigzag), 0, 0.4, 0.4).paths;
     assert!((2..=6).contains(&paths.len()), "{} paths", paths.len());
 }
 
@@ -432,7 +464,7 @@ fn zigzag_alternates_and_joins_lines() {
 #[test]
 fn contour_rings_go_all_the_way_in() {
     let (_, r) = shapes().remove(0);
-    let paths = fill_layer(&[r], &params(PathMode::Contour), 0, 0.4, 0.4);
+    let paths = fill_layer(&[r], &params(PathMode::Contour), 0, 0.4, 0.4).paths;
     let rings: Vec<&Path2> = paths
         .iter()
         .filter(|p| p.kind == PathKind::Perimeter)
@@ -458,7 +490,7 @@ fn contour_rings_go_all_the_way_in() {
 
     // The disk: 25 concentric rings, 0.4 apart.
     let (_, r) = shapes().remove(1);
-    let paths = fill_layer(&[r], &params(PathMode::Contour), 0, 0.4, 0.4);
+    let paths = fill_layer(&[r], &params(PathMode::Contour), 0, 0.4, 0.4).paths;
     assert_eq!(paths.len(), 25);
     for (k, ring) in paths.iter().enumerate() {
         let radius = 9.8 - 0.4 * k as f64;
@@ -481,7 +513,7 @@ fn filling_ratio_spreads_the_paths() {
     let spacing = p.spacing(0.4);
     assert!((spacing - 0.5).abs() < 1e-12);
     let (_, r) = shapes().remove(1);
-    let paths = fill_layer(std::slice::from_ref(&r), &p, 0, 0.4, spacing);
+    let paths = fill_layer(std::slice::from_ref(&r), &p, 0, 0.4, spacing).paths;
     let ratio = total_length(&paths) * 0.4 / region_area(&r);
     assert!((ratio - 0.8).abs() < 0.03, "{ratio}");
 }
@@ -496,35 +528,38 @@ fn degenerate_input_does_not_panic() {
     for mode in MODES {
         let p = params(mode);
         // Nothing.
-        assert!(fill_layer(&[], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[], &p, 0, 0.4, 0.4).paths.is_empty());
         // Zero-area slivers.
         let sliver = Region {
             outer: vec![[0.0, 0.0], [5.0, 0.0], [10.0, 0.0]],
             holes: vec![],
         };
-        assert!(fill_layer(&[sliver], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[sliver], &p, 0, 0.4, 0.4).paths.is_empty());
         let two = Region {
             outer: vec![[0.0, 0.0], [5.0, 5.0]],
             holes: vec![],
         };
-        assert!(fill_layer(&[two], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[two], &p, 0, 0.4, 0.4).paths.is_empty());
         let empty = Region {
             outer: vec![],
             holes: vec![vec![]],
         };
-        assert!(fill_layer(&[empty], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[empty], &p, 0, 0.4, 0.4).paths.is_empty());
         // Narrower than a bead: nothing fits.
         let thin = Region {
             outer: rect(0.0, 0.0, 10.0, 0.3),
             holes: vec![],
         };
-        assert!(fill_layer(&[thin], &p, 0, 0.4, 0.4).is_empty(), "{mode:?}");
+        assert!(
+            fill_layer(&[thin], &p, 0, 0.4, 0.4).paths.is_empty(),
+            "{mode:?}"
+        );
         // Just over a bead: what fits, inside.
         let narrow = Region {
             outer: rect(0.0, 0.0, 10.0, 0.45),
             holes: vec![],
         };
-        for path in fill_layer(std::slice::from_ref(&narrow), &p, 0, 0.4, 0.4) {
+        for path in fill_layer(std::slice::from_ref(&narrow), &p, 0, 0.4, 0.4).paths {
             for q in path.points {
                 assert!(in_region(q, &narrow, 1e-6));
             }
@@ -539,31 +574,37 @@ fn degenerate_input_does_not_panic() {
             (0.4, -1.0),
         ] {
             assert!(
-                fill_layer(std::slice::from_ref(&sq), &p, 0, w, s).is_empty(),
+                fill_layer(std::slice::from_ref(&sq), &p, 0, w, s)
+                    .paths
+                    .is_empty(),
                 "{w} {s}"
             );
         }
         // Absurdly fine spacing: refused, not hours of lines.
-        assert!(fill_layer(std::slice::from_ref(&sq), &p, 0, 1e-9, 1e-9).is_empty());
+        assert!(fill_layer(std::slice::from_ref(&sq), &p, 0, 1e-9, 1e-9)
+            .paths
+            .is_empty());
         // Spacing wider than the region, bead wider than the region.
-        let _ = fill_layer(std::slice::from_ref(&sq), &p, 0, 0.4, 50.0);
-        assert!(fill_layer(std::slice::from_ref(&sq), &p, 0, 20.0, 20.0).is_empty());
+        let _ = fill_layer(std::slice::from_ref(&sq), &p, 0, 0.4, 50.0).paths;
+        assert!(fill_layer(std::slice::from_ref(&sq), &p, 0, 20.0, 20.0)
+            .paths
+            .is_empty());
         // Non-finite and huge coordinates.
         let nan = Region {
             outer: vec![[0.0, 0.0], [f64::NAN, 0.0], [1.0, 1.0]],
             holes: vec![],
         };
-        assert!(fill_layer(&[nan], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[nan], &p, 0, 0.4, 0.4).paths.is_empty());
         let inf_hole = Region {
             outer: rect(0.0, 0.0, 10.0, 10.0),
             holes: vec![vec![[1.0, 1.0], [f64::INFINITY, 1.0], [2.0, 2.0]]],
         };
-        assert!(!fill_layer(&[inf_hole], &p, 0, 0.4, 0.4).is_empty());
+        assert!(!fill_layer(&[inf_hole], &p, 0, 0.4, 0.4).paths.is_empty());
         let huge = Region {
             outer: rect(0.0, 0.0, 1e300, 1e300),
             holes: vec![],
         };
-        assert!(fill_layer(&[huge], &p, 0, 0.4, 0.4).is_empty());
+        assert!(fill_layer(&[huge], &p, 0, 0.4, 0.4).paths.is_empty());
         // Clockwise outer, counter-clockwise hole, a hole poking out, a bow-tie, repeated
         // points and a closing repeat: filled, inside the non-zero area.
         let mut cw = rect(0.0, 0.0, 10.0, 10.0);
@@ -572,12 +613,12 @@ fn degenerate_input_does_not_panic() {
             outer: cw,
             holes: vec![rect(8.0, 4.0, 12.0, 6.0), rect(2.0, 2.0, 3.0, 3.0)],
         };
-        assert!(!fill_layer(&[odd], &p, 0, 0.4, 0.4).is_empty());
+        assert!(!fill_layer(&[odd], &p, 0, 0.4, 0.4).paths.is_empty());
         let bowtie = Region {
             outer: vec![[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]],
             holes: vec![],
         };
-        let _ = fill_layer(&[bowtie], &p, 0, 0.4, 0.4);
+        let _ = fill_layer(&[bowtie], &p, 0, 0.4, 0.4).paths;
         let dup = Region {
             outer: vec![
                 [0.0, 0.0],
@@ -590,7 +631,7 @@ fn degenerate_input_does_not_panic() {
             ],
             holes: vec![],
         };
-        assert!(!fill_layer(&[dup], &p, 0, 0.4, 0.4).is_empty());
+        assert!(!fill_layer(&[dup], &p, 0, 0.4, 0.4).paths.is_empty());
         // Bad parameters do not panic either.
         let bad = LayerParams {
             tolerance: f64::NAN,
@@ -598,7 +639,7 @@ fn degenerate_input_does_not_panic() {
             perimeters: usize::MAX,
             ..p.clone()
         };
-        let _ = fill_layer(std::slice::from_ref(&sq), &bad, 3, 0.4, 0.4);
+        let _ = fill_layer(std::slice::from_ref(&sq), &bad, 3, 0.4, 0.4).paths;
     }
 }
 
@@ -677,7 +718,7 @@ fn order_paths_takes_the_nearest_end() {
 
     // On a real fill, ordering never lengthens travel over the fill order and loses nothing.
     let (_, r) = shapes().remove(2);
-    let paths = fill_layer(&[r], &params(PathMode::Raster), 0, 0.4, 0.4);
+    let paths = fill_layer(&[r], &params(PathMode::Raster), 0, 0.4, 0.4).paths;
     let travel = |ps: &[Path2]| {
         let mut cur = [0.0, 0.0];
         let mut t = 0.0;
@@ -711,7 +752,8 @@ fn raster_lines_agree_with_i_overlay_clipping() {
         0,
         0.4,
         0.4,
-    );
+    )
+    .paths;
     let d = [45f64.to_radians().cos(), 45f64.to_radians().sin()];
     let mut checked = 0;
     for p in &paths {
@@ -760,7 +802,9 @@ fn fill_timing() {
             let t = std::time::Instant::now();
             let mut n = 0;
             for layer in 0..runs {
-                n = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4).len();
+                n = fill_layer(std::slice::from_ref(&r), &params(mode), layer, 0.4, 0.4)
+                    .paths
+                    .len();
             }
             let per = t.elapsed() / runs as u32;
             println!("{name:35} {mode:?}: {n} paths, {per:?} per layer");
@@ -803,7 +847,7 @@ fn random_regions_fill_inside() {
                 ..params(mode)
             };
             for layer in 0..2 {
-                let paths = fill_layer(std::slice::from_ref(&region), &p, layer, 0.4, 0.4);
+                let paths = fill_layer(std::slice::from_ref(&region), &p, layer, 0.4, 0.4).paths;
                 for path in &paths {
                     if path.kind == PathKind::Perimeter {
                         assert!(path.is_closed(), "case {case}, {mode:?}");
@@ -818,7 +862,8 @@ fn random_regions_fill_inside() {
                 if mode != PathMode::Raster && layer == 0 {
                     // What no bead reaches is at most part of the half-width band along the
                     // boundary (spikes narrower than a bead, zig-zag's ends).
-                    let gap = uncovered_area(&region, &paths, 0.4) / region_area(&region);
+                    let gap = uncovered_area(&region, &fill_all(&region, &p, layer))
+                        / region_area(&region);
                     let band = 0.2 * loop_length(&region.outer) / region_area(&region);
                     assert!(
                         gap < 0.6 * band + 0.02,
@@ -965,7 +1010,8 @@ fn check_clearance(name: &str, r: &Region, width: f64) {
                     layer,
                     width,
                     spacing,
-                );
+                )
+                .paths;
                 assert!(!paths.is_empty(), "{name}, {mode:?}");
                 if seen.contains(&paths) {
                     continue;
@@ -1041,5 +1087,58 @@ fn many_sided_holes_keep_half_a_width_clear() {
                 check_clearance(&name, &r, 0.45);
             }
         }
+    }
+}
+
+/// An I-section whose web (1.4 mm) takes the first ring's beads from both sides but leaves
+/// the second ring's offset only 0.2 mm wide: that ring's beads would overlap by half a bead
+/// down the whole web. The second ring keeps to the flanges; the web's middle is handed back
+/// as a gap and filled with beads as wide as it, so the beads put the region's area down
+/// without laying the web twice.
+#[test]
+fn a_web_narrower_than_two_rings_is_not_laid_twice() {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::float::simplify::SimplifyShape;
+    use i_overlay::mesh::float::stroke::offset::StrokeOffset;
+    use i_overlay::mesh::float::style::{LineJoin, StrokeStyle};
+    let outer = vec![
+        [0.0, 0.0],
+        [6.0, 0.0],
+        [6.0, 3.0],
+        [3.7, 3.0],
+        [3.7, 13.0],
+        [6.0, 13.0],
+        [6.0, 16.0],
+        [0.0, 16.0],
+        [0.0, 13.0],
+        [2.3, 13.0],
+        [2.3, 3.0],
+        [0.0, 3.0],
+    ];
+    let r = Region {
+        outer,
+        holes: vec![],
+    };
+    let area = region_area(&r);
+    for mode in [PathMode::Contour, PathMode::ContourZigzag] {
+        let filled = fill_layer(std::slice::from_ref(&r), &params(mode), 0, 0.4, 0.4);
+        assert!(!filled.gaps.is_empty(), "{mode:?}: the web's middle is a gap");
+        // Ring beads laid twice: their stroked areas less the area of their union.
+        let style = StrokeStyle::new(0.4).line_join(LineJoin::Miter(0.1));
+        let mut sum = 0.0;
+        let mut all: Vec<Vec<Vec<Point2>>> = vec![];
+        for p in filled.paths.iter().filter(|p| p.kind == PathKind::Perimeter) {
+            let s = p.points[..p.points.len() - 1].to_vec().stroke(style.clone(), true);
+            sum += s.iter().flatten().map(|c| 0.5 * area2(c)).sum::<f64>();
+            all.extend(s);
+        }
+        let union = all.simplify_shape(FillRule::NonZero);
+        let twice = sum - union.iter().flatten().map(|c| 0.5 * area2(c)).sum::<f64>();
+        assert!(
+            twice < 0.005 * area,
+            "{mode:?}: {twice:.3} mm^2 of ring bead laid twice"
+        );
+        let ratio = bead_area(&fill_all(&r, &params(mode), 0)) / area;
+        assert!((ratio - 1.0).abs() < 0.02, "{mode:?}: bead area / area {ratio:.4}");
     }
 }
