@@ -1656,16 +1656,7 @@ mod tests {
                 path_mode: mode,
                 ..LayerParams::default()
             };
-            let paths = fill_region(
-                &chart,
-                &region,
-                0.2,
-                &params,
-                1,
-                0.45,
-                0.45,
-                SLIVER_INSET * 0.45,
-            );
+            let paths = fill_test_region(&chart, &region, 0.2, &params, 1);
             let covered = covered_area(&paths);
             let r = covered / area;
             assert!(r > lo && r < 1.02, "{mode:?}: {r}");
@@ -1826,12 +1817,23 @@ mod tests {
             path_mode: mode,
             ..LayerParams::default()
         };
+        fill_test_region(chart, &region, 8.0, &params, 0)
+    }
+
+    /// `fill_region` with 0.45 mm beads 0.45 mm apart, the part's boundary round the region.
+    fn fill_test_region(
+        chart: &Chart,
+        region: &Region,
+        z: f64,
+        params: &LayerParams,
+        layer: usize,
+    ) -> Vec<FillPath> {
         fill_region(
             chart,
-            &region,
-            8.0,
-            &params,
-            0,
+            region,
+            z,
+            params,
+            layer,
             0.45,
             0.45,
             SLIVER_INSET * 0.45,
@@ -1864,16 +1866,7 @@ mod tests {
             path_mode: PathMode::ContourZigzag,
             ..LayerParams::default()
         };
-        let paths = fill_region(
-            &chart,
-            &region,
-            8.0,
-            &params,
-            0,
-            0.45,
-            0.45,
-            SLIVER_INSET * 0.45,
-        );
+        let paths = fill_test_region(&chart, &region, 8.0, &params, 0);
         let pts = lifted(&chart, &paths, 8.0);
         for c in &outer {
             let pc = chart.at(*c, 8.0).expect("corner").0;
@@ -1967,16 +1960,7 @@ mod tests {
             path_mode: PathMode::Contour,
             ..LayerParams::default()
         };
-        let paths = fill_region(
-            &chart,
-            &region,
-            8.0,
-            &params,
-            0,
-            0.45,
-            0.45,
-            SLIVER_INSET * 0.45,
-        );
+        let paths = fill_test_region(&chart, &region, 8.0, &params, 0);
         // Each path point's distance (on the unrolled layer) to the strip's near long side,
         // away from the strip's ends.
         let mut by_ring: Vec<Vec<f64>> = vec![];

@@ -828,6 +828,11 @@ mod tests {
 
     #[test]
     fn clipping_cuts_at_the_crossings_and_runs_on_to_the_edge() {
+        /// 0.45 mm beads run on to the region's boundary.
+        const TO_BOUNDARY: RunOn = RunOn {
+            width: 0.45,
+            edge: 0.0,
+        };
         let flat = |a: Point2, b: Point2| (a[0] - b[0]).hypot(a[1] - b[1]);
         // `other` falls to 0 (the boundary) at both ends of the line.
         let line = IsoLine {
@@ -835,15 +840,7 @@ mod tests {
             other: vec![0.0, 1.0, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(
-            &line,
-            0.5,
-            RunOn {
-                width: 0.45,
-                edge: 0.0,
-            },
-            flat,
-        );
+        let pieces = clip_reaching(&line, 0.5, TO_BOUNDARY, flat);
         assert_eq!(pieces.len(), 1);
         let p = &pieces[0];
         assert_eq!(p.body, vec![[0.5, 0.0], [1.0, 0.0], [2.0, 0.0], [2.5, 0.0]]);
@@ -881,15 +878,7 @@ mod tests {
             other: vec![0.0, 1.0, 0.2, 1.0, 0.0],
             closed: false,
         };
-        let pieces = clip_reaching(
-            &line,
-            0.5,
-            RunOn {
-                width: 0.45,
-                edge: 0.0,
-            },
-            flat,
-        );
+        let pieces = clip_reaching(&line, 0.5, TO_BOUNDARY, flat);
         assert_eq!(pieces.len(), 2);
         let (a, b) = (&pieces[0], &pieces[1]);
         assert!((a.body[a.body.len() - 1][0] - 1.625).abs() < 1e-12);

@@ -1122,13 +1122,22 @@ fn a_web_narrower_than_two_rings_is_not_laid_twice() {
     let area = region_area(&r);
     for mode in [PathMode::Contour, PathMode::ContourZigzag] {
         let filled = fill_layer(std::slice::from_ref(&r), &params(mode), 0, 0.4, 0.4);
-        assert!(!filled.gaps.is_empty(), "{mode:?}: the web's middle is a gap");
+        assert!(
+            !filled.gaps.is_empty(),
+            "{mode:?}: the web's middle is a gap"
+        );
         // Ring beads laid twice: their stroked areas less the area of their union.
         let style = StrokeStyle::new(0.4).line_join(LineJoin::Miter(0.1));
         let mut sum = 0.0;
         let mut all: Vec<Vec<Vec<Point2>>> = vec![];
-        for p in filled.paths.iter().filter(|p| p.kind == PathKind::Perimeter) {
-            let s = p.points[..p.points.len() - 1].to_vec().stroke(style.clone(), true);
+        for p in filled
+            .paths
+            .iter()
+            .filter(|p| p.kind == PathKind::Perimeter)
+        {
+            let s = p.points[..p.points.len() - 1]
+                .to_vec()
+                .stroke(style.clone(), true);
             sum += s.iter().flatten().map(|c| 0.5 * area2(c)).sum::<f64>();
             all.extend(s);
         }
@@ -1139,6 +1148,9 @@ fn a_web_narrower_than_two_rings_is_not_laid_twice() {
             "{mode:?}: {twice:.3} mm^2 of ring bead laid twice"
         );
         let ratio = bead_area(&fill_all(&r, &params(mode), 0)) / area;
-        assert!((ratio - 1.0).abs() < 0.02, "{mode:?}: bead area / area {ratio:.4}");
+        assert!(
+            (ratio - 1.0).abs() < 0.02,
+            "{mode:?}: bead area / area {ratio:.4}"
+        );
     }
 }
