@@ -14,6 +14,7 @@ use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
 use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
+use rayon::prelude::*;
 
 /// What the planner needs to know about the machine's bead.
 #[derive(Debug, Clone, Copy)]
@@ -287,21 +288,29 @@ pub fn plan_two5d(
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
     let mut fig = FeatureFigures::default();
     let mut printed = vec![];
+    // Each layer's section and fill depend on that layer alone: computed in parallel, then
+    // ordered and joined by travel one layer after the other.
+    let mut tops = Vec::with_capacity(heights.len());
     let mut z = 0.0;
-    for (layer, &dl) in heights.iter().enumerate() {
-        let mid = z + 0.5 * dl;
+    for &dl in &heights {
+        tops.push((z + 0.5 * dl, z + dl, dl));
         z += dl;
-        let cut = plane.offset(mid);
-        let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
-            .iter()
-            .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
-            .collect();
-        let regions = regions_from_loops(&loops);
-        if regions.is_empty() {
-            continue;
-        }
+    }
+    let filled: Vec<Vec<FillPath>> = tops
+        .par_iter()
+        .enumerate()
+        .map(|(layer, &(mid, _, _))| {
+            let cut = plane.offset(mid);
+            let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
+                .iter()
+                .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
+                .collect();
+            let regions = regions_from_loops(&loops);
+            fill_regions(regions, params, layer, bead.width, spacing)
+        })
+        .collect();
+    for (layer, (paths, &(_, z, dl))) in filled.into_iter().zip(&tops).enumerate() {
         let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-        let paths = fill_regions(regions, params, layer, bead.width, spacing);
         let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
         if paths.is_empty() {
             continue;
