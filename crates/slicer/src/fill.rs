@@ -24,9 +24,10 @@
 //!
 //! Where successive rings leave a strip narrower than a bead uncovered (the middle of a
 //! rectangle whose width is not a multiple of the spacing, the neck between a hole and the
-//! outside), or a part of the region is too narrow for a ring's beads from both sides, that
-//! strip is handed back ([`FilledLayer::gaps`]) to be filled with beads as wide as it is, so
-//! contour fills cover the region without laying any of it twice.
+//! outside), that strip gets a gap-fill line along its length (kind [`PathKind::Infill`]).
+//! Where a part of the region is too narrow for a ring's beads from both sides, or for the
+//! first ring at all, that part is handed back ([`FilledLayer::gaps`]) to be filled with beads
+//! as wide as it is. So contour fills cover the region without laying any of it twice.
 
 use crate::params::{LayerParams, PathMode};
 use i_overlay::core::fill_rule::FillRule;
@@ -538,12 +539,14 @@ struct Ctx {
 ///   on the boundary between them (and the connector is shorter than ten spacings); the
 ///   first and last end of each chain run on to the boundary as raster ends do;
 /// - contour: rings offset inward by `width / 2`, `width / 2 + spacing`, ... until nothing is
-///   left; the strips the rings leave uncovered go to [`FilledLayer::gaps`];
+///   left, plus gap-fill lines in strips the rings leave uncovered (parts too narrow for a
+///   ring go to [`FilledLayer::gaps`]);
 /// - contour_zigzag: `perimeters` rings, then zig-zag inside the region offset inward by
 ///   `width / 2 + perimeters · spacing`.
 ///
 /// Rings are [`PathKind::Perimeter`] and closed (first point repeated); lines are
-/// [`PathKind::Infill`]. Paths come region by region, rings outermost first, infill last; use [`order_paths`] for a print order. No
+/// [`PathKind::Infill`]. Paths come region by region, rings outermost first (a gap-fill line
+/// right after the ring it lies inside), infill last; use [`order_paths`] for a print order. No
 /// path has a segment shorter than a micrometre (none of zero length). Degenerate input (no
 /// regions, slivers, a region narrower than a bead, width or spacing not positive) gives fewer
 /// paths or none, never a panic.
@@ -657,9 +660,9 @@ pub fn fill_layer(
 pub struct FilledLayer {
     /// Paths of one bead width.
     pub paths: Vec<Path2>,
-    /// Strips of the regions narrower than a ring (thin parts the rings cannot take, the
-    /// middle left between rings): each is to be filled with beads as wide as it is there
-    /// (`freeform::fill_flat_region`; `planar` does so).
+    /// Parts of the regions too narrow for a ring (where its beads would meet from both
+    /// sides, or the first ring cannot reach): each is to be filled with beads as wide as it
+    /// is there (`freeform::fill_flat_region`; `planar::fill_regions` does so).
     pub gaps: Vec<Region>,
 }
 
@@ -776,15 +779,15 @@ fn bounds(s: &Shapes) -> (Point2, Point2) {
 
 /// Up to `max` rings inward from `base` (the first at `width / 2`, then every `spacing`);
 /// returns the area inside the last ring, offset by one more spacing (the infill area of
-/// contour-zig-zag; empty once the region is used up). What the rings leave uncovered, strips
-/// too narrow for another ring, goes to `gaps`.
+/// contour-zig-zag; empty once the region is used up). Strips narrower than a bead that the
+/// rings leave uncovered get gap-fill lines; parts too narrow for a ring go to `gaps`.
 ///
 /// Where a ring's offset has parts narrower than a spacing, its beads from either side
 /// overlap there (a 1.5 mm web took two rings of 0.45 mm beads 0.15 mm apart, 0.3 mm of bead
 /// laid twice): the ring keeps only where a whole bead nearly fits (the offset opened by
-/// [`OPEN_SHARE`] of a spacing), and the part it drops is left in the gap, to be filled by beads as wide as it is
-/// ([`FilledLayer::gaps`]). The same goes for parts of the region narrower than a bead, which
-/// the first ring cannot reach at all.
+/// [`OPEN_SHARE`] of a spacing), and the part it drops goes to `gaps`, to be filled by beads
+/// as wide as it is ([`FilledLayer::gaps`]). The same goes for parts of the region narrower
+/// than a bead, which the first ring cannot reach at all.
 ///
 /// Each ring is offset from the one before rather than from `base` (a large offset that
 /// collapses a many-sided polygon costs i_overlay time quadratic in its vertices: a 256-gon
