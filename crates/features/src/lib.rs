@@ -1,7 +1,7 @@
 //! `features`: what a part is built from. AM feature recognition after the feature-based
 //! five-axis AM paper: an attributed adjacency graph with edge convexity ([`aag`]), concave
 //! loops, shell splitting and healing, classification into `two5d` and `freeform` features and
-//! their dependency graph ([`extract`]); the solids of a file together ([`assembly`]).
+//! their dependency graph ([`extract`](mod@extract)); the solids of a file together ([`assembly`]).
 #![warn(missing_docs)]
 
 pub mod aag;

@@ -171,7 +171,7 @@ fn surface_points(tree: &FeatureTree, f: &Feature) -> Vec<P3> {
 
 /// How far (mm) feature `f` reaches below `plane` (the build plate): 0 when it does not.
 /// Measured on its faces' surfaces, not its vertices, so a curved face dipping below the
-/// plate between its vertices counts; within [`EXTREME_TOL`].
+/// plate between its vertices counts; within `EXTREME_TOL` (0.01 mm).
 pub fn depth_below(tree: &FeatureTree, f: &Feature, plane: &Plane) -> f64 {
     surface_points(tree, f)
         .iter()
