@@ -101,7 +101,11 @@ pub fn extract_all(brep: &Brep, opts: &ExtractOptions) -> Result<Assembly, Extra
     let boxes: Vec<Aabb> = order.iter().map(|&k| boxes[k]).collect();
 
     if trees.len() > 1 {
-        let solids: Vec<Solid> = trees.iter().map(Solid::new).collect();
+        let solids: Vec<Solid> = trees
+            .iter()
+            .zip(&boxes)
+            .map(|(t, b)| Solid::new(t, *b))
+            .collect();
         // Solids that overlap one built before them stand on it.
         let mut supported = vec![false; solids.len()];
         for i in 0..solids.len() {
@@ -148,8 +152,8 @@ struct Solid {
 }
 
 impl Solid {
-    fn new(t: &FeatureTree) -> Solid {
-        let bbox = t.mesh.bbox();
+    /// `t`'s solid, whose analysis mesh has the box `bbox`.
+    fn new(t: &FeatureTree, bbox: Aabb) -> Solid {
         let vertices: Vec<Point3<f32>> = t
             .mesh
             .positions

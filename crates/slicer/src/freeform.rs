@@ -85,6 +85,20 @@ pub struct Chart<'a> {
 }
 
 impl<'a> Chart<'a> {
+    /// The chart of `surf` in its own (u, v), unscaled: exact on a plane.
+    fn unit(surf: &'a Surface) -> Chart<'a> {
+        Chart {
+            surf,
+            sign: 1.0,
+            kind: ChartKind::Native {
+                u0: 0.0,
+                v0: 0.0,
+                su: 1.0,
+                sv: 1.0,
+            },
+        }
+    }
+
     fn normal_at(&self, u: f64, v: f64) -> Option<V3> {
         self.surf.normal(u, v).map(|n| n * self.sign)
     }
@@ -596,16 +610,7 @@ pub fn fill_flat_region(
         frame: brep::math::Frame::world(P3::origin()),
     };
     // The plane's own (u, v) at scale 1 is the identity on the layer's 2-D coordinates.
-    let chart = Chart {
-        surf: &plane,
-        sign: 1.0,
-        kind: ChartKind::Native {
-            u0: 0.0,
-            v0: 0.0,
-            su: 1.0,
-            sv: 1.0,
-        },
-    };
+    let chart = Chart::unit(&plane);
     let sliver_inset = match boundary {
         Boundary::Part => SLIVER_INSET,
         Boundary::Beads => GAP_INSET,
@@ -1634,7 +1639,7 @@ mod tests {
     fn a_flat_disc_is_covered_in_every_mode() {
         // On a plane the chart is exact: the fills must cover the disc like planar fills do.
         let surf = world_plane();
-        let chart = unit_chart(&surf);
+        let chart = Chart::unit(&surf);
         let outer: Vec<Point2> = (0..64)
             .map(|i| {
                 let a = i as f64 / 64.0 * std::f64::consts::TAU;
@@ -1770,20 +1775,6 @@ mod tests {
         }
     }
 
-    /// The chart of `surf` in its own (u, v), unscaled: exact on a plane.
-    fn unit_chart(surf: &Surface) -> Chart<'_> {
-        Chart {
-            surf,
-            sign: 1.0,
-            kind: ChartKind::Native {
-                u0: 0.0,
-                v0: 0.0,
-                su: 1.0,
-                sv: 1.0,
-            },
-        }
-    }
-
     /// A cylinder of radius 4 about the z axis.
     fn radius_4_cylinder() -> Surface {
         Surface::Cylinder {
@@ -1887,7 +1878,7 @@ mod tests {
         // A 30° wedge on a plane: rings stop (w/2)/sin 15° = 0.87 mm short of the tip; the
         // spur runs on along the bisector, as wide as the wedge, to where it is 0.3 bead wide.
         let surf = world_plane();
-        let chart = unit_chart(&surf);
+        let chart = Chart::unit(&surf);
         let half = 15f64.to_radians();
         let (l, w) = (10.0, 0.45);
         let outer = vec![
@@ -2037,7 +2028,7 @@ mod tests {
         // A strip 0.3 mm wide and 6 mm long on a plane: no ring of a 0.45 mm bead fits, so
         // the gap fill lays it down, as wide as the strip, with about the strip's area.
         let surf = world_plane();
-        let chart = unit_chart(&surf);
+        let chart = Chart::unit(&surf);
         let outer = vec![[0.0, 0.0], [6.0, 0.0], [6.0, 0.3], [0.0, 0.3]];
         for mode in [PathMode::ContourZigzag, PathMode::Contour, PathMode::Zigzag] {
             let paths = fill_on_layer(&chart, outer.clone(), mode);
