@@ -4,6 +4,7 @@
 //! surface and order them by what grows on what.
 
 use crate::aag::{self, Convexity};
+use crate::split;
 use brep::math::V3;
 use brep::mesh::{loop_roles, mesh_faces, LoopRole, MeshError};
 use brep::solid::analysis_options;
@@ -99,8 +100,11 @@ pub struct Feature {
     pub root_loops: usize,
     /// Longest chain of parents above it.
     pub depth: usize,
-    /// Every edge of its shell used twice in opposite directions.
+    /// It passed [`check_solid`](crate::check::check_solid): a closed, outward, watertight
+    /// shell of valid faces enclosing a positive volume.
     pub closed: bool,
+    /// What [`check_solid`](crate::check::check_solid) found wrong (empty when `closed`).
+    pub problems: Vec<crate::check::SolidProblem>,
 }
 
 impl Feature {
@@ -141,6 +145,8 @@ pub struct FeatureTree {
     /// The solid as read (outer and void shells), meshed for analysis: closed, faces outward,
     /// chord tolerance 0.2 % of its size.
     pub mesh: brep::mesh::Mesh,
+    /// Every closed concave loop found, and whether it was split off or kept (and why).
+    pub roots: Vec<RootLoop>,
     /// What the user should know.
     pub warnings: Vec<String>,
 }
@@ -257,23 +263,23 @@ pub fn extract(
     // Split, heal, repeat. The parent side of a cut holds the draft's anchor: the build-plate
     // face for the base, the healing faces for a feature split off before.
     let plate = base_reference(&b, &outer, &mut vec![]).face;
+    let tol = split::Tol::for_size(diag);
     let mut drafts = vec![Draft {
         faces: outer.clone(),
         host: None,
         heal: vec![],
     }];
-    let mut done = vec![false; chains.len()];
-    let mut unsplit: Vec<usize> = vec![];
+    let mut outcome: Vec<Option<RootOutcome>> = vec![None; chains.len()];
     let mut i = 0;
     while i < drafts.len() {
         loop {
             let here: HashSet<FaceId> = drafts[i].faces.iter().copied().collect();
             let live: Vec<usize> = (0..chains.len())
                 .filter(|&k| {
-                    !done[k]
+                    outcome[k].is_none()
                         && chains[k]
                             .iter()
-                            .all(|e| edge_faces(&b, *e).iter().any(|f| here.contains(f)))
+                            .all(|e| split::edge_faces(&b, *e).iter().any(|f| here.contains(f)))
                 })
                 .collect();
             if live.is_empty() {
@@ -284,71 +290,73 @@ pub fn extract(
             } else {
                 drafts[i].heal.clone()
             };
-            let mut split = false;
-            // One chain at a time.
+            let mut ctx = SplitCtx {
+                b: &mut b,
+                shares: &mut shares,
+                origin,
+                mopts: &mopts,
+                tol,
+            };
+            let mut split_made = false;
+            let mut refusals: Vec<(usize, split::Refusal)> = vec![];
+            // One chain at a time, with the chains bounding any face it would wrongly take
+            // along (the plate's top inside a tube).
             for &k in &live {
-                if let Some(plan) = plan_cut(&b, &drafts[i].faces, &anchor, &[&chains[k]]) {
-                    done[k] = true;
-                    if try_split(&mut b, &mut drafts, i, plan) {
-                        split = true;
+                let group = ctx.with_enclosed(&drafts[i].faces, &anchor, &chains, &live, k);
+                match ctx.split(&mut drafts, i, &anchor, &chains, &group) {
+                    Ok(f) => {
+                        for &g in &group {
+                            outcome[g] = Some(RootOutcome::Split(f));
+                        }
+                        split_made = true;
                         break;
                     }
-                    unsplit.push(k);
+                    Err(r) => refusals.push((k, r)),
                 }
             }
-            if split {
+            if split_made {
                 continue;
             }
-            // Genus > 0: all live chains together (an arch standing on two feet).
+            // Genus > 0: all live chains together (an arch standing on two feet, a collar).
             if live.len() > 1 {
-                let all: Vec<&Vec<EdgeId>> = live.iter().map(|&k| &chains[k]).collect();
-                if let Some(plan) = plan_cut(&b, &drafts[i].faces, &anchor, &all) {
-                    split = try_split(&mut b, &mut drafts, i, plan);
-                    if split {
-                        for &k in &live {
-                            done[k] = true;
-                        }
+                if let Ok(f) = ctx.split(&mut drafts, i, &anchor, &chains, &live) {
+                    for &k in &live {
+                        outcome[k] = Some(RootOutcome::Split(f));
                     }
+                    continue;
                 }
             }
-            if !split {
-                for &k in &live {
-                    if !done[k] {
-                        done[k] = true;
-                        unsplit.push(k);
-                    }
+            for (k, r) in refusals {
+                if outcome[k].is_none() {
+                    outcome[k] = Some(RootOutcome::Kept(r.to_string()));
                 }
-                break;
             }
+            break;
         }
         i += 1;
     }
-
-    if !unsplit.is_empty() {
-        let ids: Vec<String> = unsplit
-            .iter()
-            .take(6)
-            .map(|&k| format!("#{}", b.edge(chains[k][0]).step_id))
-            .collect();
-        warnings.push(format!(
-            "{} closed concave loop(s) do not bound a feature that can be split off (pocket floors, slots, or roots spread over several faces); kept in their features (through edges {}{})",
-            unsplit.len(),
-            ids.join(", "),
-            if unsplit.len() > 6 { ", ..." } else { "" }
-        ));
-    }
-
-    // Faces the splits changed (re-trimmed hosts, healing faces) get fresh shares.
-    let changed: Vec<FaceId> = drafts
+    let roots: Vec<RootLoop> = chains
         .iter()
-        .flat_map(|d| d.heal.iter().copied().chain(d.host.iter().map(|h| h.0)))
-        .collect::<HashSet<_>>()
-        .into_iter()
+        .zip(outcome)
+        .map(|(c, o)| {
+            let mut edges: Vec<u64> = c.iter().map(|e| part.edge(*e).step_id).collect();
+            edges.sort_unstable();
+            RootLoop {
+                edges,
+                outcome: o.unwrap_or_else(|| {
+                    RootOutcome::Kept("it does not lie on one feature's faces".into())
+                }),
+            }
+        })
         .collect();
-    if !changed.is_empty() {
-        let m = mesh_faces(&b, &changed, &mopts)?;
-        for (f, v, a) in brep::mass::face_shares(&b, &m, &origin) {
-            shares.insert(f, (v, a));
+    for r in &roots {
+        if let RootOutcome::Kept(why) = &r.outcome {
+            let ids: Vec<String> = r.edges.iter().take(6).map(|e| format!("#{e}")).collect();
+            warnings.push(format!(
+                "concave loop through edges {}{} kept in its feature: {why}",
+                ids.join(", "),
+                if r.edges.len() > 6 { ", ..." } else { "" }
+            ));
         }
     }
 
@@ -372,10 +380,14 @@ pub fn extract(
         let fvoids = if k == 0 { voids.clone() } else { vec![] };
         let volume = vol_of(&shares, &d.faces).abs()
             - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
-        let closed = brep::validate::check_shell(&b, shell).closed;
+        let problems = crate::check::check_solid(&b, &d.faces, &fvoids, &mopts).problems;
+        let closed = problems.is_empty();
         if !closed {
+            let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();
             warnings.push(format!(
-                "feature {k}: its shell is not closed after splitting"
+                "feature {k} is not a valid solid: {}{}",
+                list.join("; "),
+                if problems.len() > 4 { "; ..." } else { "" }
             ));
         }
         let (parents, reference) = match &d.host {
@@ -408,6 +420,7 @@ pub fn extract(
             root_loops: d.host.map_or(0, |h| h.1),
             depth: 0,
             closed,
+            problems,
         });
     }
 
@@ -473,6 +486,7 @@ pub fn extract(
         part_faces: all_faces.len(),
         genus,
         mesh,
+        roots,
         warnings,
     })
 }
@@ -545,278 +559,6 @@ fn concave_chains(b: &Brep, faces: &[FaceId], g: &aag::Aag) -> Vec<Vec<EdgeId>> 
         }
     }
     out
-}
-
-/// The faces using an edge through their current loops.
-fn edge_faces(b: &Brep, e: EdgeId) -> Vec<FaceId> {
-    let mut out = vec![];
-    for &c in &b.edge(e).coedges {
-        let f = b.coedge_face(c);
-        if b.face(f).loops.contains(&b.coedges[c.idx()].lp) && !out.contains(&f) {
-            out.push(f);
-        }
-    }
-    out
-}
-
-/// A planned cut: which faces leave, and for each chain, the host face on the parent side.
-struct Cut {
-    child: Vec<FaceId>,
-    hosts: Vec<(FaceId, Vec<EdgeId>)>,
-}
-
-/// Plans cutting `faces` along `chains`: the child is the component(s) across the chains from
-/// the anchor (the largest component when there is no anchor), each chain's host is the single
-/// parent-side face along it. `None` when the chains do not separate anything or a chain runs
-/// along several parent-side faces.
-fn plan_cut(b: &Brep, faces: &[FaceId], anchor: &[FaceId], chains: &[&Vec<EdgeId>]) -> Option<Cut> {
-    let cut: HashSet<EdgeId> = chains.iter().flat_map(|c| c.iter().copied()).collect();
-    let comps = components(b, faces, &cut);
-    let parent = match anchor.iter().find_map(|f| comps.get(f)) {
-        Some(&c) => c,
-        None => {
-            let mut count: HashMap<usize, usize> = HashMap::new();
-            for c in comps.values() {
-                *count.entry(*c).or_default() += 1;
-            }
-            count.into_iter().max_by_key(|x| (x.1, usize::MAX - x.0))?.0
-        }
-    };
-    let mut child: HashSet<usize> = HashSet::new();
-    let mut hosts = vec![];
-    for chain in chains {
-        let mut host: Option<FaceId> = None;
-        for e in chain.iter() {
-            let fs: Vec<FaceId> = edge_faces(b, *e)
-                .into_iter()
-                .filter(|f| comps.contains_key(f))
-                .collect();
-            if fs.len() != 2 {
-                return None;
-            }
-            let (p, c): (Vec<FaceId>, Vec<FaceId>) =
-                fs.into_iter().partition(|f| comps[f] == parent);
-            if p.len() != 1 || c.len() != 1 {
-                return None;
-            }
-            if host.is_some_and(|h| h != p[0]) {
-                return None;
-            }
-            host = Some(p[0]);
-            child.insert(comps[&c[0]]);
-        }
-        hosts.push((host?, chain.to_vec()));
-    }
-    if child.is_empty() || child.contains(&parent) {
-        return None;
-    }
-    let child_faces: Vec<FaceId> = faces
-        .iter()
-        .copied()
-        .filter(|f| child.contains(&comps[f]))
-        .collect();
-    Some(Cut {
-        child: child_faces,
-        hosts,
-    })
-}
-
-/// Applies a cut and heals both sides (paper, Fig. 8): each host face drops the chain's edges
-/// (and any seam left dangling), so its surface runs across the root; the child gets, per chain,
-/// a face on the host's surface facing the other way, bounded by the chain. Kept only if both
-/// shells come out closed.
-fn try_split(b: &mut Brep, drafts: &mut Vec<Draft>, i: usize, cut: Cut) -> bool {
-    let saved = b.clone();
-    let mut heal = vec![];
-    for (t, chain) in &cut.hosts {
-        let host = b.face(*t).clone();
-        // The host's own uses of the chain's edges, ordered head to tail.
-        let mut uses: Vec<(EdgeId, bool)> = vec![];
-        for l in &host.loops {
-            for c in &b.loops[l.idx()].coedges {
-                let ce = &b.coedges[c.idx()];
-                if chain.contains(&ce.edge) && !uses.iter().any(|u| u.0 == ce.edge) {
-                    uses.push((ce.edge, ce.forward));
-                }
-            }
-        }
-        let Some(ordered) = order_cycle(b, &uses) else {
-            *b = saved;
-            return false;
-        };
-        let h = FaceId(b.faces.len() as u32);
-        let nl = LoopId(b.loops.len() as u32);
-        let mut coedges = vec![];
-        for (e, fwd) in ordered {
-            let nc = CoedgeId(b.coedges.len() as u32);
-            b.coedges.push(Coedge {
-                step_id: 0,
-                edge: e,
-                forward: fwd,
-                lp: nl,
-            });
-            b.edges[e.idx()].coedges.push(nc);
-            coedges.push(nc);
-        }
-        b.loops.push(Loop {
-            step_id: 0,
-            face: h,
-            outer: true,
-            coedges,
-            vertex: None,
-        });
-        b.faces.push(Face {
-            step_id: 0,
-            surface: host.surface,
-            same_sense: !host.same_sense,
-            loops: vec![nl],
-            shell: host.shell,
-        });
-        heal.push(h);
-        // The host drops the chain, and seams that now lead nowhere (used twice in a row).
-        let mut loops = vec![];
-        for l in &host.loops {
-            let mut cs: Vec<CoedgeId> = b.loops[l.idx()]
-                .coedges
-                .iter()
-                .copied()
-                .filter(|c| !chain.contains(&b.coedges[c.idx()].edge))
-                .collect();
-            let mut changed = true;
-            while changed && cs.len() >= 2 {
-                changed = false;
-                let n = cs.len();
-                for k in 0..n {
-                    let (x, y) = (&b.coedges[cs[k].idx()], &b.coedges[cs[(k + 1) % n].idx()]);
-                    if x.edge == y.edge && x.forward != y.forward {
-                        let (a, c) = (k, (k + 1) % n);
-                        let (hi, lo) = (a.max(c), a.min(c));
-                        cs.remove(hi);
-                        cs.remove(lo);
-                        changed = true;
-                        break;
-                    }
-                }
-            }
-            if !cs.is_empty()
-                || !b.loops[l.idx()]
-                    .coedges
-                    .iter()
-                    .any(|c| chain.contains(&b.coedges[c.idx()].edge))
-            {
-                b.loops[l.idx()].coedges = cs;
-                loops.push(*l);
-            }
-        }
-        b.faces[t.idx()].loops = loops;
-    }
-    let set: HashSet<FaceId> = cut.child.iter().copied().collect();
-    let parent: Vec<FaceId> = drafts[i]
-        .faces
-        .iter()
-        .copied()
-        .filter(|f| !set.contains(f))
-        .collect();
-    let mut child = cut.child.clone();
-    child.extend(heal.iter().copied());
-    // Both sides must close.
-    let closed = |b: &mut Brep, faces: &[FaceId]| {
-        let s = ShellId(b.shells.len() as u32);
-        b.shells.push(Shell {
-            step_id: 0,
-            faces: faces.to_vec(),
-            void: false,
-        });
-        let ok = brep::validate::check_shell(b, s).closed;
-        b.shells.pop();
-        ok
-    };
-    // And every changed face must still bound a region of its surface.
-    let mut touched: Vec<FaceId> = cut.hosts.iter().map(|(t, _)| *t).collect();
-    touched.extend(heal.iter().copied());
-    let coarse = brep::mesh::MeshOptions::with_tolerance(0.5);
-    let valid = touched
-        .iter()
-        .all(|f| brep::mesh::face_domain(b, *f, &coarse).is_ok_and(|d| !d.loops.is_empty()));
-    if !valid || !closed(b, &parent) || !closed(b, &child) {
-        *b = saved;
-        return false;
-    }
-    let host = cut.hosts[0].0;
-    let loops_n = cut.hosts.len();
-    drafts[i].faces = parent;
-    drafts.push(Draft {
-        faces: child,
-        host: Some((host, loops_n)),
-        heal,
-    });
-    true
-}
-
-/// Orders edge uses `(edge, forward)` into one closed head-to-tail cycle.
-fn order_cycle(b: &Brep, uses: &[(EdgeId, bool)]) -> Option<Vec<(EdgeId, bool)>> {
-    let ends = |(e, f): (EdgeId, bool)| {
-        let ed = b.edge(e);
-        if f {
-            (ed.start, ed.end)
-        } else {
-            (ed.end, ed.start)
-        }
-    };
-    let mut left: Vec<(EdgeId, bool)> = uses.to_vec();
-    let first = left.pop()?;
-    let mut out = vec![first];
-    let start = ends(first).0;
-    let mut at = ends(first).1;
-    while !left.is_empty() {
-        let k = left.iter().position(|u| ends(*u).0 == at)?;
-        let u = left.remove(k);
-        at = ends(u).1;
-        out.push(u);
-    }
-    (at == start).then_some(out)
-}
-
-/// Connected components of `faces` through shared edges, not crossing `cut`.
-fn components(b: &Brep, faces: &[FaceId], cut: &HashSet<EdgeId>) -> HashMap<FaceId, usize> {
-    let mut by_edge: HashMap<EdgeId, Vec<FaceId>> = HashMap::new();
-    for &f in faces {
-        for l in &b.face(f).loops {
-            for c in &b.loops[l.idx()].coedges {
-                let e = b.coedges[c.idx()].edge;
-                if !cut.contains(&e) {
-                    by_edge.entry(e).or_default().push(f);
-                }
-            }
-        }
-    }
-    let idx: HashMap<FaceId, usize> = faces.iter().enumerate().map(|(k, f)| (*f, k)).collect();
-    let mut parent: Vec<usize> = (0..faces.len()).collect();
-    fn find(p: &mut [usize], x: usize) -> usize {
-        let mut r = x;
-        while p[r] != r {
-            r = p[r];
-        }
-        let mut y = x;
-        while p[y] != r {
-            let n = p[y];
-            p[y] = r;
-            y = n;
-        }
-        r
-    }
-    for fs in by_edge.values() {
-        for w in fs.windows(2) {
-            let (a, c) = (find(&mut parent, idx[&w[0]]), find(&mut parent, idx[&w[1]]));
-            if a != c {
-                parent[a] = c;
-            }
-        }
-    }
-    faces
-        .iter()
-        .map(|f| (*f, find(&mut parent, idx[f])))
-        .collect()
 }
 
 fn surface_kind(s: &Surface) -> String {
@@ -957,5 +699,128 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
         "stretch".into()
     } else {
         "loft".into()
+    }
+}
+
+/// What became of one closed concave loop.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RootOutcome {
+    /// The feature split off along it.
+    Split(usize),
+    /// Kept in its feature, and why.
+    Kept(String),
+}
+
+/// One closed concave loop of the part and what became of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RootLoop {
+    /// STEP `#id`s of its edges, sorted.
+    pub edges: Vec<u64>,
+    /// Split off, or kept and why.
+    pub outcome: RootOutcome,
+}
+
+/// What a split needs besides the drafts: the B-rep, the faces' volume shares (kept current for
+/// the faces a split re-makes), and the tolerances.
+struct SplitCtx<'a> {
+    b: &'a mut Brep,
+    shares: &'a mut HashMap<FaceId, (f64, f64)>,
+    origin: brep::math::P3,
+    mopts: &'a brep::mesh::MeshOptions,
+    tol: split::Tol,
+}
+
+impl SplitCtx<'_> {
+    /// Chain `k`, with the live chains that bound faces its cut would take along although they
+    /// lie on its host surface (the plate's top inside a tube standing on it: its root is the
+    /// tube's inner root).
+    fn with_enclosed(
+        &self,
+        faces: &[FaceId],
+        anchor: &[FaceId],
+        chains: &[Vec<EdgeId>],
+        live: &[usize],
+        k: usize,
+    ) -> Vec<usize> {
+        let mut group = vec![k];
+        if let Ok(cut) = split::plan_cut(self.b, faces, anchor, &[&chains[k]], self.tol) {
+            let on: HashSet<FaceId> = split::child_faces_on_hosts(self.b, &cut, self.tol)
+                .into_iter()
+                .collect();
+            if !on.is_empty() {
+                for &j in live {
+                    if j != k
+                        && chains[j]
+                            .iter()
+                            .all(|e| split::edge_faces(self.b, *e).iter().any(|f| on.contains(f)))
+                    {
+                        group.push(j);
+                    }
+                }
+            }
+        }
+        group
+    }
+
+    /// Splits draft `i` along the chains `group` and heals both sides. Kept only if both sides
+    /// pass the topology check, every re-made face meshes, both volumes are positive and they
+    /// add up to the draft's. Returns the new draft's index.
+    fn split(
+        &mut self,
+        drafts: &mut Vec<Draft>,
+        i: usize,
+        anchor: &[FaceId],
+        chains: &[Vec<EdgeId>],
+        group: &[usize],
+    ) -> Result<usize, split::Refusal> {
+        let sel: Vec<&Vec<EdgeId>> = group.iter().map(|&k| &chains[k]).collect();
+        let cut = split::plan_cut(self.b, &drafts[i].faces, anchor, &sel, self.tol)?;
+        let vol = |shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]| {
+            fs.iter()
+                .map(|f| shares.get(f).map_or(0.0, |s| s.0))
+                .sum::<f64>()
+        };
+        let before = vol(self.shares, &drafts[i].faces);
+        let saved = self.b.clone();
+        let s = split::apply_cut(self.b, &drafts[i].faces, &cut, self.tol)?;
+        // The re-made faces mesh, and cleanly: no mesh edge of theirs used twice the same way
+        // (their seams with untouched faces show as open edges here, which is expected).
+        let fresh = match mesh_faces(self.b, &s.touched, self.mopts) {
+            Ok(m) if m.open_edges().1 == 0 => brep::mass::face_shares(self.b, &m, &self.origin),
+            Ok(m) => {
+                *self.b = saved;
+                return Err(split::Refusal::Invalid(format!(
+                    "a healed face's mesh has {} non-manifold edge(s)",
+                    m.open_edges().1
+                )));
+            }
+            Err(e) => {
+                *self.b = saved;
+                return Err(split::Refusal::Invalid(e.to_string()));
+            }
+        };
+        let mut shares = self.shares.clone();
+        for (f, v, a) in fresh {
+            shares.insert(f, (v, a));
+        }
+        let (pv, cv) = (vol(&shares, &s.parent), vol(&shares, &s.child));
+        let conserved = (pv + cv - before).abs() <= 2e-3 * before.abs() + 1e-9;
+        if pv * before <= 0.0 || cv * before <= 0.0 || !conserved {
+            *self.b = saved;
+            return Err(split::Refusal::Invalid(format!(
+                "the sides would enclose {:.3} and {:.3} mm^3 of the {:.3} mm^3 split",
+                pv.abs(),
+                cv * before.signum(),
+                before.abs()
+            )));
+        }
+        *self.shares = shares;
+        drafts[i].faces = s.parent;
+        drafts.push(Draft {
+            faces: s.child,
+            host: Some((s.host, group.len())),
+            heal: s.heal,
+        });
+        Ok(drafts.len() - 1)
     }
 }

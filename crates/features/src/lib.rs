@@ -6,9 +6,13 @@
 
 pub mod aag;
 pub mod assembly;
+pub mod check;
 pub mod extract;
+pub mod split;
 
 pub use assembly::{extract_all, solid_name, Assembly};
+pub use check::{check_solid, SolidCheck, SolidProblem};
 pub use extract::{
-    extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference,
+    extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference, RootLoop,
+    RootOutcome,
 };
