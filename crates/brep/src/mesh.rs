@@ -1215,6 +1215,9 @@ fn triangulate(
         let mut triangles = vec![];
         let mut splits: Vec<[f64; 2]> = vec![];
         let mut seen = std::collections::HashSet::new();
+        // Every drawn edge: (local handles, mesh vertices, constraint, middle).
+        #[allow(clippy::type_complexity)]
+        let mut drawn: Vec<((usize, usize), (u32, u32), bool, [f64; 2])> = vec![];
         for face in cdt.inner_faces() {
             let vs = face.vertices();
             let inside = match &depth {
@@ -1265,10 +1268,21 @@ fn triangulate(
                     }
                 }
                 for e in face.adjacent_edges() {
+                    let (ha, hb) = (e.from().fix().index(), e.to().fix().index());
+                    if let (Some(&la), Some(&lb)) =
+                        (loc.handle_local.get(&ha), loc.handle_local.get(&hb))
+                    {
+                        let (pa, pb) = (e.from().position(), e.to().position());
+                        drawn.push((
+                            (ha.min(hb), ha.max(hb)),
+                            (loc.vertex[la], loc.vertex[lb]),
+                            e.is_constraint_edge(),
+                            [(pa.x + pb.x) * 0.5, (pa.y + pb.y) * 0.5],
+                        ));
+                    }
                     if e.is_constraint_edge() {
                         continue;
                     }
-                    let (ha, hb) = (e.from().fix().index(), e.to().fix().index());
                     let (Some(&la), Some(&lb)) =
                         (loc.handle_local.get(&ha), loc.handle_local.get(&hb))
                     else {
@@ -1290,7 +1304,28 @@ fn triangulate(
             }
             triangles.push(t);
         }
-        if splits.is_empty() {
+        // Two drawn edges between the same mesh vertices, one of them free: points that are
+        // one vertex in 3-D (a pole's points along its singular line, the two sides of the
+        // cut to a pole) joined to the same neighbour more than once. Split the free ones.
+        let mut by_pair: HashMap<(u32, u32), Vec<(usize, usize)>> = HashMap::new();
+        for (h, (ga, gb), _, _) in &drawn {
+            if ga != gb {
+                let v = by_pair.entry((*ga.min(gb), *ga.max(gb))).or_default();
+                if !v.contains(h) {
+                    v.push(*h);
+                }
+            }
+        }
+        for (h, (ga, gb), constraint, mid) in &drawn {
+            if !constraint
+                && ga != gb
+                && by_pair[&(*ga.min(gb), *ga.max(gb))].len() > 1
+                && seen.insert(*h)
+            {
+                splits.push(*mid);
+            }
+        }
+        if splits.is_empty() || rounds >= MAX_ROUNDS {
             return Ok(FaceTriangulation {
                 face: f,
                 uv: loc.uv,
