@@ -688,10 +688,19 @@ fn extract_json_plate_boss_boss_has_the_exact_shape() {
             "features",
             "build_order",
             "depth",
+            "concave_loops",
             "warnings"
         ]
     );
     assert_eq!(v["schema"], "features.extract/1");
+    // Both roots of the two bosses are split off, each naming the feature it bounds.
+    let loops = v["concave_loops"].as_array().expect("concave_loops array");
+    assert_eq!(loops.len(), 2);
+    for l in loops {
+        assert_eq!(l["split"], true, "{l}");
+        assert!(l["feature"].as_u64().is_some_and(|k| k == 1 || k == 2));
+        assert!(!l["edges"].as_array().unwrap().is_empty());
+    }
     assert_eq!(v["units"], "mm");
     assert_eq!(
         keys(&v["part"]),

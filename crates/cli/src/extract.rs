@@ -54,8 +54,19 @@ fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
     let genus: Option<i64> = solids.iter().map(|s| s.tree.genus).sum();
     let mut features = vec![];
     let mut order = vec![];
+    let mut roots = vec![];
     for s in solids {
         let t = &s.tree;
+        for r in &t.roots {
+            roots.push(match &r.outcome {
+                features::RootOutcome::Split(k) => {
+                    json!({"edges": r.edges, "split": true, "feature": s.offset + k})
+                }
+                features::RootOutcome::Kept(why) => {
+                    json!({"edges": r.edges, "split": false, "reason": why})
+                }
+            });
+        }
         for f in &t.features {
             features.push(feature_json_fields(t, f, s.offset));
         }
@@ -69,6 +80,7 @@ fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
         "features": features,
         "build_order": order,
         "depth": solids.iter().map(|s| s.tree.depth).max().unwrap_or(0),
+        "concave_loops": roots,
         "warnings": warnings,
     })
 }
