@@ -499,8 +499,15 @@ fn heal_hosts(
             continue;
         }
         let (ui, uo) = (uses[i], uses[o]);
-        let (a, c) = (use_start(b, &ui), use_end(b, &uo));
-        let (t0, _) = use_params(b, &ui);
+        let (t0, t1) = use_params(b, &ui);
+        // A piece that continues into itself closes round its curve through the gap.
+        let (a, c, z) = if i == o {
+            let per = b.edge_curve(ui.edge).period().unwrap_or(0.0);
+            let a = use_start(b, &ui);
+            (a, a, t0 + (t1 - t0).signum() * per)
+        } else {
+            (use_start(b, &ui), use_end(b, &uo), z)
+        };
         let key = (ui.edge.min(uo.edge), ui.edge.max(uo.edge));
         let (m, fwd) = match merged.get(&key) {
             Some(&m) => {
@@ -611,6 +618,26 @@ fn heal_hosts(
                 .entry(class[fidx[&uses[s].face]])
                 .or_default()
                 .push(cyc);
+        }
+    }
+    // A closed edge that is a whole loop on its own, once each way in one face, is a seam the
+    // face no longer needs (two faces either side of a torus's seam circle, joined).
+    for loops in loops_by_class.values_mut() {
+        let single = |l: &Vec<(EdgeId, bool)>| (l.len() == 1).then(|| l[0]);
+        let mut k = 0;
+        while k < loops.len() {
+            let pair = single(&loops[k]).and_then(|(e, fwd)| {
+                (0..loops.len()).find(|&j| j != k && single(&loops[j]) == Some((e, !fwd)))
+            });
+            match pair {
+                Some(j) => {
+                    let (hi, lo) = (j.max(k), j.min(k));
+                    loops.remove(hi);
+                    loops.remove(lo);
+                    k = 0;
+                }
+                None => k += 1,
+            }
         }
     }
     for (f, seq) in kept_loops {
