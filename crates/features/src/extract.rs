@@ -366,6 +366,9 @@ pub fn extract(
         .enumerate()
         .flat_map(|(k, d)| d.faces.iter().map(move |f| (*f, k)))
         .collect();
+    // The solid check meshes each feature again: coarser than the analysis mesh, since it asks
+    // only whether every face meshes, the mesh closes and the volume is positive.
+    let check_opts = analysis_options(diag * 4.0);
     let mut features = vec![];
     for (k, d) in drafts.iter().enumerate() {
         let shell = ShellId(b.shells.len() as u32);
@@ -380,7 +383,7 @@ pub fn extract(
         let fvoids = if k == 0 { voids.clone() } else { vec![] };
         let volume = vol_of(&shares, &d.faces).abs()
             - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
-        let problems = crate::check::check_solid(&b, &d.faces, &fvoids, &mopts).problems;
+        let problems = crate::check::check_solid(&b, &d.faces, &fvoids, &check_opts).problems;
         let closed = problems.is_empty();
         if !closed {
             let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();

@@ -37,6 +37,9 @@ fn check_file(path: &Path, failures: &mut Vec<String>) {
                 continue;
             }
         };
+        let check_opts = brep::solid::analysis_options(
+            brep::solid::rough_bbox(&tree.brep, tree.solid).diagonal(),
+        );
         let sum: f64 = tree.features.iter().map(|f| f.volume).sum();
         if (sum - part_volume).abs() > 5e-3 * part_volume.abs().max(1e-9) {
             failures.push(format!(
@@ -77,6 +80,14 @@ fn check_file(path: &Path, failures: &mut Vec<String>) {
                     f.closed,
                     f.faces.len(),
                     f.volume
+                ));
+            }
+            // The library's solid check, called as a user of the crate would.
+            let c = features::check_solid(&tree.brep, &f.faces, &f.voids, &check_opts);
+            if !c.is_valid() {
+                failures.push(format!(
+                    "{name}: feature {} fails the solid check: {:?}",
+                    f.id, c.problems
                 ));
             }
             if let Some(n) = f.reference.normal {
