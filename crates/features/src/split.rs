@@ -25,6 +25,9 @@ pub enum Refusal {
     /// Its root runs over faces of different surfaces (a blade taller than its hub, rooted on
     /// the hub's side and top): `(face #id, surface kind)` of the host faces.
     MixedSurfaces(Vec<(u64, String)>),
+    /// On its host surface the root bounds no region: it winds round the surface (the floor
+    /// of a blind hole, seen from the hole's wall; a ring round a shaft).
+    NoRegion(u64),
     /// Healing could not re-make the host's boundary across the root.
     Heal(String),
     /// Healing gave a shell that is not a valid solid.
@@ -43,6 +46,10 @@ impl std::fmt::Display for Refusal {
                     names.join(", ")
                 )
             }
+            Refusal::NoRegion(face) => write!(
+                f,
+                "on its host face #{face} it bounds no region (it winds round the surface: a blind hole's floor, a ring round a shaft)"
+            ),
             Refusal::Heal(s) => write!(f, "the host cannot be healed across it: {s}"),
             Refusal::Invalid(s) => write!(f, "healing would not give a valid solid: {s}"),
         }
@@ -858,8 +865,19 @@ fn apply_inner(b: &mut Brep, faces: &[FaceId], cut: &Cut, tol: Tol) -> Result<Sp
     let mut heal = vec![];
     let mut hosts_after: Vec<(FaceId, Vec<Vec<(EdgeId, bool)>>)> = vec![];
     let mut dropped: HashSet<FaceId> = HashSet::new();
+    let coarse = MeshOptions::with_tolerance(0.5);
     for g in &cut.groups {
-        heal.extend(heal_child(b, g)?);
+        let faces = heal_child(b, g)?;
+        for &h in &faces {
+            match face_domain(b, h, &coarse) {
+                Ok(d) if !d.loops.is_empty() => {}
+                Err(e) if !e.to_string().contains("wraps around") => {
+                    return Err(Refusal::Invalid(e.to_string()))
+                }
+                _ => return Err(Refusal::NoRegion(b.face(g.faces[0]).step_id)),
+            }
+        }
+        heal.extend(faces);
         let healed = heal_hosts(b, g, tol)?;
         for &f in &g.faces {
             if !healed.iter().any(|(h, _)| *h == f) {
