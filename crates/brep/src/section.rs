@@ -92,11 +92,12 @@ pub fn section(mesh: &Mesh, plane: &Plane) -> Vec<Vec<P3>> {
         let (p1, p2) = (cross(a, b), cross(a, c));
         point.insert(e1, p1);
         point.insert(e2, p2);
-        // Orient so material is on the left looking down the normal: along normal × N_t.
-        let nt = (mesh.positions[b as usize] - mesh.positions[a as usize])
-            .cross(&(mesh.positions[c as usize] - mesh.positions[a as usize]));
-        let dir = plane.normal.cross(&nt);
-        if (p2 - p1).dot(&dir) >= 0.0 {
+        // Orient so material is on the left looking down the normal, i.e. along normal × N_t
+        // for the triangle's outward normal N_t: for a triangle wound counter-clockwise about
+        // N_t, from the crossing on (a, b) to the one on (a, c) when the lone vertex is above,
+        // the other way when it is below. Read from the winding, not from the crossing points,
+        // which coincide where the level runs through a vertex.
+        if above(a) {
             next.insert(e1, e2);
         } else {
             next.insert(e2, e1);
@@ -181,6 +182,38 @@ mod tests {
             "{} vs {want}",
             signed_area(&poly)
         );
+    }
+
+    #[test]
+    fn levels_through_mesh_vertices_still_close_every_loop() {
+        // A level through a ring of the mesh's own vertices (the middle row of a cylinder's
+        // grid) makes crossing points coincide; each loop must still close.
+        let part = fixture("cylinder.step");
+        let b = &part.brep;
+        let m = mesh_faces(
+            b,
+            &b.solid_faces(crate::topology::SolidId(0)),
+            &MeshOptions::with_tolerance(0.0125),
+        )
+        .expect("mesh");
+        let bb = m.bbox();
+        let mut levels: Vec<f64> = m
+            .positions
+            .iter()
+            .map(|p| p.z)
+            .filter(|z| *z > bb.min.z + 1e-6 && *z < bb.max.z - 1e-6)
+            .collect();
+        levels.sort_by(f64::total_cmp);
+        levels.dedup();
+        assert!(!levels.is_empty(), "the mesh has vertices between its ends");
+        for z in levels {
+            let plane = Plane::new(P3::new(0.0, 0.0, z), V3::z());
+            let loops = section(&m, &plane);
+            assert_eq!(loops.len(), 1, "level {z}");
+            let poly: Vec<[f64; 2]> = loops[0].iter().map(|p| plane.to_2d(p)).collect();
+            let want = 0.25 * (bb.max.x - bb.min.x) * (bb.max.y - bb.min.y) * std::f64::consts::PI;
+            assert!((signed_area(&poly) - want).abs() < 1e-2 * want, "level {z}");
+        }
     }
 
     #[test]
