@@ -720,7 +720,14 @@ fn a_feature_reaching_below_the_build_plate_is_named_with_its_depth() {
         return;
     }
     let [lo, _] = bboxes(&part)[0];
-    let (_dir, plan, csv, _, stderr) = plan_part(&part, &[]);
+    // Its plan also fails the self-check (the part below the plate is not printed, and the
+    // I-section's web loses material): --keep-going, since this test is about the depth.
+    let (_dir, plan, csv, _, stderr) = plan_part(&part, &["--keep-going"]);
+    assert_eq!(plan["complete"], false);
+    assert!(
+        stderr.contains("feature 0 (two5d):") && stderr.contains("mm^3 extruded for"),
+        "{stderr}"
+    );
     let first_top = rows(&csv)
         .iter()
         .filter(|r| r.print && r.layer == 0)
@@ -824,5 +831,57 @@ fn several_solids_are_printed_lowest_first_and_their_overlap_and_gap_warned() {
     for w in overlap.iter().chain(&air) {
         assert!(w.starts_with("solid #"), "{w}");
         assert!(stderr.contains(**w), "{w} not on stderr");
+    }
+}
+
+#[test]
+fn a_plan_that_passes_its_self_check_says_it_is_complete() {
+    let (_dir, plan, _, _) = plan("plate_boss_boss", &[]);
+    assert_eq!(plan["complete"], true);
+    for f in plan["features"].as_array().expect("features") {
+        let (v, e) = (
+            f["volume_mm3"].as_f64().unwrap(),
+            f["extruded_volume_mm3"].as_f64().unwrap(),
+        );
+        assert!(
+            (e - v).abs() <= 0.03 * v,
+            "feature {}: {e} for {v}",
+            f["id"]
+        );
+        assert!(f["layers"].as_u64().unwrap() > 0);
+    }
+}
+
+#[test]
+fn a_plan_that_loses_material_exits_2_naming_the_feature_and_writes_nothing() {
+    // SolidWorks' leg fork loses 45 % of its base feature (the rounded end below the plate, the
+    // web between flanges): the self-check stops it.
+    let part =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/sw2017_leg_fork.step");
+    if !part.exists() {
+        eprintln!("skipped: {} is not there", part.display());
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("features-plan-selfcheck-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(BIN)
+        .arg("plan")
+        .arg(&part)
+        .arg("-o")
+        .arg(&dir)
+        .output()
+        .expect("runs");
+    let _guard = Out(dir.clone());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains(": feature ") && l.contains("mm^3 extruded for"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(lines[0].contains("feature 0 (two5d)"), "{}", lines[0]);
+    assert!(stderr.contains("fails its self-check"), "{stderr}");
+    for f in ["plan.json", "toolpath.csv", "program.gcode"] {
+        assert!(!dir.join(f).exists(), "{f} written");
     }
 }

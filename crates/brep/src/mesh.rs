@@ -1304,22 +1304,36 @@ fn triangulate(
             }
             triangles.push(t);
         }
-        // Two drawn edges between the same mesh vertices, one of them free: points that are
-        // one vertex in 3-D (a pole's points along its singular line, the two sides of the
-        // cut to a pole) joined to the same neighbour more than once. Split the free ones.
-        let mut by_pair: HashMap<(u32, u32), Vec<(usize, usize)>> = HashMap::new();
-        for (h, (ga, gb), _, _) in &drawn {
-            if ga != gb {
-                let v = by_pair.entry((*ga.min(gb), *ga.max(gb))).or_default();
-                if !v.contains(h) {
-                    v.push(*h);
+        // A pair of mesh vertices joined by more than one triangle on the same side: points
+        // that are one vertex in 3-D (a pole's points along its singular line, the two sides
+        // of the cut to a pole) joined to the same neighbour twice over. Split the free edges
+        // drawn between them.
+        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        for t in &triangles {
+            let g = [
+                loc.vertex[t[0] as usize],
+                loc.vertex[t[1] as usize],
+                loc.vertex[t[2] as usize],
+            ];
+            if g[0] == g[1] || g[1] == g[2] || g[0] == g[2] {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, c) = (g[k], g[(k + 1) % 3]);
+                let u = uses.entry((a.min(c), a.max(c))).or_default();
+                if a < c {
+                    u.0 += 1;
+                } else {
+                    u.1 += 1;
                 }
             }
         }
         for (h, (ga, gb), constraint, mid) in &drawn {
             if !constraint
                 && ga != gb
-                && by_pair[&(*ga.min(gb), *ga.max(gb))].len() > 1
+                && uses
+                    .get(&(*ga.min(gb), *ga.max(gb)))
+                    .is_some_and(|u| u.0 > 1 || u.1 > 1)
                 && seen.insert(*h)
             {
                 splits.push(*mid);

@@ -60,6 +60,11 @@ pub struct PlanArgs {
     /// Output directory for toolpath.csv, plan.json and the machine program [required]
     #[arg(short, long, value_name = "DIR")]
     pub output: PathBuf,
+    /// Write the plan even when its self-check fails (a feature with no layer, or extruded
+    /// volume more than 3 % from volume x fill): the failures become warnings and plan.json
+    /// says `"complete": false`
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 /// Arguments of `features extract`.

@@ -111,6 +111,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let mut feature_values = vec![];
     let mut warnings: Vec<String> = vec![];
     let mut offset = 0usize;
+    let mut planned = vec![];
     for t in trees {
         let plate = t
             .features
@@ -146,6 +147,14 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             for p in &mut points[start..] {
                 p.feature = id;
             }
+            planned.push(slicer::verify::PlannedFeature {
+                id,
+                kind: f.kind.as_str().to_string(),
+                volume: f.volume,
+                fill: params.filling_ratio,
+                layers: fig.layers,
+                extruded: fig.filament * filament_area,
+            });
             let mut v = feature_json_fields(t, f, offset);
             let o = v.as_object_mut().expect("object");
             o.insert("layers".into(), json!(fig.layers));
@@ -282,10 +291,29 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             }
         }
     }
+    // The self-check: every feature got layers and the material it holds. A failure stops the
+    // run before any file is written, unless --keep-going.
+    let problems = slicer::verify::check_plan(&planned);
+    if !problems.is_empty() {
+        if !args.keep_going {
+            for p in &problems {
+                eprintln!("features: {}: {p}", path.display());
+            }
+            return Err(Failure::new(
+                path,
+                format!(
+                    "the plan fails its self-check for {} feature(s) (listed above); nothing written (--keep-going writes it anyway)",
+                    problems.len()
+                ),
+            ));
+        }
+        warnings.extend(problems.iter().map(|p| p.to_string()));
+    }
     let plan = json!({
         "schema": "features.plan/1",
         "source": source,
         "machine": machine.name,
+        "complete": problems.is_empty(),
         "features": feature_values,
         "warnings": warnings,
     });

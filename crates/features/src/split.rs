@@ -322,6 +322,9 @@ pub fn child_faces_on_hosts(b: &Brep, cut: &Cut, tol: Tol) -> Vec<FaceId> {
         .collect()
 }
 
+/// A host face after healing and its loops, as edge uses `(edge, forward)`.
+type HealedFace = (FaceId, Vec<Vec<(EdgeId, bool)>>);
+
 /// One use of an edge in a loop.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Use {
@@ -408,7 +411,7 @@ fn heal_hosts(
     b: &mut Brep,
     group: &HostGroup,
     tol: Tol,
-) -> Result<Vec<(FaceId, Vec<Vec<(EdgeId, bool)>>)>, Refusal> {
+) -> Result<Vec<HealedFace>, Refusal> {
     let chain: HashSet<EdgeId> = group.chains.iter().flatten().copied().collect();
     let fidx: HashMap<FaceId, usize> = group
         .faces
@@ -863,7 +866,7 @@ pub fn apply_cut(b: &mut Brep, faces: &[FaceId], cut: &Cut, tol: Tol) -> Result<
 
 fn apply_inner(b: &mut Brep, faces: &[FaceId], cut: &Cut, tol: Tol) -> Result<Split, Refusal> {
     let mut heal = vec![];
-    let mut hosts_after: Vec<(FaceId, Vec<Vec<(EdgeId, bool)>>)> = vec![];
+    let mut hosts_after: Vec<HealedFace> = vec![];
     let mut dropped: HashSet<FaceId> = HashSet::new();
     let coarse = MeshOptions::with_tolerance(0.5);
     for g in &cut.groups {

@@ -21,6 +21,7 @@ pub mod params;
 pub mod planar;
 pub mod toolpath;
 pub mod vec3;
+pub mod verify;
 
 pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
 pub use params::{LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

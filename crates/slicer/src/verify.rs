@@ -1,0 +1,126 @@
+//! A plan checks itself: every feature it lists got layers, and puts down the material the
+//! feature holds. A plan that silently loses material is the worst defect a planner can ship.
+
+/// How far a feature's extruded volume may stray from what it should be, as a fraction.
+pub const VOLUME_TOLERANCE: f64 = 0.03;
+
+/// What went wrong with one feature's plan.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanProblem {
+    /// Nothing was laid down.
+    #[error("feature {id} ({kind}): no layer planned for its {volume:.3} mm^3")]
+    NoLayers {
+        /// Feature id in the plan.
+        id: usize,
+        /// `two5d` or `freeform`.
+        kind: String,
+        /// The feature's volume, mm³.
+        volume: f64,
+    },
+    /// The extruded volume is off by more than [`VOLUME_TOLERANCE`].
+    #[error(
+        "feature {id} ({kind}): {extruded:.3} mm^3 extruded for {expected:.3} mm^3 expected (volume {volume:.3} mm^3 x fill {fill}), {percent:+.2} %"
+    )]
+    Volume {
+        /// Feature id in the plan.
+        id: usize,
+        /// `two5d` or `freeform`.
+        kind: String,
+        /// The feature's volume, mm³.
+        volume: f64,
+        /// The fill it was planned with (`filling_ratio`).
+        fill: f64,
+        /// Volume × fill, mm³.
+        expected: f64,
+        /// What the plan puts down, mm³.
+        extruded: f64,
+        /// `(extruded − expected) / expected`, in percent.
+        percent: f64,
+    },
+}
+
+/// What the plan did with one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedFeature {
+    /// Feature id in the plan.
+    pub id: usize,
+    /// `two5d` or `freeform`.
+    pub kind: String,
+    /// The feature's solid volume, mm³.
+    pub volume: f64,
+    /// Its `filling_ratio`: beads `w` wide laid `w / filling_ratio` apart cover that share of
+    /// each layer, perimeters and infill alike, so the plan should put down `volume × fill`.
+    pub fill: f64,
+    /// Layers planned.
+    pub layers: usize,
+    /// Bead volume put down (Eq. 1 filament length × filament area), mm³.
+    pub extruded: f64,
+}
+
+/// Checks one feature's plan: at least one layer, and extruded volume within
+/// [`VOLUME_TOLERANCE`] of `volume × fill`.
+pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
+    if f.layers == 0 || f.extruded <= 0.0 {
+        return Some(PlanProblem::NoLayers {
+            id: f.id,
+            kind: f.kind.clone(),
+            volume: f.volume,
+        });
+    }
+    let expected = f.volume * f.fill;
+    let rel = (f.extruded - expected) / expected.max(1e-12);
+    (rel.abs() > VOLUME_TOLERANCE).then(|| PlanProblem::Volume {
+        id: f.id,
+        kind: f.kind.clone(),
+        volume: f.volume,
+        fill: f.fill,
+        expected,
+        extruded: f.extruded,
+        percent: rel * 100.0,
+    })
+}
+
+/// Checks every feature of a plan; the problems in feature order.
+pub fn check_plan(features: &[PlannedFeature]) -> Vec<PlanProblem> {
+    features.iter().filter_map(check_planned).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f(layers: usize, extruded: f64, fill: f64) -> PlannedFeature {
+        PlannedFeature {
+            id: 3,
+            kind: "freeform".into(),
+            volume: 100.0,
+            fill,
+            layers,
+            extruded,
+        }
+    }
+
+    #[test]
+    fn a_feature_with_no_layer_is_a_problem() {
+        assert!(matches!(
+            check_planned(&f(0, 0.0, 1.0)),
+            Some(PlanProblem::NoLayers { id: 3, .. })
+        ));
+    }
+
+    #[test]
+    fn ten_percent_short_is_a_problem_and_within_three_is_not() {
+        let p = check_planned(&f(10, 90.0, 1.0)).expect("short");
+        assert!(p.to_string().contains("-10.00 %"), "{p}");
+        assert!(check_planned(&f(10, 102.9, 1.0)).is_none());
+        assert!(check_planned(&f(10, 97.1, 1.0)).is_none());
+        assert!(check_planned(&f(10, 103.1, 1.0)).is_some());
+    }
+
+    #[test]
+    fn the_fill_sets_what_is_expected() {
+        assert!(check_planned(&f(10, 80.0, 0.8)).is_none());
+        assert!(check_planned(&f(10, 100.0, 0.8)).is_some());
+        assert_eq!(check_plan(&[f(10, 80.0, 0.8), f(0, 0.0, 1.0)]).len(), 1);
+    }
+}
