@@ -885,3 +885,82 @@ fn a_plan_that_loses_material_exits_2_naming_the_feature_and_writes_nothing() {
         assert!(!dir.join(f).exists(), "{f} written");
     }
 }
+
+#[test]
+fn every_corpus_plan_passes_its_self_check_or_exits_2_naming_why() {
+    // Real files from other CAD writers: a plan either passes its self-check (exit 0,
+    // "complete": true) or exits 2 with one line per failing feature (or one line naming the
+    // cause, such as the machine's envelope) and writes nothing. The two largest files (NIST
+    // CTC-05, the Shapr3D impeller: 15 and 30 s each in release) are left to the benches.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipped: {} is not there", dir.display());
+        return;
+    };
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "step"))
+        .filter(|p| {
+            let n = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            !n.starts_with("nist_ctc05") && !n.starts_with("shapr3d_impeller")
+        })
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
+    let mut failures = vec![];
+    for (k, part) in files.iter().enumerate() {
+        let name = part.file_name().unwrap().to_string_lossy().to_string();
+        let out_dir =
+            std::env::temp_dir().join(format!("features-corpus-{}-{k}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out_dir);
+        let out = Command::new(BIN)
+            .arg("plan")
+            .arg(part)
+            .args(["--machine", "delta5", "-o"])
+            .arg(&out_dir)
+            .output()
+            .expect("runs");
+        let _guard = Out(out_dir.clone());
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        match out.status.code() {
+            Some(0) => {
+                let plan: Value = serde_json::from_str(
+                    &std::fs::read_to_string(out_dir.join("plan.json")).expect("plan.json"),
+                )
+                .expect("json");
+                if plan["complete"] != true {
+                    failures.push(format!(
+                        "{name}: exit 0 but complete is {}",
+                        plan["complete"]
+                    ));
+                }
+                for f in plan["features"].as_array().expect("features") {
+                    if f["layers"].as_u64() == Some(0) {
+                        failures.push(format!("{name}: exit 0 with feature {} unplanned", f["id"]));
+                    }
+                }
+            }
+            Some(2) => {
+                let errors: Vec<&str> = stderr
+                    .lines()
+                    .filter(|l| !l.contains(": warning: "))
+                    .collect();
+                let self_check = stderr.contains("fails its self-check");
+                let named = errors.iter().any(|l| l.contains(": feature "));
+                if (self_check && !named) || errors.is_empty() {
+                    failures.push(format!("{name}: exit 2 naming nothing: {stderr}"));
+                }
+                if !self_check && errors.len() != 1 {
+                    failures.push(format!("{name}: exit 2 with {} error lines", errors.len()));
+                }
+                for f in ["plan.json", "toolpath.csv", "program.gcode"] {
+                    if out_dir.join(f).exists() {
+                        failures.push(format!("{name}: {f} written on exit 2"));
+                    }
+                }
+            }
+            other => failures.push(format!("{name}: exit {other:?}: {stderr}")),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
