@@ -407,11 +407,7 @@ fn continuation(b: &Brep, i: &Use, o: &Use, tol: Tol) -> Option<(f64, f64)> {
 /// Re-makes the boundary of a group's host faces without its roots. Returns the new faces'
 /// loops: for each surviving face, its loops as edge uses; faces absent from the result are
 /// dropped (they lay inside a root).
-fn heal_hosts(
-    b: &mut Brep,
-    group: &HostGroup,
-    tol: Tol,
-) -> Result<Vec<HealedFace>, Refusal> {
+fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFace>, Refusal> {
     let chain: HashSet<EdgeId> = group.chains.iter().flatten().copied().collect();
     let fidx: HashMap<FaceId, usize> = group
         .faces
@@ -762,7 +758,6 @@ fn push_face(b: &mut Brep, like: FaceId, loops: &[Vec<(EdgeId, bool)>]) -> FaceI
 /// encloses as holes; all roots in one face when a root alone bounds no region (two rims of a
 /// band round a cylinder).
 fn heal_child(b: &mut Brep, group: &HostGroup) -> Result<Vec<FaceId>, Refusal> {
-    let host_faces: HashSet<FaceId> = group.faces.iter().copied().collect();
     let mut cycles = vec![];
     for chain in &group.chains {
         let set: HashSet<EdgeId> = chain.iter().copied().collect();
@@ -777,7 +772,6 @@ fn heal_child(b: &mut Brep, group: &HostGroup) -> Result<Vec<FaceId>, Refusal> {
                 }
             }
         }
-        let _ = &host_faces;
         let cyc = order_cycle(b, &uses)
             .ok_or_else(|| Refusal::Heal("a root is not one closed loop on its host".into()))?;
         cycles.push(cyc);
