@@ -333,22 +333,22 @@ struct Use {
     face: FaceId,
 }
 
-fn use_start(b: &Brep, u: &Use) -> VertexId {
-    let e = b.edge(u.edge);
-    if u.fwd {
-        e.start
+/// The vertices an edge used along (`fwd`) or against its direction runs from and to.
+fn oriented_ends(b: &Brep, e: EdgeId, fwd: bool) -> (VertexId, VertexId) {
+    let ed = b.edge(e);
+    if fwd {
+        (ed.start, ed.end)
     } else {
-        e.end
+        (ed.end, ed.start)
     }
 }
 
+fn use_start(b: &Brep, u: &Use) -> VertexId {
+    oriented_ends(b, u.edge, u.fwd).0
+}
+
 fn use_end(b: &Brep, u: &Use) -> VertexId {
-    let e = b.edge(u.edge);
-    if u.fwd {
-        e.end
-    } else {
-        e.start
-    }
+    oriented_ends(b, u.edge, u.fwd).1
 }
 
 /// Curve parameters of a use's start and end.
@@ -421,12 +421,13 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
     let mut into: Vec<usize> = vec![];
     let mut out_of: Vec<usize> = vec![];
     let mut kept_loops: Vec<(FaceId, Vec<(EdgeId, bool)>)> = vec![];
-    let mut vertex_loops: Vec<(FaceId, LoopId)> = vec![];
+    // Faces with a vertex loop (a pole): such a face is kept even with no edge loop left.
+    let mut vertex_faces: Vec<FaceId> = vec![];
     for &f in &group.faces {
         for &l in &b.face(f).loops {
             let lp = &b.loops[l.idx()];
             if lp.vertex.is_some() {
-                vertex_loops.push((f, l));
+                vertex_faces.push(f);
                 continue;
             }
             let seq: Vec<(EdgeId, bool)> = lp
@@ -656,7 +657,7 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
             continue;
         }
         let mut loops = loops_by_class.remove(&class[k]).unwrap_or_default();
-        let has_vertex = vertex_loops.iter().any(|(g, _)| class[fidx[g]] == class[k]);
+        let has_vertex = vertex_faces.iter().any(|g| class[fidx[g]] == class[k]);
         if loops.is_empty() && !has_vertex {
             continue;
         }
@@ -688,14 +689,7 @@ fn cancel_spikes(cyc: &mut Vec<(EdgeId, bool)>) {
 
 /// Orders edge uses into one closed head-to-tail cycle.
 fn order_cycle(b: &Brep, uses: &[(EdgeId, bool)]) -> Option<Vec<(EdgeId, bool)>> {
-    let ends = |(e, f): (EdgeId, bool)| {
-        let ed = b.edge(e);
-        if f {
-            (ed.start, ed.end)
-        } else {
-            (ed.end, ed.start)
-        }
-    };
+    let ends = |(e, f): (EdgeId, bool)| oriented_ends(b, e, f);
     let mut left: Vec<(EdgeId, bool)> = uses.to_vec();
     let first = left.pop()?;
     let mut out = vec![first];
