@@ -75,9 +75,45 @@ const GAUSS7: [([f64; 3], f64); 7] = [
 /// The divergence integrals of one face about `origin`: signed volume share, area, and the
 /// first-moment share `∫ x_i² n_i / 2` (7-point Gauss rule on each parameter triangle, the
 /// exact surface and its natural normal; the signed triangle area carries the face's sense).
-fn face_integrals(brep: &Brep, ft: &crate::mesh::FaceTriangulation, origin: &P3) -> (f64, f64, V3) {
+fn face_integrals(
+    brep: &Brep,
+    mesh: &Mesh,
+    ft: &crate::mesh::FaceTriangulation,
+    origin: &P3,
+) -> (f64, f64, V3) {
     let s = brep.face_surface(ft.face);
     let (mut vol, mut area, mut first) = (0.0, 0.0, V3::zeros());
+    if let crate::surface::Surface::Plane { frame } = s {
+        // A plane's integrand is constant: its share is `d·A/3` for its signed area A, which
+        // the chords of curved edges cut short. Each chord's sliver (Green's theorem along
+        // the curve, less the chord) makes A that of the exact boundary, so a planar face
+        // meets its curved neighbours (whose parameters follow the edge) without a gap: a
+        // disc of radius 28 had lost 1.1 mm² of its 2449 to the chords of its rim.
+        let mut signed = 0.0;
+        for t in &ft.triangles {
+            let [a, b, d] = t.map(|i| ft.uv[i as usize]);
+            signed += 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]));
+        }
+        let slivers = plane_slivers(brep, mesh, ft.face, frame);
+        let total = signed + slivers;
+        let d = (frame.origin - origin).dot(&frame.z);
+        vol = d * total / 3.0;
+        area = total.abs();
+        // The first moment over the triangles (the slivers' share of it is left out).
+        for t in &ft.triangles {
+            let [a, b, c] = t.map(|i| ft.uv[i as usize]);
+            let det = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+            for (w, wt) in GAUSS7.iter() {
+                let u = w[0] * a[0] + w[1] * b[0] + w[2] * c[0];
+                let v = w[0] * a[1] + w[1] * b[1] + w[2] * c[1];
+                let p = frame.at(u, v, 0.0) - origin;
+                let n = frame.z;
+                first +=
+                    wt * det * V3::new(p.x * p.x * n.x, p.y * p.y * n.y, p.z * p.z * n.z) * 0.5;
+            }
+        }
+        return (vol, area, first);
+    }
     for t in &ft.triangles {
         let a = ft.uv[t[0] as usize];
         let b = ft.uv[t[1] as usize];
@@ -101,6 +137,62 @@ fn face_integrals(brep: &Brep, ft: &crate::mesh::FaceTriangulation, origin: &P3)
     (vol, area, first)
 }
 
+/// The signed area, in a plane face's `(u, v)`, between its boundary's curved edges and the
+/// chords the mesher drew along them: for each sampled segment, Green's `½∮(u dv − v du)`
+/// along the curve (5-point Gauss–Legendre) less the same along the chord, in the direction
+/// each coedge runs in its loop.
+fn plane_slivers(
+    brep: &Brep,
+    mesh: &Mesh,
+    f: crate::topology::FaceId,
+    frame: &crate::math::Frame,
+) -> f64 {
+    const GL5: [(f64, f64); 5] = [
+        (0.0, 0.568_888_888_888_889),
+        (-0.538_469_310_105_683, 0.478_628_670_499_366),
+        (0.538_469_310_105_683, 0.478_628_670_499_366),
+        (-0.906_179_845_938_664, 0.236_926_885_056_189),
+        (0.906_179_845_938_664, 0.236_926_885_056_189),
+    ];
+    let face = brep.face(f);
+    let mut sum = 0.0;
+    for &l in &face.loops {
+        for &ce in &brep.loops[l.idx()].coedges {
+            let co = &brep.coedges[ce.idx()];
+            let c = brep.edge_curve(co.edge);
+            if matches!(
+                c,
+                crate::curve::Curve::Line { .. } | crate::curve::Curve::Polyline(_)
+            ) {
+                continue;
+            }
+            let Some(ts) = mesh.edge_params.get(&co.edge) else {
+                continue;
+            };
+            let mut piece = 0.0;
+            for w in ts.windows(2) {
+                let (t0, t1) = (w[0], w[1]);
+                let (h, m) = (0.5 * (t1 - t0), 0.5 * (t1 + t0));
+                let mut curve = 0.0;
+                for (x, wt) in GL5 {
+                    let t = m + h * x;
+                    let p = frame.local(&c.eval(t));
+                    let d = c.deriv(t);
+                    let (du, dv) = (d.dot(&frame.x), d.dot(&frame.y));
+                    curve += wt * h * 0.5 * (p.x * dv - p.y * du);
+                }
+                let (a, b) = (frame.local(&c.eval(t0)), frame.local(&c.eval(t1)));
+                let chord = 0.5 * (a.x * b.y - b.x * a.y);
+                piece += curve - chord;
+            }
+            if piece.is_finite() {
+                sum += if co.forward { piece } else { -piece };
+            }
+        }
+    }
+    sum
+}
+
 /// Each face's share of the divergence integrals about `origin`: `(face, signed volume, area)`.
 /// Shares about one origin add up, so the volume of any closed set of faces is the sum of its
 /// faces' shares, however the faces were meshed.
@@ -112,7 +204,7 @@ pub fn face_shares(
     mesh.faces
         .iter()
         .map(|ft| {
-            let (v, a, _) = face_integrals(brep, ft, origin);
+            let (v, a, _) = face_integrals(brep, mesh, ft, origin);
             (ft.face, v, a)
         })
         .collect()
@@ -128,7 +220,7 @@ pub fn mass_properties(brep: &Brep, mesh: &Mesh) -> MassProperties {
     };
     let (mut vol, mut area, mut first) = (0.0, 0.0, V3::zeros());
     for ft in &mesh.faces {
-        let (v, a, m) = face_integrals(brep, ft, &c);
+        let (v, a, m) = face_integrals(brep, mesh, ft, &c);
         vol += v;
         area += a;
         first += m;
@@ -156,6 +248,13 @@ pub fn exact_bbox(brep: &Brep, mesh: &Mesh) -> Aabb {
     let mut tol = 1e-3 * bbox.diagonal();
     let mut cands: Vec<(usize, [[f64; 2]; 3])> = vec![];
     for (fi, ft) in mesh.faces.iter().enumerate() {
+        // A plane's extremes over a triangle are at its corners, already in the mesh's box.
+        if matches!(
+            brep.face_surface(ft.face),
+            crate::surface::Surface::Plane { .. }
+        ) {
+            continue;
+        }
         for t in &ft.triangles {
             let ps = t.map(|i| mesh.positions[ft.vertex[i as usize] as usize]);
             if ps.iter().any(|p| near(p, &bbox, tol.max(1e-9))) {

@@ -357,6 +357,38 @@ impl LayerMesh {
     /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
     /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
     /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
+    /// The area on the layer surface (the lifted vertices `p`) of the part of the region
+    /// where the piecewise-linear field `f` is at least `level`.
+    pub fn area_above(&self, f: &[f64], level: f64) -> f64 {
+        let tri = |a: P3, b: P3, c: P3| 0.5 * (b - a).cross(&(c - a)).norm();
+        let mut sum = 0.0;
+        for t in &self.tris {
+            let v = t.map(|i| i as usize);
+            let (p, h) = (v.map(|i| self.p[i]), v.map(|i| f[i] - level));
+            if h.iter().any(|x| !x.is_finite()) {
+                continue;
+            }
+            let above = h.iter().filter(|x| **x >= 0.0).count();
+            let whole = tri(p[0], p[1], p[2]);
+            let cut = |i: usize, j: usize| p[i] + (p[j] - p[i]) * (h[i] / (h[i] - h[j]));
+            sum += match above {
+                3 => whole,
+                0 => 0.0,
+                1 => {
+                    let i = (0..3).find(|&i| h[i] >= 0.0).unwrap_or(0);
+                    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                    tri(p[i], cut(i, j), cut(i, k))
+                }
+                _ => {
+                    let i = (0..3).find(|&i| h[i] < 0.0).unwrap_or(0);
+                    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                    whole - tri(p[i], cut(i, j), cut(i, k))
+                }
+            };
+        }
+        sum
+    }
+
     pub fn build_with_metric(region: &Region, step: f64, g: [[f64; 2]; 2]) -> LayerMesh {
         let a = g[0][0];
         let m = if a > 1e-12 {
