@@ -21,6 +21,7 @@ pub mod math;
 pub mod mesh;
 pub mod nurbs;
 pub mod p21;
+mod schema_names;
 pub mod section;
 pub mod solid;
 pub mod step;

@@ -49,6 +49,32 @@ pub fn translate(file: &P21File) -> R<Brep> {
         ));
     }
     t.brep.units = unit_names;
+    // Entities of no schema the reader knows (a misspelt name): skipped, but said.
+    let unknown: Vec<(u64, &str)> = file
+        .entities
+        .iter()
+        .flat_map(|e| {
+            e.instance
+                .names()
+                .into_iter()
+                .filter(|n| !crate::schema_names::is_known(n))
+                .map(move |n| (e.id, n))
+        })
+        .collect();
+    for (id, name) in unknown.iter().take(5) {
+        let hint = crate::schema_names::nearest(name)
+            .map(|k| format!(" (did you mean {k}?)"))
+            .unwrap_or_default();
+        t.brep
+            .warnings
+            .push(format!("#{id}: unknown entity {name}{hint}; skipped"));
+    }
+    if unknown.len() > 5 {
+        t.brep.warnings.push(format!(
+            "{} more entities of unknown names skipped",
+            unknown.len() - 5
+        ));
+    }
     if t.brep.solids.is_empty() {
         let mut why = String::new();
         for w in &t.brep.warnings {
@@ -845,7 +871,8 @@ impl<'a> Translator<'a> {
             let focal = self.positive(id, r, 2, "focal distance")?;
             return Ok(Curve::Parabola { frame, focal });
         }
-        if i.record("B_SPLINE_CURVE").is_some() || i.record("B_SPLINE_CURVE_WITH_KNOTS").is_some() {
+        if i.record("B_SPLINE_CURVE").is_some() || CURVE_FORMS.iter().any(|n| i.record(n).is_some())
+        {
             return self.bspline_curve(id);
         }
         for n in [
@@ -991,10 +1018,14 @@ impl<'a> Translator<'a> {
         let e = self.entity(id, id)?;
         let i = &e.instance;
         // Simple B_SPLINE_CURVE_WITH_KNOTS carries everything; a complex entity splits it.
+        // A complex entity's B_SPLINE_CURVE record has no name; a simple instance of any
+        // form (with knots, uniform, quasi-uniform, Bezier) starts with its name.
         let (base, base_off) = match i.record("B_SPLINE_CURVE") {
             Some(b) => (b, 0usize),
             None => (
-                i.record("B_SPLINE_CURVE_WITH_KNOTS")
+                CURVE_FORMS
+                    .iter()
+                    .find_map(|n| i.record(n))
                     .ok_or_else(|| self.bad(id, "missing B-spline data"))?,
                 1usize,
             ),
@@ -1154,7 +1185,7 @@ impl<'a> Translator<'a> {
             return Ok((Surface::Extrusion { profile, dir }, false));
         }
         if i.record("B_SPLINE_SURFACE").is_some()
-            || i.record("B_SPLINE_SURFACE_WITH_KNOTS").is_some()
+            || SURFACE_FORMS.iter().any(|n| i.record(n).is_some())
         {
             return Ok((self.bspline_surface(id)?, false));
         }
@@ -1189,7 +1220,9 @@ impl<'a> Translator<'a> {
         let (base, off) = match i.record("B_SPLINE_SURFACE") {
             Some(b) => (b, 0usize),
             None => (
-                i.record("B_SPLINE_SURFACE_WITH_KNOTS")
+                SURFACE_FORMS
+                    .iter()
+                    .find_map(|n| i.record(n))
                     .ok_or_else(|| self.bad(id, "missing B-spline data"))?,
                 1usize,
             ),
@@ -1304,3 +1337,19 @@ pub(crate) fn as_real(p: &Param) -> Option<f64> {
         _ => None,
     }
 }
+
+/// The B-spline curve forms STEP writes, each a record of its own in a simple instance.
+const CURVE_FORMS: [&str; 4] = [
+    "B_SPLINE_CURVE_WITH_KNOTS",
+    "UNIFORM_CURVE",
+    "QUASI_UNIFORM_CURVE",
+    "BEZIER_CURVE",
+];
+
+/// The B-spline surface forms, as [`CURVE_FORMS`].
+const SURFACE_FORMS: [&str; 4] = [
+    "B_SPLINE_SURFACE_WITH_KNOTS",
+    "UNIFORM_SURFACE",
+    "QUASI_UNIFORM_SURFACE",
+    "BEZIER_SURFACE",
+];

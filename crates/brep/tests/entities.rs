@@ -224,3 +224,71 @@ fn an_edge_far_off_its_curve_is_refused_naming_it() {
         "{msg}"
     );
 }
+
+#[test]
+fn uniform_quasi_uniform_and_bezier_forms_read_with_their_implied_knots() {
+    // The face on x = 0 (#32: u along +z, v along -y, normal +x) put on a flat B-spline patch
+    // written as a simple instance of each form, and its edge #21 (x = y = 0, z 0..10) on a
+    // straight B-spline curve: the solid is unchanged. An I-DEAS file was refused with
+    // "unsupported entity QUASI_UNIFORM_SURFACE".
+    let box_step = fixture("box.step");
+    let pts = "#900101 = CARTESIAN_POINT('',(0.,35.,-5.));\n#900102 = CARTESIAN_POINT('',(0.,15.,-5.));\n#900103 = CARTESIAN_POINT('',(0.,-5.,-5.));\n\
+#900104 = CARTESIAN_POINT('',(0.,35.,5.));\n#900105 = CARTESIAN_POINT('',(0.,15.,5.));\n#900106 = CARTESIAN_POINT('',(0.,-5.,5.));\n\
+#900107 = CARTESIAN_POINT('',(0.,35.,15.));\n#900108 = CARTESIAN_POINT('',(0.,15.,15.));\n#900109 = CARTESIAN_POINT('',(0.,-5.,15.));\n\
+#900110 = CARTESIAN_POINT('',(0.,0.,-2.));\n#900111 = CARTESIAN_POINT('',(0.,0.,6.));\n#900112 = CARTESIAN_POINT('',(0.,0.,14.));\n";
+    let grid2 = "((#900101,#900103),(#900107,#900109))";
+    let grid3 = "((#900101,#900102,#900103),(#900104,#900105,#900106),(#900107,#900108,#900109))";
+    for (surface, curve) in [
+        (
+            format!("BEZIER_SURFACE('',1,1,{grid2},.UNSPECIFIED.,.F.,.F.,.F.)"),
+            "BEZIER_CURVE('',1,(#900110,#900112),.UNSPECIFIED.,.F.,.F.)",
+        ),
+        (
+            format!("QUASI_UNIFORM_SURFACE('',2,1,{grid3},.UNSPECIFIED.,.F.,.F.,.F.)"),
+            "QUASI_UNIFORM_CURVE('',2,(#900110,#900111,#900112),.UNSPECIFIED.,.F.,.F.)",
+        ),
+        (
+            format!("UNIFORM_SURFACE('',1,1,{grid3},.UNSPECIFIED.,.F.,.F.,.F.)"),
+            "UNIFORM_CURVE('',1,(#900110,#900111,#900112),.UNSPECIFIED.,.F.,.F.)",
+        ),
+    ] {
+        let changed = rewrite(
+            &box_step,
+            &[
+                ("#32 = PLANE('',#33);", &format!("#32 = {surface};")),
+                ("#27 = LINE('',#28,#29);", &format!("#27 = {curve};")),
+            ],
+            pts,
+        );
+        assert_same_solid_within(&box_step, &changed, 1e-6);
+    }
+}
+
+#[test]
+fn a_misspelt_entity_is_warned_naming_its_id() {
+    let box_step = fixture("box.step");
+    let changed = rewrite(
+        &box_step,
+        &[],
+        "#900201 = CARTESIAN_POINTX('',(1.,2.,3.));\n",
+    );
+    let part = brep::read_step_bytes(changed.as_bytes()).expect("reads");
+    assert!(
+        part.brep
+            .warnings
+            .iter()
+            .any(|w| w.contains("#900201") && w.contains("CARTESIAN_POINTX")),
+        "warnings: {:?}",
+        part.brep.warnings
+    );
+    let clean = brep::read_step_bytes(box_step.as_bytes()).expect("reads");
+    assert!(
+        clean
+            .brep
+            .warnings
+            .iter()
+            .all(|w| !w.contains("unknown entity")),
+        "{:?}",
+        clean.brep.warnings
+    );
+}
