@@ -133,8 +133,6 @@ fn main() {
 
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let fixtures = root.join("../../fixtures");
-    let corpus = root.join("../../../shared/corpus");
-
     let mut files: Vec<(String, PathBuf)> = vec![];
     match step_files(&fixtures) {
         Some(ps) => files.extend(ps.into_iter().map(|p| {
@@ -145,17 +143,20 @@ fn main() {
         })),
         None => println!("note: {} not found, fixtures skipped", fixtures.display()),
     }
-    match step_files(&corpus) {
-        Some(ps) => files.extend(ps.into_iter().map(|p| {
-            (
-                format!("corpus/{}", p.file_name().unwrap().to_string_lossy()),
-                p,
-            )
-        })),
-        None => println!(
-            "note: shared corpus {} not found, corpus files skipped",
-            corpus.display()
-        ),
+    for set in ["corpus", "corpus-more"] {
+        let dir = root.join("../../../shared").join(set);
+        match step_files(&dir) {
+            Some(ps) => files.extend(ps.into_iter().map(|p| {
+                (
+                    format!("{set}/{}", p.file_name().unwrap().to_string_lossy()),
+                    p,
+                )
+            })),
+            None => println!(
+                "note: shared {set} {} not found, its files skipped",
+                dir.display()
+            ),
+        }
     }
     if let Some(f) = filter {
         files.retain(|(name, _)| name.contains(f));

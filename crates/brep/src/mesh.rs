@@ -133,6 +133,40 @@ impl Mesh {
         (open, bad)
     }
 
+    /// The faces with a triangle edge not shared by exactly two triangles in opposite
+    /// directions: where the mesh opens (or folds), face by face, in mesh order.
+    pub fn faces_at_open_edges(&self) -> Vec<FaceId> {
+        let mut count: HashMap<(u32, u32), (i32, i32)> = HashMap::new();
+        let mut owners: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (k, ft) in self.faces.iter().enumerate() {
+            for t in &ft.triangles {
+                let g = t.map(|i| ft.vertex[i as usize]);
+                if g[0] == g[1] || g[1] == g[2] || g[0] == g[2] {
+                    continue;
+                }
+                for j in 0..3 {
+                    let (a, b) = (g[j], g[(j + 1) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    let e = count.entry(key).or_default();
+                    if a < b {
+                        e.0 += 1
+                    } else {
+                        e.1 += 1
+                    }
+                    owners.entry(key).or_default().push(k);
+                }
+            }
+        }
+        let mut bad: Vec<usize> = count
+            .iter()
+            .filter(|(_, (f, b))| *f != 1 || *b != 1)
+            .flat_map(|(key, _)| owners.get(key).cloned().unwrap_or_default())
+            .collect();
+        bad.sort_unstable();
+        bad.dedup();
+        bad.into_iter().map(|k| self.faces[k].face).collect()
+    }
+
     /// The generalised winding number of the closed mesh around `p`: about 1 inside, 0 outside
     /// (the sum of the solid angles the triangles subtend, after Van Oosterom & Strackee), robust
     /// where a ray cast would graze an edge.

@@ -85,8 +85,13 @@ pub fn analysis_options(diag: f64) -> MeshOptions {
 /// A bounding box good enough to size tolerances: vertices, a few points of every edge, and
 /// samples of faces that have no edge at all (a whole sphere or torus).
 pub fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
+    faces_rough_bbox(brep, &brep.solid_faces(s))
+}
+
+/// [`rough_bbox`] of a set of faces.
+pub fn faces_rough_bbox(brep: &Brep, faces: &[crate::topology::FaceId]) -> Aabb {
     let mut b = Aabb::empty();
-    let faces = brep.solid_faces(s);
+    let faces = faces.to_vec();
     for v in brep.vertices_of(&faces) {
         b.add(&brep.vertices[v.idx()].point);
     }
@@ -161,6 +166,22 @@ pub fn report_solid(brep: &Brep, s: SolidId) -> Result<SolidReport, MeshError> {
         let (open, bad) = mesh.open_edges();
         if open + bad > 0 {
             watertight = false;
+            let faces = mesh.faces_at_open_edges();
+            let names: Vec<String> = faces
+                .iter()
+                .take(8)
+                .map(|f| format!("#{}", brep.face(*f).step_id))
+                .collect();
+            findings.push(format!(
+                "shell #{} is not watertight: its mesh has {open} open and {bad} non-manifold edge(s), at face(s) {}{}",
+                shell.step_id,
+                names.join(", "),
+                if faces.len() > 8 {
+                    format!(" and {} more", faces.len() - 8)
+                } else {
+                    String::new()
+                }
+            ));
         }
         let mp = mass_properties(brep, &mesh);
         let void = k > 0;
@@ -182,6 +203,12 @@ pub fn report_solid(brep: &Brep, s: SolidId) -> Result<SolidReport, MeshError> {
             bbox.add(&b.min);
             bbox.add(&b.max);
         }
+    }
+    if volume <= 0.0 {
+        findings.push(format!(
+            "solid #{} encloses no positive volume ({volume:.3} mm^3): its voids outweigh its outer shell",
+            solid.step_id
+        ));
     }
     let faces_ids = brep.solid_faces(s);
     let mut surfaces = BTreeMap::new();

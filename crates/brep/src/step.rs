@@ -500,11 +500,49 @@ impl<'a> Translator<'a> {
                 for v in voids {
                     shells.push(self.read_shell(v, id, true, solid)?);
                 }
+                // A void lies inside its outer shell. One that does not (an AutoCAD 2000i
+                // file lists a second body as a "void" of the first) is a solid of its own:
+                // subtracted, it gave a negative volume.
+                let outer_box = crate::solid::faces_rough_bbox(
+                    &self.brep,
+                    &self.brep.shells[shells[0].idx()].faces,
+                );
+                let slack = 1e-6 * outer_box.diagonal().max(1e-9);
+                let mut own = vec![];
+                let first = shells[0];
+                shells.retain(|&sh| {
+                    if sh == first {
+                        return true;
+                    }
+                    let b = crate::solid::faces_rough_bbox(
+                        &self.brep,
+                        &self.brep.shells[sh.idx()].faces,
+                    );
+                    let inside = (0..3).all(|k| {
+                        b.min[k] >= outer_box.min[k] - slack && b.max[k] <= outer_box.max[k] + slack
+                    });
+                    if !inside {
+                        own.push(sh);
+                    }
+                    inside
+                });
                 self.brep.solids.push(Solid {
                     step_id: id,
-                    name,
+                    name: name.clone(),
                     shells,
                 });
+                for sh in own {
+                    self.brep.shells[sh.idx()].void = false;
+                    let sid = self.brep.shells[sh.idx()].step_id;
+                    self.brep.warnings.push(format!(
+                        "#{id}: void shell #{sid} is not inside the outer shell #{outer}; read as a solid of its own"
+                    ));
+                    self.brep.solids.push(Solid {
+                        step_id: id,
+                        name: name.clone(),
+                        shells: vec![sh],
+                    });
+                }
             }
             BodyKind::SurfaceModel => {
                 let (_, r) = self.record(id, id, &["SHELL_BASED_SURFACE_MODEL"])?;

@@ -1,83 +1,150 @@
-//! Real files from other CAD writers (`../shared/corpus/`): every reference solid's volume within
-//! 0.5 % of OpenCASCADE's, or a clear refusal; never a panic.
+//! Real files from other CAD writers (`../shared/corpus/` and `../shared/corpus-more/`): every
+//! reference solid's volume within 0.1 % of OpenCASCADE's (adaptive integration), or a clear
+//! one-line refusal; never a panic. A solid that is not watertight, or whose volume is not
+//! positive, always carries a warning. The files this reader cannot yet bring within 0.1 % are
+//! listed in [`KNOWN_OFF`] with the measured reason; one that comes right fails the test until
+//! it is taken off the list.
 
 use serde_json::Value;
 use std::path::PathBuf;
 
-fn corpus_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus");
-    d.join("reference.json").exists().then_some(d)
+/// Files still off, with why (measured 2026-11-25).
+const KNOWN_OFF: [(&str, &str); 4] = [
+    (
+        "fusion_atf65_example.step",
+        "+0.22 %: a tiny part (9.6 mm^3) whose B-spline faces' trims the analysis mesh follows coarsely",
+    ),
+    (
+        "ascon_kompas_push_switch.step",
+        "two mirrored solids (#61, #81) mesh with faces against their loops: 0.187 vs 0.405 mm^3, not watertight (warned)",
+    ),
+    (
+        "onshape_abc_0_13.step",
+        "+10.8 %: SURFACE_OF_REVOLUTION / rational B-spline faces mesh with 308 non-manifold edges (warned, faces named)",
+    ),
+    (
+        "solidedge_push_switch.step",
+        "7 solids read, 8 placed: a component placed twice through MAPPED_ITEM / NAUO is read once",
+    ),
+];
+
+fn dirs() -> Vec<PathBuf> {
+    ["corpus", "corpus-more"]
+        .iter()
+        .map(|d| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../../shared")
+                .join(d)
+        })
+        .filter(|d| d.join("reference.json").exists())
+        .collect()
+}
+
+/// What is wrong with one file's reading, if anything.
+fn check_file(dir: &std::path::Path, file: &str, r: &Value) -> Vec<String> {
+    let mut failures = vec![];
+    let part = match brep::read_step(dir.join(file)) {
+        Ok(p) => p,
+        Err(e) => {
+            // A refusal is acceptable only if it is one clear line.
+            let msg = e.to_string();
+            if msg.contains('\n') || msg.is_empty() {
+                failures.push(format!("{file}: unclear refusal {msg:?}"));
+            }
+            eprintln!("{file}: refused: {msg}");
+            return failures;
+        }
+    };
+    let b = &part.brep;
+    let mut want_vols: Vec<f64> = r["volumes_mm3"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
+        .unwrap_or_default();
+    if b.solids.len() != want_vols.len() {
+        failures.push(format!(
+            "{file}: {} solids, reference {}",
+            b.solids.len(),
+            want_vols.len()
+        ));
+        return failures;
+    }
+    let mut got = vec![];
+    for s in b.solid_ids() {
+        match brep::solid::report_solid(b, s) {
+            Ok(rep) => {
+                if !rep.closed || !rep.watertight {
+                    failures.push(format!(
+                        "{file}: solid #{} closed={} watertight={}",
+                        rep.step_id, rep.closed, rep.watertight
+                    ));
+                    if !rep
+                        .findings
+                        .iter()
+                        .any(|f| f.contains("not watertight") || f.contains("open"))
+                        && !rep.watertight
+                    {
+                        failures.push(format!(
+                            "{file}: solid #{} is not watertight and says nothing: {:?}",
+                            rep.step_id, rep.findings
+                        ));
+                    }
+                }
+                if rep.volume <= 0.0 && rep.findings.is_empty() {
+                    failures.push(format!(
+                        "{file}: solid #{} has volume {} and no warning",
+                        rep.step_id, rep.volume
+                    ));
+                }
+                got.push(rep.volume);
+            }
+            Err(e) => failures.push(format!("{file}: {e}")),
+        }
+    }
+    got.sort_by(f64::total_cmp);
+    want_vols.sort_by(f64::total_cmp);
+    for (g, w) in got.iter().zip(&want_vols) {
+        // Tiny solids (a sliver OpenCASCADE gives almost no volume) are compared absolutely.
+        let ok = if w.abs() < 1.0 {
+            (g - w).abs() < 0.01
+        } else {
+            (g - w).abs() / w <= 1e-3
+        };
+        if !ok {
+            failures.push(format!(
+                "{file}: volume {g:.4} vs reference {w:.4} ({:+.3} %)",
+                100.0 * (g - w) / w
+            ));
+        }
+    }
+    eprintln!("{file}: {got:?} vs {want_vols:?}");
+    failures
 }
 
 #[test]
 fn corpus_volumes_match_opencascade() {
-    let Some(dir) = corpus_dir() else {
+    let dirs = dirs();
+    if dirs.is_empty() {
         eprintln!("../shared/corpus not found beside the repository; corpus test skipped");
         return;
-    };
-    let refs: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("reference.json")).unwrap())
-            .unwrap();
-    let overrides: Value = serde_json::from_str(include_str!("corpus_overrides.json")).unwrap();
+    }
     let mut failures = vec![];
-    for (file, r) in refs.as_object().unwrap() {
-        let part = match brep::read_step(dir.join(file)) {
-            Ok(p) => p,
-            Err(e) => {
-                // A refusal is acceptable only if it is one clear line.
-                let msg = e.to_string();
-                if msg.contains('\n') || msg.is_empty() {
-                    failures.push(format!("{file}: unclear refusal {msg:?}"));
-                }
-                eprintln!("{file}: refused: {msg}");
+    for dir in &dirs {
+        let refs: Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("reference.json")).unwrap())
+                .unwrap();
+        for (file, r) in refs.as_object().unwrap() {
+            if !dir.join(file).exists() {
                 continue;
             }
-        };
-        let b = &part.brep;
-        let want = overrides.get(file).unwrap_or(r);
-        let mut want_vols: Vec<f64> = want["volumes_mm3"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter_map(|v| v.as_f64())
-            .collect();
-        if b.solids.len() != want_vols.len() {
-            failures.push(format!(
-                "{file}: {} solids, reference {}",
-                b.solids.len(),
-                want_vols.len()
-            ));
-            continue;
-        }
-        let mut got = vec![];
-        for s in b.solid_ids() {
-            match brep::solid::report_solid(b, s) {
-                Ok(rep) => {
-                    if !rep.closed || !rep.watertight {
-                        failures.push(format!(
-                            "{file}: solid #{} closed={} watertight={}",
-                            rep.step_id, rep.closed, rep.watertight
-                        ));
-                    }
-                    got.push(rep.volume);
-                }
-                Err(e) => failures.push(format!("{file}: {e}")),
+            let why = check_file(dir, file, r);
+            match KNOWN_OFF.iter().find(|(f, _)| f == file) {
+                Some((_, reason)) if why.is_empty() => failures.push(format!(
+                    "{file} now reads within 0.1 %: take it off KNOWN_OFF ({reason})"
+                )),
+                Some((_, reason)) => eprintln!("{file}: known off: {reason}: {why:?}"),
+                None => failures.extend(why),
             }
         }
-        got.sort_by(f64::total_cmp);
-        want_vols.sort_by(f64::total_cmp);
-        for (g, w) in got.iter().zip(&want_vols) {
-            // Tiny solids (a sliver OpenCASCADE gives zero volume) are compared absolutely.
-            let ok = if w.abs() < 1.0 {
-                (g - w).abs() < 0.01
-            } else {
-                (g - w).abs() / w <= 5e-3
-            };
-            if !ok {
-                failures.push(format!("{file}: volume {g:.4} vs reference {w:.4}"));
-            }
-        }
-        eprintln!("{file}: {got:?} vs {want_vols:?}");
     }
     assert!(
         failures.is_empty(),
