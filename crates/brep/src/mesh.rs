@@ -72,6 +72,22 @@ pub struct FaceTriangulation {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// How a mesh edge is used: by triangles running it low-to-high and high-to-low vertex
+/// index, and which face triangulations (indices into [`Mesh::faces`]) those are.
+#[derive(Debug, Default)]
+struct EdgeUse {
+    up: i32,
+    down: i32,
+    faces: Vec<usize>,
+}
+
+impl EdgeUse {
+    /// Used once each way: a closed, consistently oriented edge.
+    fn closed(&self) -> bool {
+        self.up == 1 && self.down == 1
+    }
+}
+
 /// A triangle mesh of a set of faces, sharing vertices along edges.
 #[derive(Debug, Clone, Default)]
 pub struct Mesh {
@@ -89,44 +105,47 @@ pub struct Mesh {
 impl Mesh {
     /// All triangles as global vertex indices, without those that collapse in 3-D.
     pub fn triangles(&self) -> Vec<[u32; 3]> {
-        let mut out = vec![];
-        for f in &self.faces {
-            for t in &f.triangles {
-                let g = [
-                    f.vertex[t[0] as usize],
-                    f.vertex[t[1] as usize],
-                    f.vertex[t[2] as usize],
-                ];
-                if g[0] != g[1] && g[1] != g[2] && g[0] != g[2] {
-                    out.push(g);
+        self.face_triangles().map(|(_, g)| g).collect()
+    }
+
+    /// Each triangle that does not collapse in 3-D, as global vertex indices, with the index
+    /// of its face triangulation in [`Mesh::faces`].
+    fn face_triangles(&self) -> impl Iterator<Item = (usize, [u32; 3])> + '_ {
+        self.faces.iter().enumerate().flat_map(|(k, f)| {
+            f.triangles
+                .iter()
+                .map(move |t| (k, t.map(|i| f.vertex[i as usize])))
+                .filter(|(_, g)| g[0] != g[1] && g[1] != g[2] && g[0] != g[2])
+        })
+    }
+
+    /// How each undirected mesh edge (its vertex indices, low first) is used.
+    fn edge_uses(&self) -> HashMap<(u32, u32), EdgeUse> {
+        let mut uses: HashMap<(u32, u32), EdgeUse> = HashMap::new();
+        for (k, t) in self.face_triangles() {
+            for j in 0..3 {
+                let (a, b) = (t[j], t[(j + 1) % 3]);
+                let e = uses.entry((a.min(b), a.max(b))).or_default();
+                if a < b {
+                    e.up += 1
+                } else {
+                    e.down += 1
                 }
+                e.faces.push(k);
             }
         }
-        out
+        uses
     }
 
     /// Edges of the 3-D mesh not shared by exactly two triangles in opposite directions:
     /// `(boundary, non_manifold_or_misoriented)` counts. Both zero means watertight.
     pub fn open_edges(&self) -> (usize, usize) {
-        let mut count: HashMap<(u32, u32), (i32, i32)> = HashMap::new();
-        for t in self.triangles() {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                let e = count.entry(key).or_default();
-                if a < b {
-                    e.0 += 1
-                } else {
-                    e.1 += 1
-                }
-            }
-        }
         let mut open = 0;
         let mut bad = 0;
-        for (f, b) in count.values() {
-            if f + b == 1 {
+        for e in self.edge_uses().values() {
+            if e.up + e.down == 1 {
                 open += 1;
-            } else if *f != 1 || *b != 1 {
+            } else if !e.closed() {
                 bad += 1;
             }
         }
@@ -136,31 +155,11 @@ impl Mesh {
     /// The faces with a triangle edge not shared by exactly two triangles in opposite
     /// directions: where the mesh opens (or folds), face by face, in mesh order.
     pub fn faces_at_open_edges(&self) -> Vec<FaceId> {
-        let mut count: HashMap<(u32, u32), (i32, i32)> = HashMap::new();
-        let mut owners: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-        for (k, ft) in self.faces.iter().enumerate() {
-            for t in &ft.triangles {
-                let g = t.map(|i| ft.vertex[i as usize]);
-                if g[0] == g[1] || g[1] == g[2] || g[0] == g[2] {
-                    continue;
-                }
-                for j in 0..3 {
-                    let (a, b) = (g[j], g[(j + 1) % 3]);
-                    let key = (a.min(b), a.max(b));
-                    let e = count.entry(key).or_default();
-                    if a < b {
-                        e.0 += 1
-                    } else {
-                        e.1 += 1
-                    }
-                    owners.entry(key).or_default().push(k);
-                }
-            }
-        }
-        let mut bad: Vec<usize> = count
-            .iter()
-            .filter(|(_, (f, b))| *f != 1 || *b != 1)
-            .flat_map(|(key, _)| owners.get(key).cloned().unwrap_or_default())
+        let mut bad: Vec<usize> = self
+            .edge_uses()
+            .into_values()
+            .filter(|e| !e.closed())
+            .flat_map(|e| e.faces)
             .collect();
         bad.sort_unstable();
         bad.dedup();
@@ -489,7 +488,8 @@ fn edge_params(c: &Curve, t0: f64, t1: f64, opts: &MeshOptions) -> Vec<f64> {
         ..*opts
     };
     let n0 = match c {
-        Curve::Line { .. } => 1,
+        // A line is its chord.
+        Curve::Line { .. } => return vec![t0, t1],
         Curve::Polyline(p) => p.len().saturating_sub(1).max(1),
         Curve::Circle { radius, .. } => arc_segments((t1 - t0).abs(), *radius, opts),
         Curve::Ellipse { a, b, .. } => arc_segments((t1 - t0).abs(), a.max(*b), opts) * 2,

@@ -750,6 +750,18 @@ fn fill_region(
     // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
     // the rings leave only a strip narrower than that (a thin blade), the lines cross the strip
     // from the edge of the last ring's bead instead, filling the gap.
+    // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
+    // it), within what that core holds.
+    let core_fill = |gap: Gap| {
+        let ridge = ridge_for(&lm, &db, gap, spacing);
+        conserved(
+            gap_fill(&lm, &db, &ridge, gap, width),
+            &lm,
+            &db,
+            gap.edge,
+            |a, b| surface_length(chart, z, a, b),
+        )
+    };
     let inner = match last_ring {
         Some(c) if dmax > c + 1.5 * spacing => c + spacing,
         Some(c) => {
@@ -761,14 +773,7 @@ fn fill_region(
                 min_width: GAP_MIN_WIDTH_SHARE * width,
                 below: f64::INFINITY,
             };
-            let ridge = ridge_for(&lm, &db, gap, spacing);
-            out.extend(conserved(
-                gap_fill(&lm, &db, &ridge, gap, width),
-                &lm,
-                &db,
-                gap.edge,
-                |a, b| surface_length(chart, z, a, b),
-            ));
+            out.extend(core_fill(gap));
             return out;
         }
         // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
@@ -781,14 +786,7 @@ fn fill_region(
                 min_width: 0.2 * width,
                 below: f64::INFINITY,
             };
-            let ridge = ridge_for(&lm, &db, gap, spacing);
-            out.extend(conserved(
-                gap_fill(&lm, &db, &ridge, gap, width),
-                &lm,
-                &db,
-                gap.edge,
-                |a, b| surface_length(chart, z, a, b),
-            ));
+            out.extend(core_fill(gap));
             return out;
         }
         None => 0.5 * width,
