@@ -10,8 +10,8 @@
 //! are measured the same way, over their extrusion segments of any feature or type whose box
 //! meets the feature's box grown by 2 mm:
 //!
-//! - ours: `features plan PART.step --machine delta5`, `toolpath.csv` print rows; a row's segment
-//!   runs from the previous row; the bead centre is the nozzle tip minus axis × thickness / 2;
+//! - ours: `plan::plan` (what `features plan PART.step --machine delta5` runs), the tool path's
+//!   print points; a point's segment runs from the previous point; the bead centre is the nozzle tip minus axis × thickness / 2;
 //! - PrusaSlicer: planar slicing of `features mesh PART.step --tolerance 0.01` at the same 0.2 mm
 //!   layers and 0.45 mm beads; G1 moves in X/Y that add filament; the bead centre is the layer's
 //!   Z − h/2; coordinates mapped back from the bed (the XY box centred on `--center`, the lowest
@@ -33,7 +33,7 @@
 //! face, distance to its face's edges, normal, and the |cos| between the normal and the height
 //! axis of our bead nearest in envelope.
 //!
-//! Also reported: material (our `extruded_volume_mm3` from `plan.json`, PrusaSlicer's filament
+//! Also reported: material (our `extruded_volume_mm3` of the plan's report, PrusaSlicer's filament
 //! used × filament area) and the wall time of each run.
 //!
 //! `cargo bench -p features-cli --bench stairstep [-- impeller fan PATH.step ...]` (default: the
@@ -524,72 +524,39 @@ struct Ours {
     seconds: f64,
 }
 
-fn run_ours(exe: &Path, step: &Path, dir: &Path) -> Result<Ours, String> {
+/// Plans `step` for the built-in 5-axis printer with the planner library (no files written).
+fn run_ours(step: &Path) -> Result<Ours, String> {
     let t = Instant::now();
-    let out = Command::new(exe)
-        .args(["plan"])
-        .arg(step)
-        .arg("-o")
-        .arg(dir)
-        .args(["--machine", "delta5"])
-        .output()
-        .map_err(|e| format!("running {}: {e}", exe.display()))?;
+    let part = brep::read_step(step).map_err(|e| format!("{}: {e}", step.display()))?;
+    let machine = robot_post::MachineProfile::builtin(robot_post::MachineKind::Delta5);
+    let options = plan::Options {
+        source: step.display().to_string(),
+        stem: "part".into(),
+        ..Default::default()
+    };
+    let planned = plan::plan(&part, &plan::Process::default(), &machine, &options)
+        .map_err(|e| format!("{}: features plan failed: {e}", step.display()))?;
     let seconds = t.elapsed().as_secs_f64();
-    if !out.status.success() {
-        return Err(format!(
-            "features plan failed: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
-    }
-    let csv_path = dir.join("toolpath.csv");
-    let csv =
-        std::fs::read_to_string(&csv_path).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     let mut segs = vec![];
     let mut prev: Option<P3> = None;
-    for (n, line) in csv.lines().enumerate().skip(1) {
-        let bad = |what: &str| format!("{}:{}: {what}", csv_path.display(), n + 1);
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() < 12 {
-            return Err(bad("fewer than 12 fields"));
-        }
-        let num = |i: usize| -> Result<f64, String> {
-            f[i].trim()
-                .parse::<f64>()
-                .map_err(|_| bad(&format!("field {} is not a number", i + 1)))
-        };
-        let p = P3::new(num(3)?, num(4)?, num(5)?);
-        let axis = V3::new(num(6)?, num(7)?, num(8)?);
-        let thickness = num(10)?;
-        let centre = p - axis * (thickness / 2.0);
-        if f[2] == "print" {
+    for q in &planned.toolpath.points {
+        let p = P3::from(q.p);
+        let axis = V3::from(q.axis);
+        let centre = p - axis * (q.thickness / 2.0);
+        if q.kind == robot_post::MoveKind::Print {
             if let Some(a) = prev {
-                segs.push(Seg::new(a, centre, axis, thickness, num(11)?));
+                segs.push(Seg::new(a, centre, axis, q.thickness, q.width));
             }
         }
         prev = Some(centre);
     }
-    let json_path = dir.join("plan.json");
-    let text =
-        std::fs::read_to_string(&json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
     let mut volume = HashMap::new();
     let mut faces = HashMap::new();
-    for f in json["features"]
-        .as_array()
-        .ok_or_else(|| format!("{}: no features", json_path.display()))?
-    {
-        let id = f["id"]
-            .as_u64()
-            .ok_or_else(|| format!("{}: a feature without id", json_path.display()))?
-            as usize;
-        volume.insert(id, f["extruded_volume_mm3"].as_f64().unwrap_or(0.0));
-        let mut fs: Vec<u64> = f["faces"]
-            .as_array()
-            .map(|a| a.iter().filter_map(|x| x.as_u64()).collect())
-            .unwrap_or_default();
+    for f in planned.features() {
+        volume.insert(f.feature.id, f.extruded_volume_mm3);
+        let mut fs = f.feature.faces.clone();
         fs.sort_unstable();
-        faces.insert(id, fs);
+        faces.insert(f.feature.id, fs);
     }
     Ok(Ours {
         segs,
@@ -948,7 +915,7 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
         println!("{name}: no freeform features");
         return Ok(());
     }
-    let ours = run_ours(&exe, step, &dir.join("plan"))?;
+    let ours = run_ours(step)?;
     for s in &surfs {
         match ours.faces.get(&s.id) {
             Some(f) if *f == s.step_faces => {}

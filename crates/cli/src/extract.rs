@@ -1,6 +1,6 @@
 //! `features extract`: the AM feature tree of every solid in a file.
 
-use crate::mesh::{solid_mesh, write_stl, TempFile};
+use crate::mesh::{solid_mesh, write_atomic, write_stl};
 use crate::{emit, ExtractArgs, Failure};
 use features::{extract_all, solid_name, ExtractOptions, FeatureTree};
 use serde_json::{json, Value};
@@ -86,22 +86,8 @@ fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
 }
 
 /// The `extract` fields of one feature, numbered from `offset` (the features of earlier solids).
-pub fn feature_json_fields(t: &FeatureTree, f: &features::Feature, offset: usize) -> Value {
-    let r = &f.reference;
-    json!({
-        "id": offset + f.id,
-        "kind": f.kind.as_str(),
-        "subtype": f.subtype,
-        "reference": {
-            "surface": r.surface,
-            "step_face": r.step_face,
-            "normal": r.normal.map(|n| n.map(|x| round(x, 1e6))),
-        },
-        "parents": f.parents.iter().map(|p| offset + p).collect::<Vec<_>>(),
-        "volume_mm3": round(f.volume, 1e3),
-        "faces": f.step_faces(&t.brep),
-        "root_loops": f.root_loops,
-    })
+fn feature_json_fields(t: &FeatureTree, f: &features::Feature, offset: usize) -> Value {
+    serde_json::to_value(plan::FeatureEntry::new(t, f, offset)).unwrap_or(Value::Null)
 }
 
 /// The trees as text, each solid's warnings under it and those about the solids together
@@ -202,17 +188,4 @@ fn export(dir: &Path, solids: &[Solid]) -> std::io::Result<()> {
         }
     }
     Ok(())
-}
-
-fn write_atomic(
-    dest: &Path,
-    body: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let (tmp, file) = TempFile::create(dest)?;
-    let mut w = std::io::BufWriter::new(file);
-    body(&mut w)?;
-    w.flush()?;
-    w.get_ref().sync_all()?;
-    drop(w);
-    tmp.persist(dest)
 }

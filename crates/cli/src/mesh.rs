@@ -96,6 +96,21 @@ impl Drop for TempFile {
     }
 }
 
+/// Writes `dest` whole or not at all: `body` writes a temporary file beside it, which is
+/// synced and renamed into place only when `body` succeeded.
+pub(crate) fn write_atomic(
+    dest: &Path,
+    body: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let (tmp, file) = TempFile::create(dest)?;
+    let mut w = std::io::BufWriter::new(file);
+    body(&mut w)?;
+    w.flush()?;
+    w.get_ref().sync_all()?;
+    drop(w);
+    tmp.persist(dest)
+}
+
 /// Runs the command.
 pub fn run(args: &MeshArgs) -> Result<(), Failure> {
     let start = Instant::now();

@@ -1,0 +1,191 @@
+//! The plan's report, `plan.json` (schema `features.plan/1`): what was planned for each feature
+//! and what the post found. These types *are* the schema: serialising them writes the file.
+
+use features::{Feature, FeatureTree};
+use robot_post::delta5::KinematicFigures;
+use robot_post::kuka::KukaFigures;
+use serde::Serialize;
+use slicer::orient::OrientationFigures;
+
+/// Schema name of `plan.json`.
+pub const PLAN_SCHEMA: &str = "features.plan/1";
+
+/// `x` rounded to `1 / scale` (`scale` a power of ten), never `-0`.
+pub fn round(x: f64, scale: f64) -> f64 {
+    (x * scale).round() / scale + 0.0
+}
+
+/// A feature's reference, as reported.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceEntry {
+    /// `build_plate`, or the kind of the host face's surface.
+    pub surface: String,
+    /// STEP `#id` of the host face.
+    pub step_face: Option<u64>,
+    /// Unit normal into the feature (planes and the build plate), rounded to 1e-6.
+    pub normal: Option<[f64; 3]>,
+}
+
+/// What a feature is: the fields `features extract --json` and `plan.json` share.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeatureEntry {
+    /// File-wide id.
+    pub id: usize,
+    /// `two5d` or `freeform`.
+    pub kind: String,
+    /// What it looks like (`stretch`, `brep_freeform`, ...).
+    pub subtype: String,
+    /// What it is built on.
+    pub reference: ReferenceEntry,
+    /// File-wide ids of the features it is built on.
+    pub parents: Vec<usize>,
+    /// Solid volume, mm³, rounded to 1e-3.
+    pub volume_mm3: f64,
+    /// STEP `#id`s of its faces.
+    pub faces: Vec<u64>,
+    /// Concave loops at its root.
+    pub root_loops: usize,
+}
+
+impl FeatureEntry {
+    /// Feature `f` of `tree`, its ids numbered from `offset` (the features of earlier solids).
+    pub fn new(tree: &FeatureTree, f: &Feature, offset: usize) -> FeatureEntry {
+        let r = &f.reference;
+        FeatureEntry {
+            id: offset + f.id,
+            kind: f.kind.as_str().to_string(),
+            subtype: f.subtype.clone(),
+            reference: ReferenceEntry {
+                surface: r.surface.clone(),
+                step_face: r.step_face,
+                normal: r.normal.map(|n| n.map(|x| round(x, 1e6))),
+            },
+            parents: f.parents.iter().map(|p| offset + p).collect(),
+            volume_mm3: round(f.volume, 1e3),
+            faces: f.step_faces(&tree.brep),
+            root_loops: f.root_loops,
+        }
+    }
+}
+
+/// What the freeform planner reports of a curved feature.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FreeformEntry {
+    /// `native` (the surface's parameters) or `projection` (tangent-plane chart).
+    pub chart: String,
+    /// Print points with nothing under them.
+    pub overhang_points: usize,
+    /// Smallest concave radius of the reference under the feature, mm; `null` when none.
+    pub concave_radius_mm: Option<f64>,
+}
+
+/// What the post found for one feature, by machine.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum PostEntry {
+    /// 5-axis printer: kinematic error of the posted moves.
+    Delta5 {
+        /// Largest deviation of a posted move from the planned path, mm.
+        kinematic_error_max_mm: f64,
+        /// Mean deviation, mm.
+        kinematic_error_mean_mm: f64,
+        /// Print segments subdivided to bound the error.
+        subdivided_segments: usize,
+        /// Points where C is undefined (axis along B's singular direction).
+        singular_points: usize,
+        /// Largest C step between consecutive moves, degrees.
+        c_step_max_deg: f64,
+    },
+    /// KUKA cell: reach and wrist checks.
+    Kuka {
+        /// Points the robot cannot reach.
+        unreachable_points: usize,
+        /// Points in or near the wrist singularity.
+        wrist_singular_points: usize,
+        /// Changes of arm configuration along the path.
+        configuration_changes: usize,
+    },
+}
+
+impl PostEntry {
+    /// The delta5 post's figures, rounded as reported.
+    pub fn delta5(k: &KinematicFigures) -> PostEntry {
+        PostEntry::Delta5 {
+            kinematic_error_max_mm: round(k.max_mm, 1e6),
+            kinematic_error_mean_mm: round(k.mean_mm, 1e6),
+            subdivided_segments: k.subdivided_segments,
+            singular_points: k.singular_points,
+            c_step_max_deg: round(k.max_c_step_deg, 1e6),
+        }
+    }
+
+    /// The KUKA post's figures.
+    pub fn kuka(k: &KukaFigures) -> PostEntry {
+        PostEntry::Kuka {
+            unreachable_points: k.unreachable_points,
+            wrist_singular_points: k.wrist_singular_points,
+            configuration_changes: k.configuration_changes,
+        }
+    }
+}
+
+/// One feature in `plan.json`: what it is, what was planned, what smoothing and the post found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeatureReport {
+    /// What the feature is.
+    #[serde(flatten)]
+    pub feature: FeatureEntry,
+    /// Layers that print.
+    pub layers: usize,
+    /// Tool path points.
+    pub points: usize,
+    /// Printed length, mm.
+    pub print_length_mm: f64,
+    /// Travel length, mm.
+    pub travel_length_mm: f64,
+    /// Bead volume laid down (Eq. 1 filament × filament area), mm³.
+    pub extruded_volume_mm3: f64,
+    /// Thinnest layer, mm.
+    pub thickness_min_mm: f64,
+    /// Mean layer, mm.
+    pub thickness_mean_mm: f64,
+    /// Thickest layer, mm.
+    pub thickness_max_mm: f64,
+    /// Curved features only.
+    #[serde(flatten)]
+    pub freeform: Option<FreeformEntry>,
+    /// Things to know about this feature.
+    pub warnings: Vec<String>,
+    /// Tool-axis smoothing before and after (features with points).
+    #[serde(flatten)]
+    pub orientation: Option<OrientationFigures>,
+    /// The post's figures (delta5 and KUKA).
+    #[serde(flatten)]
+    pub post: Option<PostEntry>,
+}
+
+/// `plan.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanReport {
+    /// [`PLAN_SCHEMA`].
+    pub schema: &'static str,
+    /// The STEP file, as given.
+    pub source: String,
+    /// The machine profile's name.
+    pub machine: String,
+    /// Whether every feature passed the self-check.
+    pub complete: bool,
+    /// Every feature, in build order.
+    pub features: Vec<FeatureReport>,
+    /// Things to know about the plan.
+    pub warnings: Vec<String>,
+}
+
+impl PlanReport {
+    /// The report as pretty JSON with a final newline.
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        let mut text = serde_json::to_string_pretty(self)?;
+        text.push('\n');
+        Ok(text)
+    }
+}
