@@ -1,0 +1,101 @@
+//! The planner as a library: a part planned by `plan::plan` without the binary. Every tool
+//! path point belongs to a reported feature, each feature's reported point count is its own
+//! points in the file-wide numbering (several solids included), and the material is conserved.
+
+use plan::{plan, Options, Process};
+use robot_post::{MachineKind, MachineProfile, MoveKind};
+use std::path::Path;
+
+fn fixture(name: &str) -> brep::StepPart {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name);
+    brep::read_step(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn planned(name: &str, machine: MachineKind) -> plan::Plan {
+    let options = Options {
+        source: name.into(),
+        stem: "part".into(),
+        ..Default::default()
+    };
+    plan(
+        &fixture(name),
+        &Process::default(),
+        &MachineProfile::builtin(machine),
+        &options,
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
+    for name in ["two_solids.step", "stacked_solids.step"] {
+        let p = planned(name, MachineKind::Marlin);
+        let ids: Vec<usize> = p.features().iter().map(|f| f.feature.id).collect();
+        assert!(ids.len() >= 2, "{name}: {ids:?}");
+        let mut sorted = ids.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), ids.len(), "{name}: ids repeat: {ids:?}");
+        for f in p.features() {
+            let own = p
+                .toolpath
+                .points
+                .iter()
+                .filter(|q| q.feature == f.feature.id)
+                .count();
+            assert_eq!(own, f.points, "{name}: feature {}", f.feature.id);
+            assert!(
+                f.layers > 0 && f.points > 0,
+                "{name}: feature {}",
+                f.feature.id
+            );
+            // The self-check passed: extruded within 3 % of volume × fill (solid fill).
+            let rel = (f.extruded_volume_mm3 - f.feature.volume_mm3) / f.feature.volume_mm3;
+            assert!(
+                rel.abs() <= 0.03,
+                "{name}: feature {} off by {rel}",
+                f.feature.id
+            );
+        }
+        let total: usize = p.features().iter().map(|f| f.points).sum();
+        assert_eq!(total, p.toolpath.points.len(), "{name}");
+        assert!(p.report.complete);
+        assert!(p
+            .program
+            .iter()
+            .any(|(n, b)| n == "program.gcode" && !b.is_empty()));
+    }
+}
+
+#[test]
+fn the_report_reads_back_as_the_plan_schema_with_post_figures() {
+    let p = planned("sphere_boss.step", MachineKind::Delta5);
+    let json: serde_json::Value =
+        serde_json::from_str(&p.report.to_json().expect("json")).expect("reads back");
+    assert_eq!(json["schema"], "features.plan/1");
+    let features = json["features"].as_array().expect("features");
+    assert_eq!(features.len(), p.features().len());
+    for f in features {
+        // Delta5's figures and the smoothing figures sit beside the planner's.
+        for key in [
+            "layers",
+            "extruded_volume_mm3",
+            "kinematic_error_max_mm",
+            "orientation_step_max_deg_after",
+        ] {
+            assert!(f.get(key).is_some(), "{key} missing in {f}");
+        }
+    }
+    let prints = p
+        .toolpath
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .count();
+    assert!(prints > 0);
+    assert!(json["features"].as_array().is_some_and(|a| a
+        .iter()
+        .any(|f| f["kind"] == "freeform" && f["chart"].is_string())));
+}
