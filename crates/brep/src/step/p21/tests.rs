@@ -1,4 +1,3 @@
-
 use super::*;
 
 const HEADER: &str = "ISO-10303-21;\nHEADER;\n\

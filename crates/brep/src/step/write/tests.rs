@@ -1,4 +1,3 @@
-
 use super::text::{knot_runs, wrap};
 use super::*;
 use crate::curve::Curve;
