@@ -24,6 +24,7 @@ pub mod section;
 pub mod solid;
 pub mod step;
 pub mod surface;
+pub mod tolerance;
 pub mod topology;
 pub mod validate;
 

@@ -6,6 +6,7 @@ use super::options::MeshOptions;
 use super::uv::{singular_kind, Pt};
 use crate::math::P3;
 use crate::surface::Surface;
+use crate::tolerance::NONZERO;
 
 /// Points strictly inside a cut the mesher adds across a face (not a B-rep edge: the seam side
 /// of a band or of a loop closed through a pole), from `p` to `q` in `(u, v)`, spaced like an
@@ -32,7 +33,7 @@ pub(super) fn cut_points(
     let chord = pq - pp;
     let straight = (1..START).all(|i| {
         let x = eval(i as f64 / START as f64) - pp;
-        let dev = if chord.norm() > 1e-300 {
+        let dev = if chord.norm() > NONZERO {
             x.cross(&chord).norm() / chord.norm()
         } else {
             x.norm()
@@ -78,7 +79,7 @@ fn cut_refine(
         let (pa, pm, pb) = (eval(a), eval(m), eval(b));
         let dev = chord_deviation(&pa, &pm, &pb);
         let (d0, d1) = (pm - pa, pb - pm);
-        let turn = if d0.norm() > 1e-300 && d1.norm() > 1e-300 {
+        let turn = if d0.norm() > NONZERO && d1.norm() > NONZERO {
             2.0 * d0.angle(&d1)
         } else {
             0.0

@@ -10,6 +10,7 @@ use super::options::{face_err, MeshError, MeshOptions};
 use super::uv::{signed_area, Pt};
 use crate::math::P3;
 use crate::surface::Surface;
+use crate::tolerance::{POINT_COINCIDENCE, SURFACE_COINCIDENCE};
 use crate::topology::{Brep, EdgeId, FaceId};
 use std::collections::HashMap;
 
@@ -162,7 +163,10 @@ pub(super) fn face_polygons(
             let pole = pole_vertices
                 .iter()
                 .copied()
-                .find(|&i| (positions[i as usize] - p3).norm() < 1e-6 * (1.0 + p3.coords.norm()))
+                .find(|&i| {
+                    (positions[i as usize] - p3).norm()
+                        < POINT_COINCIDENCE * (1.0 + p3.coords.norm())
+                })
                 .unwrap_or_else(|| {
                     positions.push(p3);
                     (positions.len() - 1) as u32
@@ -278,7 +282,7 @@ fn full_domain(
     let new_vertex = |p: P3, positions: &mut Vec<P3>| -> u32 {
         if let Some(&i) = pole_vertices
             .iter()
-            .find(|&&i| (positions[i as usize] - p).norm() <= 1e-7 * size.max(1e-9))
+            .find(|&&i| (positions[i as usize] - p).norm() <= SURFACE_COINCIDENCE * size.max(1e-9))
         {
             return i;
         }
@@ -288,7 +292,7 @@ fn full_domain(
     // A side collapses when all its points coincide.
     let collapsed = |pts: &[P3]| {
         pts.iter()
-            .all(|p| (p - pts[0]).norm() <= 1e-7 * size.max(1e-9))
+            .all(|p| (p - pts[0]).norm() <= SURFACE_COINCIDENCE * size.max(1e-9))
     };
     let side_u = |v: f64| -> Vec<P3> {
         (0..=nu)

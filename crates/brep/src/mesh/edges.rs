@@ -6,6 +6,7 @@ use super::uv::singular_kind;
 use crate::curve::Curve;
 use crate::math::P3;
 use crate::surface::Surface;
+use crate::tolerance::NONZERO;
 use crate::topology::{Brep, EdgeId, FaceId};
 use std::collections::HashMap;
 
@@ -200,7 +201,7 @@ fn refine(c: &Curve, a: f64, b: f64, opts: &MeshOptions, depth: u32, out: &mut V
         let dev = chord_deviation(&pa, &pm, &pb);
         let ta = c.deriv(a);
         let tb = c.deriv(b);
-        let turn = if ta.norm() > 1e-300 && tb.norm() > 1e-300 {
+        let turn = if ta.norm() > NONZERO && tb.norm() > NONZERO {
             ta.angle(&tb)
         } else {
             0.0
@@ -219,7 +220,7 @@ fn refine(c: &Curve, a: f64, b: f64, opts: &MeshOptions, depth: u32, out: &mut V
 pub(super) fn chord_deviation(pa: &P3, pm: &P3, pb: &P3) -> f64 {
     let chord = pb - pa;
     let l = chord.norm();
-    if l > 1e-300 {
+    if l > NONZERO {
         (pm - pa).cross(&chord).norm() / l
     } else {
         (pm - pa).norm()

@@ -7,6 +7,7 @@ use super::options::{face_err, MeshError, MeshOptions};
 use super::uv::Pt;
 use crate::math::P3;
 use crate::surface::Surface;
+use crate::tolerance::NONZERO;
 use crate::topology::{Brep, FaceId};
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use std::collections::HashMap;
@@ -33,7 +34,7 @@ impl Boundary {
             }
         }
         let nb = ((segs.len() as f64).sqrt() as usize).clamp(1, 512);
-        let band = ((bb.1 - bb.0) / nb as f64).max(1e-300);
+        let band = ((bb.1 - bb.0) / nb as f64).max(NONZERO);
         let mut bands = vec![vec![]; nb];
         for (i, (a, b)) in segs.iter().enumerate() {
             let lo = (((a[1].min(b[1]) - bb.0) / band).floor().max(0.0) as usize).min(nb - 1);

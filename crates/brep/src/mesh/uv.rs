@@ -2,6 +2,7 @@
 //! (pole) points and signed areas.
 
 use crate::surface::Surface;
+use crate::tolerance::SINGULAR_RATIO;
 
 /// A boundary point of a face in its parameter domain.
 #[derive(Debug, Clone, Copy)]
@@ -15,9 +16,9 @@ pub(super) struct Pt {
 pub(super) fn singular_kind(s: &Surface, uv: [f64; 2]) -> u8 {
     let (su, sv) = s.derivs(uv[0], uv[1]);
     let (a, b) = (su.norm(), sv.norm());
-    if a < 1e-7 * b {
+    if a < SINGULAR_RATIO * b {
         1
-    } else if b < 1e-7 * a {
+    } else if b < SINGULAR_RATIO * a {
         2
     } else {
         0

@@ -3,6 +3,7 @@
 use super::translator::{as_real, Translator, R};
 use crate::math::{Frame, P3, V3};
 use crate::step::p21::Record;
+use crate::tolerance::NONZERO;
 
 impl<'a> Translator<'a> {
     // ---------- geometry primitives ----------
@@ -26,7 +27,7 @@ impl<'a> Translator<'a> {
             return Err(self.bad(id, "direction ratios are not 2 or 3 finite numbers"));
         }
         let v = V3::new(c[0], c[1], c.get(2).copied().unwrap_or(0.0));
-        v.try_normalize(1e-300)
+        v.try_normalize(NONZERO)
             .ok_or_else(|| self.bad(id, "zero-length direction"))
     }
 

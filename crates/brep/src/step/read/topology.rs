@@ -4,6 +4,7 @@ use super::translator::{Translator, R};
 use crate::curve::Curve;
 use crate::math::V3;
 use crate::step::error::ReadError;
+use crate::tolerance::{NONZERO, PERIOD_FRACTION, POINT_COINCIDENCE};
 use crate::topology::*;
 use std::collections::HashMap;
 
@@ -104,7 +105,7 @@ impl<'a> Translator<'a> {
                     &self.brep,
                     &self.brep.shells[shells[0].idx()].faces,
                 );
-                let slack = 1e-6 * outer_box.diagonal().max(1e-9);
+                let slack = POINT_COINCIDENCE * outer_box.diagonal().max(1e-9);
                 let mut own = vec![];
                 let first = shells[0];
                 shells.retain(|&sh| {
@@ -345,7 +346,7 @@ impl<'a> Translator<'a> {
                 self.brep.warnings.push(format!(
                     "#{id}: edge geometry {entity} is not supported; using a straight line"
                 ));
-                let dir = (pe - ps).try_normalize(1e-300).unwrap_or_else(V3::x);
+                let dir = (pe - ps).try_normalize(NONZERO).unwrap_or_else(V3::x);
                 let c = CurveId(self.brep.curves.len() as u32);
                 self.brep.curves.push(Curve::Line { origin: ps, dir });
                 c
@@ -357,7 +358,7 @@ impl<'a> Translator<'a> {
         let mut t_end = cv.project(&pe);
         let closed = start == end;
         if let Some(per) = cv.period() {
-            let eps = 1e-9 * per;
+            let eps = PERIOD_FRACTION * per;
             if same_sense {
                 while t_end <= t_start + eps {
                     t_end += per;
@@ -385,7 +386,7 @@ impl<'a> Translator<'a> {
             .max((cv.eval(t_end) - pe).norm());
         // Far off (not modelling tolerance but a broken edge, e.g. a circle whose radius does
         // not match its vertices): refuse rather than mesh a curve that is not the edge.
-        let limit = 1.0 + 1e-6 * ps.coords.norm().max(pe.coords.norm());
+        let limit = 1.0 + POINT_COINCIDENCE * ps.coords.norm().max(pe.coords.norm());
         if off.is_nan() || off > limit {
             return Err(ReadError::Entity {
                 id,
