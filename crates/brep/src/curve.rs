@@ -1,6 +1,7 @@
 //! Exact 3-D curves: the geometry of edges and of swept-surface profiles.
 
 use crate::math::{nearest_periodic, Frame, P3, V3};
+use crate::tolerance::{NONZERO, POINT_COINCIDENCE};
 use std::f64::consts::TAU;
 use truck_geometry::prelude as tg;
 
@@ -288,7 +289,7 @@ impl Curve {
                 if let Some(per) = basis.period() {
                     tb = nearest_periodic(tb, 0.5 * (t0 + t1), per);
                 }
-                if (t1 - t0).abs() < 1e-300 {
+                if (t1 - t0).abs() < NONZERO {
                     0.0
                 } else {
                     ((tb - t0) / (t1 - t0)).clamp(-0.5, 1.5)
@@ -303,7 +304,7 @@ impl Curve {
         match self {
             Curve::Nurbs(n) => {
                 let t = self.newton(p, hint, Some((n.t0, n.t1)));
-                if (self.eval(t) - p).norm() <= 1e-6 * (1.0 + p.coords.norm()) {
+                if (self.eval(t) - p).norm() <= POINT_COINCIDENCE * (1.0 + p.coords.norm()) {
                     t
                 } else {
                     self.project(p)
@@ -333,7 +334,7 @@ impl Curve {
             let c2 = self.deriv2(t);
             let f = c1.dot(&d);
             let df = c2.dot(&d) + c1.norm_squared();
-            if df.abs() < 1e-300 || !df.is_finite() {
+            if df.abs() < NONZERO || !df.is_finite() {
                 break;
             }
             let mut step = f / df;

@@ -14,22 +14,24 @@
 // read more plainly there than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bbox;
 pub mod curve;
-pub mod error;
 pub mod mass;
 pub mod math;
 pub mod mesh;
 pub mod nurbs;
-pub mod p21;
-mod schema_names;
 pub mod section;
 pub mod solid;
 pub mod step;
 pub mod surface;
+pub mod tolerance;
 pub mod topology;
 pub mod validate;
-pub mod write;
+
+// The STEP modules' former paths (`brep::p21`, `brep::write`, `brep::error`).
+pub use step::{error, p21, write};
 
 pub use error::ReadError;
-pub use solid::{read_step, read_step_bytes, SolidReport, StepPart};
+pub use solid::SolidReport;
+pub use step::{read_step, read_step_bytes, StepPart};
 pub use topology::Brep;

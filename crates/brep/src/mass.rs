@@ -4,6 +4,7 @@
 
 use crate::math::{Aabb, P3, V3};
 use crate::mesh::Mesh;
+use crate::tolerance::NONZERO;
 use crate::topology::Brep;
 
 /// Integrals over a set of faces.
@@ -161,7 +162,7 @@ fn plane_slivers(
                 let mid = frame.local(&c.eval(m));
                 let (cx, cy) = (b.x - a.x, b.y - a.y);
                 let len = cx.hypot(cy);
-                let bow = ((mid.x - a.x) * cy - (mid.y - a.y) * cx).abs() / len.max(1e-300);
+                let bow = ((mid.x - a.x) * cy - (mid.y - a.y) * cx).abs() / len.max(NONZERO);
                 if bow <= 1e-9 * (1.0 + len) {
                     continue;
                 }

@@ -1,5 +1,7 @@
 //! Small vector types and placements shared by curves and surfaces.
 
+use crate::tolerance::{NONZERO, PARALLEL};
+
 /// A point in model space, in millimetres.
 pub type P3 = nalgebra::Point3<f64>;
 /// A vector in model space.
@@ -33,9 +35,9 @@ impl Frame {
     /// `x` is the reference direction projected orthogonal to `z` (an arbitrary perpendicular when
     /// absent or parallel). Returns `None` when `z` has zero length.
     pub fn from_axes(origin: P3, z: Option<V3>, x_ref: Option<V3>) -> Option<Self> {
-        let z = z.unwrap_or_else(V3::z).try_normalize(1e-300)?;
+        let z = z.unwrap_or_else(V3::z).try_normalize(NONZERO)?;
         let x = x_ref
-            .and_then(|r| (r - z * r.dot(&z)).try_normalize(1e-12))
+            .and_then(|r| (r - z * r.dot(&z)).try_normalize(PARALLEL))
             .unwrap_or_else(|| any_perpendicular(&z));
         let y = z.cross(&x);
         Some(Frame { origin, x, y, z })

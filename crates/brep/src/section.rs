@@ -8,6 +8,7 @@
 
 use crate::math::{any_perpendicular, P3, V3};
 use crate::mesh::Mesh;
+use crate::tolerance::NONZERO;
 use std::collections::HashMap;
 
 /// A plane with an in-plane frame, for 2-D coordinates.
@@ -27,7 +28,7 @@ impl Plane {
     /// The plane through `origin` with unit normal `normal`; its `u` axis is world X projected
     /// into the plane (or Y when X is nearly normal to it).
     pub fn new(origin: P3, normal: V3) -> Self {
-        let n = normal.try_normalize(1e-300).unwrap_or_else(V3::z);
+        let n = normal.try_normalize(NONZERO).unwrap_or_else(V3::z);
         let u = [V3::x(), V3::y()]
             .iter()
             .map(|a| a - n * a.dot(&n))

@@ -1,38 +1,13 @@
-//! Reading a file and reporting on each solid: the figures `features inspect` prints.
+//! Reporting on each solid: the figures `features inspect` prints.
 
-use crate::error::ReadError;
 use crate::mass::mass_properties;
 use crate::math::Aabb;
 use crate::mesh::{mesh_faces, Mesh, MeshError, MeshOptions};
 use crate::topology::{Brep, SolidId};
 use crate::validate::check_shell;
 use std::collections::BTreeMap;
-use std::path::Path;
 
-/// A STEP file read into a B-rep.
-#[derive(Debug, Clone)]
-pub struct StepPart {
-    /// Every solid of the file, in millimetres.
-    pub brep: Brep,
-    /// The file's schema names (`FILE_SCHEMA`).
-    pub schemas: Vec<String>,
-}
-
-/// Reads a STEP file from disk.
-pub fn read_step(path: impl AsRef<Path>) -> Result<StepPart, ReadError> {
-    let bytes = std::fs::read(path.as_ref())?;
-    read_step_bytes(&bytes)
-}
-
-/// Reads a STEP file from memory.
-pub fn read_step_bytes(bytes: &[u8]) -> Result<StepPart, ReadError> {
-    let file = crate::p21::parse(bytes)?;
-    let brep = crate::step::translate(&file)?;
-    Ok(StepPart {
-        brep,
-        schemas: file.schemas(),
-    })
-}
+pub use crate::bbox::{faces_rough_bbox, rough_bbox};
 
 /// Figures for one solid.
 #[derive(Debug, Clone)]
@@ -80,58 +55,6 @@ pub fn analysis_options(diag: f64) -> MeshOptions {
         angle_tol: 10f64.to_radians(),
         edge_chord_tol: Some((diag * 1e-4).max(1e-4)),
     }
-}
-
-/// A bounding box good enough to size tolerances: vertices, a few points of every edge, and
-/// samples of faces that have no edge at all (a whole sphere or torus).
-pub fn rough_bbox(brep: &Brep, s: SolidId) -> Aabb {
-    faces_rough_bbox(brep, &brep.solid_faces(s))
-}
-
-/// [`rough_bbox`] of a set of faces.
-pub fn faces_rough_bbox(brep: &Brep, faces: &[crate::topology::FaceId]) -> Aabb {
-    let mut b = Aabb::empty();
-    let faces = faces.to_vec();
-    for v in brep.vertices_of(&faces) {
-        b.add(&brep.vertices[v.idx()].point);
-    }
-    for e in brep.edges_of(&faces) {
-        let edge = brep.edge(e);
-        let c = brep.edge_curve(e);
-        for k in 1..8 {
-            b.add(&c.eval(edge.t_start + (edge.t_end - edge.t_start) * k as f64 / 8.0));
-        }
-    }
-    for f in faces {
-        let face = brep.face(f);
-        if face
-            .loops
-            .iter()
-            .all(|l| brep.loops[l.idx()].coedges.is_empty())
-        {
-            let srf = brep.face_surface(f);
-            let (bu, bv) = srf.bounds();
-            let ur = srf
-                .u_period()
-                .map(|p| (0.0, p))
-                .or(bu)
-                .unwrap_or((0.0, 1.0));
-            let vr = srf
-                .v_period()
-                .map(|p| (0.0, p))
-                .or(bv)
-                .unwrap_or((0.0, 1.0));
-            for i in 0..=8 {
-                for j in 0..=8 {
-                    b.add(&srf.eval(
-                        ur.0 + (ur.1 - ur.0) * i as f64 / 8.0,
-                        vr.0 + (vr.1 - vr.0) * j as f64 / 8.0,
-                    ));
-                }
-            }
-        }
-    }
-    b
 }
 
 /// Meshes one solid (all its shells) at `opts`, or at analysis precision when `None`.

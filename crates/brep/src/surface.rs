@@ -3,6 +3,7 @@
 
 use crate::curve::Curve;
 use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
+use crate::tolerance::{ANGLE_ZERO, NONZERO, PARALLEL, POINT_COINCIDENCE, SURFACE_COINCIDENCE};
 use std::f64::consts::{FRAC_PI_2, TAU};
 use truck_geometry::prelude as tg;
 
@@ -187,7 +188,7 @@ impl NurbsSurfaceData {
             samples: std::sync::OnceLock::new(),
         };
         let size = d.size_estimate();
-        let tol = 1e-7 * size.max(1e-3);
+        let tol = SURFACE_COINCIDENCE * size.max(1e-3);
         d.closed_u = (0..=8).all(|i| {
             let t = v.0 + (v.1 - v.0) * i as f64 / 8.0;
             (d.raw(u.0, t) - d.raw(u.1, t)).norm() <= tol
@@ -387,7 +388,7 @@ impl Surface {
                 let (su, sv) = self.derivs(u, v);
                 let n = su.cross(&sv);
                 let scale = su.norm() * sv.norm();
-                if scale > 0.0 && n.norm() > 1e-12 * scale {
+                if scale > 0.0 && n.norm() > PARALLEL * scale {
                     return Some(n / n.norm());
                 }
                 // Degenerate: step a little into the domain and take the limit.
@@ -499,7 +500,7 @@ impl Surface {
                 radius, semi_angle, ..
             } => {
                 let t = semi_angle.tan();
-                if t.abs() > 1e-12 {
+                if t.abs() > ANGLE_ZERO {
                     (vec![-radius / t], vec![])
                 } else {
                     (vec![], vec![])
@@ -514,7 +515,7 @@ impl Surface {
                 let mut vs = vec![];
                 let mut us = vec![];
                 let size = self.size_hint();
-                let tol = 1e-7 * size.max(1e-3);
+                let tol = SURFACE_COINCIDENCE * size.max(1e-3);
                 let (ur, vr) = self.sample_ranges();
                 if let Some((a, b)) = bv {
                     for v in [a, b] {
@@ -652,7 +653,7 @@ impl Surface {
                         let q = self.polish(p, h);
                         // Points of other writers lie off the surface by their modelling tolerance.
                         if (self.eval(q.0, q.1) - p).norm()
-                            < 1e-4f64.max(1e-6 * (1.0 + p.coords.norm()))
+                            < 1e-4f64.max(POINT_COINCIDENCE * (1.0 + p.coords.norm()))
                         {
                             return q;
                         }
@@ -724,7 +725,7 @@ impl Surface {
             let b1 = -su.dot(&d);
             let b2 = -sv.dot(&d);
             let det = a11 * a22 - a12 * a12;
-            let (du, dv) = if det.abs() > 1e-18 * (a11 * a22).max(1e-300) {
+            let (du, dv) = if det.abs() > 1e-18 * (a11 * a22).max(NONZERO) {
                 ((b1 * a22 - b2 * a12) / det, (a11 * b2 - a12 * b1) / det)
             } else if a11 > a22 && a11 > 0.0 {
                 (b1 / a11, 0.0)

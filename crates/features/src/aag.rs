@@ -1,4 +1,5 @@
-//! The attributed adjacency graph: faces as nodes, shared edges as arcs carrying convexity.
+//! The attributed adjacency graph: the convexity of each edge two faces share, and how each face
+//! rises off the other along it (kept as maps keyed by edge; nothing walks the graph itself).
 //!
 //! Convexity is sampled along each edge. At each sample the exact outward normals of both faces
 //! are taken, and the direction pointing into the first face across the edge is read from the
@@ -9,8 +10,7 @@
 use brep::math::V3;
 use brep::mesh::Mesh;
 use brep::topology::{Brep, EdgeId, FaceId};
-use petgraph::graph::{NodeIndex, UnGraph};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// How two faces meet along an edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -23,17 +23,6 @@ pub enum Convexity {
     Smooth,
     /// Concave in places and convex in others.
     Mixed,
-}
-
-/// One arc of the graph.
-#[derive(Debug, Clone, Copy)]
-pub struct EdgeAttr {
-    /// The B-rep edge.
-    pub edge: EdgeId,
-    /// How the faces meet along it.
-    pub convexity: Convexity,
-    /// The largest angle between the two faces' normals along the edge, degrees.
-    pub max_angle_deg: f64,
 }
 
 /// How the face on each side of an edge leaves the other face's tangent plane.
@@ -50,10 +39,6 @@ pub struct Rise {
 /// Faces and their adjacency.
 #[derive(Debug, Clone)]
 pub struct Aag {
-    /// The graph (parallel arcs where two faces share several edges).
-    pub graph: UnGraph<FaceId, EdgeAttr>,
-    /// Node of each face.
-    pub node: HashMap<FaceId, NodeIndex>,
     /// Convexity of each edge between two different faces (seams are absent).
     pub convexity: HashMap<EdgeId, Convexity>,
     /// Rise of each face off the other along each edge between two different faces.
@@ -77,11 +62,7 @@ impl Aag {
 /// Builds the graph of `faces` from a mesh of exactly those faces. `smooth_deg` is the angle
 /// under which two faces count as tangent.
 pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag {
-    let mut graph = UnGraph::new_undirected();
-    let mut node = HashMap::new();
-    for &f in faces {
-        node.insert(f, graph.add_node(f));
-    }
+    let member: HashSet<FaceId> = faces.iter().copied().collect();
     // For every mesh edge, the faces whose triangles use it and each triangle's third vertex.
     let mut third: HashMap<(u32, u32), Vec<(FaceId, u32)>> = HashMap::new();
     for ft in &mesh.faces {
@@ -102,7 +83,7 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         let mut adj: Vec<FaceId> = vec![];
         for &c in &brep.edge(e).coedges {
             let f = brep.coedge_face(c);
-            if node.contains_key(&f)
+            if member.contains(&f)
                 && !adj.contains(&f)
                 && brep.face(f).loops.contains(&brep.coedges[c.idx()].lp)
             {
@@ -120,7 +101,6 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
         let step = (segs / 12).max(1);
         let (mut concave, mut convex) = (0, 0);
         let (mut r12, mut r21, mut nr) = (0.0, 0.0, 0usize);
-        let mut max_angle: f64 = 0.0;
         for k in (0..segs).step_by(step) {
             let (a, b) = (pts[k], pts[k + 1]);
             let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
@@ -158,7 +138,6 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
             r21 += (mesh.positions[c1 as usize] - pa).dot(&n2);
             nr += 1;
             let angle = n1.dot(&n2).clamp(-1.0, 1.0).acos().to_degrees();
-            max_angle = max_angle.max(angle);
             if angle < smooth_deg {
                 // Tangent here: neither concave nor convex.
             } else if n2.dot(&d1) + n1.dot(&d2) > 0.0 {
@@ -183,19 +162,8 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
                 },
             );
         }
-        graph.add_edge(
-            node[&f1],
-            node[&f2],
-            EdgeAttr {
-                edge: e,
-                convexity: c,
-                max_angle_deg: max_angle,
-            },
-        );
     }
     Aag {
-        graph,
-        node,
         convexity,
         rise: rises,
     }

@@ -10,7 +10,6 @@ use brep::mesh::{loop_roles, mesh_faces, LoopRole, MeshError};
 use brep::solid::analysis_options;
 use brep::surface::Surface;
 use brep::topology::*;
-use petgraph::graph::DiGraph;
 use std::collections::{HashMap, HashSet};
 
 /// Knobs of the recognition.
@@ -429,20 +428,15 @@ pub fn extract(
 
     // Order and depth: parents first, and among features ready together the lowest id first
     // (Kahn's algorithm), so the order reads like the tree.
-    let mut g = DiGraph::<usize, ()>::new();
-    let nodes: Vec<_> = (0..features.len()).map(|k| g.add_node(k)).collect();
+    // Each feature's children (one entry per parent link, in link order) and parent-link count.
+    let mut children: Vec<Vec<usize>> = vec![vec![]; features.len()];
+    let mut indegree: Vec<usize> = vec![0; features.len()];
     for f in &features {
         for &p in &f.parents {
-            g.add_edge(nodes[p], nodes[f.id], ());
+            children[p].push(f.id);
+            indegree[f.id] += 1;
         }
     }
-    let mut indegree: Vec<usize> = nodes
-        .iter()
-        .map(|&n| {
-            g.neighbors_directed(n, petgraph::Direction::Incoming)
-                .count()
-        })
-        .collect();
     let mut ready: std::collections::BinaryHeap<std::cmp::Reverse<usize>> = (0..features.len())
         .filter(|&k| indegree[k] == 0)
         .map(std::cmp::Reverse)
@@ -450,8 +444,8 @@ pub fn extract(
     let mut build_order = vec![];
     while let Some(std::cmp::Reverse(k)) = ready.pop() {
         build_order.push(k);
-        for c in g.neighbors_directed(nodes[k], petgraph::Direction::Outgoing) {
-            let c = g[c];
+        // Newest link first, as the directed graph this replaces listed a node's out-arcs.
+        for &c in children[k].iter().rev() {
             indegree[c] -= 1;
             if indegree[c] == 0 {
                 ready.push(std::cmp::Reverse(c));

@@ -1,6 +1,6 @@
 //! Errors of reading a STEP file into a B-rep.
 
-use crate::p21::P21Error;
+use crate::step::p21::P21Error;
 
 /// Why a file could not be read. Each message is one line; the CLI prefixes the file name.
 #[derive(Debug, thiserror::Error)]
