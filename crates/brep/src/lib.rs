@@ -23,6 +23,7 @@ pub mod nurbs;
 pub mod section;
 pub mod solid;
 pub mod step;
+pub mod subset;
 pub mod surface;
 pub mod tolerance;
 pub mod topology;

@@ -163,7 +163,9 @@ pub fn extract(
     solid: SolidId,
     opts: &ExtractOptions,
 ) -> Result<FeatureTree, ExtractError> {
-    let mut b = part.clone();
+    // The solid alone, not a copy of the whole file: healing adds faces to it.
+    let mut b = part.solid_alone(solid);
+    let solid = SolidId(0);
     let mut warnings = vec![];
     let shells = b.solids[solid.idx()].shells.clone();
     let outer: Vec<FaceId> = b.shells[shells[0].idx()].faces.clone();
