@@ -9,7 +9,7 @@ use serde_json::json;
 use slicer::freeform::plan_freeform;
 use slicer::orient::{smooth, SmoothParams};
 use slicer::params::{LayerParams, LayerParamsPatch};
-use slicer::planar::{plan_two5d, Bead};
+use slicer::planar::plan_two5d;
 use slicer::toolpath::ToolPath;
 use std::collections::HashMap;
 use std::io::Write as _;
@@ -83,11 +83,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             format!("process [orientation]: {e}"),
         )
     })?;
-    let bead = Bead {
-        width: machine.bead_width,
-        filament_diameter: machine.filament_diameter,
-    };
-    let filament_area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
+    let bead = machine.bead();
+    let filament_area = bead.filament_area();
 
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     let assembly =
