@@ -46,8 +46,8 @@
 
 use std::collections::BTreeMap;
 
-use slicer::toolpath::fixed;
-use slicer::vec3::{norm, sub, unit};
+use toolpath::fixed;
+use toolpath::vec3::{norm, sub, unit};
 
 use crate::{MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
 

@@ -57,8 +57,8 @@ use std::f64::consts::PI;
 
 use crate::marlin::bed_offset;
 use crate::{MachineProfile, MoveKind, PostError, ToolPath};
-use slicer::toolpath::fixed;
-use slicer::vec3::{add, cross, dot, norm, scale, sub, V3};
+use toolpath::fixed;
+use toolpath::vec3::{add, cross, dot, norm, scale, sub, V3};
 
 /// Largest orientation change of one LIN of a travel (degrees): a travel that turns the tool
 /// further is split into several LINs.

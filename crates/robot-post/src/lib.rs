@@ -3,7 +3,7 @@
 //! - [`machine`]: machine profiles ([`MachineProfile`]), read from TOML; the built-in ones are
 //!   the files in the repository's `profiles/` folder.
 //! - [`toolpath`]: the planned path the posts consume ([`ToolPath`] of [`PathPoint`]s), from the
-//!   slicer (re-exported).
+//!   `toolpath` crate (re-exported).
 //! - [`marlin`](mod@marlin): 3-axis Marlin G-code for paths whose tool axis is +Z throughout.
 //!
 //! Every fallible function returns a [`PostError`] whose message is one line.
@@ -14,7 +14,7 @@ pub mod krl;
 pub mod kuka;
 pub mod machine;
 pub mod marlin;
-pub use slicer::toolpath;
+pub use toolpath;
 
 pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;

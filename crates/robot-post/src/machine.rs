@@ -5,6 +5,7 @@
 use std::fmt;
 
 use crate::PostError;
+use toolpath::Bead;
 
 /// The bundled `profiles/marlin.toml`: a generic 220x220x250 mm Marlin printer.
 pub const MARLIN_TOML: &str = include_str!("../../../profiles/marlin.toml");
@@ -258,8 +259,15 @@ impl MachineProfile {
     /// `4·w·dl·len / (π·D²)` with this profile's filament diameter D (Isa & Lazoglu 2019,
     /// Eq. 1). For planners; the posts only write the `e` the planner computed.
     pub fn filament_length(&self, w: f64, dl: f64, len: f64) -> f64 {
-        4.0 * w * dl * len
-            / (std::f64::consts::PI * self.filament_diameter * self.filament_diameter)
+        self.bead().filament_length(w, dl, len)
+    }
+
+    /// The profile's bead: its `bead_width` and `filament_diameter`.
+    pub fn bead(&self) -> Bead {
+        Bead {
+            width: self.bead_width,
+            filament_diameter: self.filament_diameter,
+        }
     }
 }
 

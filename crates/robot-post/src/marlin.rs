@@ -5,7 +5,7 @@
 //! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
 
 use crate::{MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
-use slicer::toolpath::fixed;
+use toolpath::fixed;
 
 /// Largest deviation of a tool axis component from +Z (0, 0, 1) that Marlin accepts.
 pub const AXIS_TOLERANCE: f64 = 1e-6;
