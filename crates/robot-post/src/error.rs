@@ -1,6 +1,6 @@
 //! The one error type of the crate.
 
-use crate::machine::MachineKind;
+use crate::kind::MachineKind;
 
 /// Why a profile, a tool path or a program could not be read or written. Every message is one
 /// line, fit to follow `features: PATH: `.

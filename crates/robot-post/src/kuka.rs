@@ -5,7 +5,7 @@
 //!
 //! - **Frames.** `$BASE` is the work table's frame in the robot's base frame (`$WORLD`, with a
 //!   null `$ROBROOT`): the profile's `[kuka.base]`, Z up from the table top. The part is placed
-//!   on the table by the rule of [`crate::marlin::bed_offset`] (XY bounding-box centre on the
+//!   on the table by the rule of [`crate::placement::bed_offset`] (XY bounding-box centre on the
 //!   table centre, lowest bead bottom on the table top); LIN targets are tool poses in `$BASE`,
 //!   part point + offset, and the offset is written in a header comment
 //!   `; part offset X.. Y.. Z.. (base = part + offset)`. `$TOOL` is the nozzle tip in the
@@ -55,7 +55,8 @@
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
-use crate::marlin::bed_offset;
+use crate::gcode::comment_text;
+use crate::placement::bed_offset;
 use crate::{MachineProfile, MoveKind, PostError, ToolPath};
 use toolpath::fixed;
 use toolpath::vec3::{add, cross, dot, norm, scale, sub, V3};
@@ -1422,13 +1423,6 @@ pub fn krl_name(s: &str, max: usize) -> String {
     }
     name.truncate(max.max(1));
     name
-}
-
-/// `s` with line breaks and other control characters replaced by spaces, for comments.
-fn comment_text(s: &str) -> String {
-    s.chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect()
 }
 
 /// A KRL frame aggregate `{X .., Y .., Z .., A .., B .., C ..}`: mm with 3 decimals, degrees

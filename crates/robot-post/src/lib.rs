@@ -10,10 +10,13 @@
 
 pub mod delta5;
 pub mod error;
+mod gcode;
+mod kind;
 pub mod krl;
 pub mod kuka;
 pub mod machine;
 pub mod marlin;
+pub mod placement;
 pub use toolpath;
 
 pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
