@@ -59,7 +59,7 @@ pub struct MachineProfile {
     pub delta5: Option<crate::delta5::geometry::Delta5Geometry>,
     /// The robot cell (`[kuka]` table); required when `kind = "kuka"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kuka: Option<crate::kuka::KukaCell>,
+    pub kuka: Option<crate::kuka::cell::KukaCell>,
 }
 
 impl MachineProfile {
@@ -209,7 +209,7 @@ impl MachineProfile {
     }
 
     /// [`MachineProfile::check_for`] a `kuka` profile, and its `[kuka]` table.
-    pub fn kuka_table(&self) -> Result<&crate::kuka::KukaCell, PostError> {
+    pub fn kuka_table(&self) -> Result<&crate::kuka::cell::KukaCell, PostError> {
         self.check_for(MachineKind::Kuka)?;
         self.kuka
             .as_ref()
