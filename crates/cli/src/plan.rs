@@ -5,6 +5,7 @@ use crate::mesh::TempFile;
 use crate::{emit, Failure, PlanArgs};
 use features::{extract_all, ExtractOptions};
 use robot_post::machine::{MachineKind, MachineProfile};
+use robot_post::post::FigureValue;
 use serde_json::json;
 use slicer::freeform::plan_freeform;
 use slicer::orient::{smooth, SmoothParams};
@@ -236,58 +237,32 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_else(|| "part".into());
-    let mut files: Vec<(String, Vec<u8>)> = vec![];
-    match machine.kind {
-        MachineKind::Marlin => {
-            let program = robot_post::marlin::marlin(&toolpath, &machine, &source)
-                .map_err(|e| Failure::new(path, e))?;
-            files.push(("program.gcode".into(), program.into_bytes()));
-        }
-        MachineKind::Delta5 => {
-            let program = robot_post::delta5::delta5(&toolpath, &machine, &source)
-                .map_err(|e| Failure::new(path, e))?;
-            for v in &mut feature_values {
-                let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
-                if let (Some(o), Some(k)) = (v.as_object_mut(), program.figures.get(&id)) {
-                    o.insert("kinematic_error_max_mm".into(), json!(round(k.max_mm, 1e6)));
-                    o.insert(
-                        "kinematic_error_mean_mm".into(),
-                        json!(round(k.mean_mm, 1e6)),
-                    );
-                    o.insert("subdivided_segments".into(), json!(k.subdivided_segments));
-                    o.insert("singular_points".into(), json!(k.singular_points));
-                    o.insert("c_step_max_deg".into(), json!(round(k.max_c_step_deg, 1e6)));
-                }
-            }
-            files.push(("program.gcode".into(), program.gcode.into_bytes()));
-            files.push((
-                "kinematic_error.svg".into(),
-                program.error_plot_svg.into_bytes(),
-            ));
-        }
-        MachineKind::Kuka => {
-            let program = robot_post::kuka::kuka(&toolpath, &machine, &stem, &source)
-                .map_err(|e| Failure::new(path, e))?;
-            for v in &mut feature_values {
-                let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
-                if let (Some(o), Some(k)) = (v.as_object_mut(), program.figures.get(&id)) {
-                    o.insert("unreachable_points".into(), json!(k.unreachable_points));
-                    o.insert(
-                        "wrist_singular_points".into(),
-                        json!(k.wrist_singular_points),
-                    );
-                    o.insert(
-                        "configuration_changes".into(),
-                        json!(k.configuration_changes),
-                    );
-                }
-            }
-            warnings.extend(program.warnings.iter().cloned());
-            for (name, text) in program.files {
-                files.push((name, text.into_bytes()));
+    let job = robot_post::Job {
+        source: &source,
+        stem: &stem,
+    };
+    let program = machine
+        .post()
+        .post(&toolpath, &job)
+        .map_err(|e| Failure::new(path, e))?;
+    for v in &mut feature_values {
+        let id = v["id"].as_u64().unwrap_or(u64::MAX) as usize;
+        if let (Some(o), Some(k)) = (v.as_object_mut(), program.figures.get(&id)) {
+            for (key, x) in k.named() {
+                let x = match x {
+                    FigureValue::Real(x) => json!(round(x, 1e6)),
+                    FigureValue::Count(n) => json!(n),
+                };
+                o.insert(key.into(), x);
             }
         }
     }
+    warnings.extend(program.warnings.iter().cloned());
+    let mut files: Vec<(String, Vec<u8>)> = program
+        .files
+        .into_iter()
+        .map(|f| (f.name, f.bytes))
+        .collect();
     // The self-check: every feature got layers and the material it holds. A failure stops the
     // run before any file is written, unless --keep-going.
     let problems = slicer::verify::check_plan(&planned);
