@@ -73,10 +73,17 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let dir = &args.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
-    let mut files = vec![("toolpath.csv".into(), plan.toolpath.to_csv().into_bytes())];
-    files.push(("plan.json".to_string(), json.into_bytes()));
-    files.extend(plan.program.iter().cloned());
-    for (name, bytes) in &files {
+    let csv = plan.toolpath.to_csv();
+    let mut files = vec![
+        ("toolpath.csv", csv.as_bytes()),
+        ("plan.json", json.as_bytes()),
+    ];
+    files.extend(
+        plan.program
+            .iter()
+            .map(|f| (f.name.as_str(), f.bytes.as_slice())),
+    );
+    for (name, bytes) in files {
         write_atomic(&dir.join(name), |w| w.write_all(bytes))
             .map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))?;
     }

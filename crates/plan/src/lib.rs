@@ -18,10 +18,11 @@ pub use report::{FeatureEntry, FeatureReport, PlanReport};
 
 use features::{extract_all, ExtractOptions, FeatureKind};
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
-use robot_post::machine::{MachineKind, MachineProfile};
+use robot_post::machine::MachineProfile;
+use robot_post::{Job, PostFigures, ProgramFile};
 use slicer::freeform::plan_freeform;
 use slicer::orient::{smooth, OrientationFigures};
-use slicer::planar::{plan_two5d, Bead};
+use slicer::planar::plan_two5d;
 use slicer::toolpath::ToolPath;
 use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
 
@@ -89,8 +90,8 @@ pub struct Plan {
     pub report: PlanReport,
     /// The tool path every feature is printed along, in build order.
     pub toolpath: ToolPath,
-    /// The machine program's files (name, contents), in the order they are written.
-    pub program: Vec<(String, Vec<u8>)>,
+    /// The machine program's files, in the order they are written.
+    pub program: Vec<ProgramFile>,
 }
 
 impl Plan {
@@ -119,11 +120,8 @@ pub fn plan(
         }
     };
     let base = process.base();
-    let bead = Bead {
-        width: machine.bead_width,
-        filament_diameter: machine.filament_diameter,
-    };
-    let filament_area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
+    let bead = machine.bead();
+    let filament_area = bead.filament_area();
 
     let assembly = extract_all(&part.brep, &ExtractOptions::default())?;
     let trees = &assembly.trees;
@@ -225,35 +223,18 @@ pub fn plan(
             rate_max_deg_per_mm_after: round(o.rate_max_deg_per_mm_after, 1e6),
         });
     }
-    let mut files: Vec<(String, Vec<u8>)> = vec![];
-    match machine.kind {
-        MachineKind::Marlin => {
-            let program = robot_post::marlin::marlin(&toolpath, machine, &options.source)?;
-            files.push(("program.gcode".into(), program.into_bytes()));
-        }
-        MachineKind::Delta5 => {
-            let program = robot_post::delta5::delta5(&toolpath, machine, &options.source)?;
-            for r in &mut reports {
-                r.post = program.figures.get(&r.feature.id).map(PostEntry::delta5);
-            }
-            files.push(("program.gcode".into(), program.gcode.into_bytes()));
-            files.push((
-                "kinematic_error.svg".into(),
-                program.error_plot_svg.into_bytes(),
-            ));
-        }
-        MachineKind::Kuka => {
-            let program =
-                robot_post::kuka::kuka(&toolpath, machine, &options.stem, &options.source)?;
-            for r in &mut reports {
-                r.post = program.figures.get(&r.feature.id).map(PostEntry::kuka);
-            }
-            warnings.extend(program.warnings.iter().cloned());
-            for (name, text) in program.files {
-                files.push((name, text.into_bytes()));
-            }
-        }
+    let job = Job {
+        source: &options.source,
+        stem: &options.stem,
+    };
+    let program = machine.post().post(&toolpath, &job)?;
+    for r in &mut reports {
+        r.post = program.figures.get(&r.feature.id).map(|k| match k {
+            PostFigures::Delta5(k) => PostEntry::delta5(k),
+            PostFigures::Kuka(k) => PostEntry::kuka(k),
+        });
     }
+    warnings.extend(program.warnings.iter().cloned());
     // The self-check: every feature got layers and the material it holds.
     let problems = check_plan(&planned);
     if !problems.is_empty() {
@@ -273,6 +254,6 @@ pub fn plan(
     Ok(Plan {
         report,
         toolpath,
-        program: files,
+        program: program.files,
     })
 }

@@ -1,6 +1,6 @@
 //! The one error type of the crate.
 
-use crate::machine::MachineKind;
+use crate::kind::MachineKind;
 
 /// Why a profile, a tool path or a program could not be read or written. Every message is one
 /// line, fit to follow `features: PATH: `.
@@ -31,7 +31,7 @@ pub enum PostError {
     },
     /// The tool path is unreadable or holds non-finite numbers.
     #[error(transparent)]
-    ToolPath(#[from] slicer::toolpath::ToolPathError),
+    ToolPath(#[from] toolpath::ToolPathError),
     /// A feature's tool axis is not one the machine can follow.
     #[error("feature {feature} has tool axis ({i:.6}, {j:.6}, {k:.6}), not +Z: `{machine}` prints only along +Z; it needs `delta5` or `kuka`")]
     ToolAxis {

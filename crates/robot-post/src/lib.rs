@@ -2,23 +2,35 @@
 //!
 //! - [`machine`]: machine profiles ([`MachineProfile`]), read from TOML; the built-in ones are
 //!   the files in the repository's `profiles/` folder.
+//! - [`post`](mod@post): one entry for every post: [`MachineProfile::post`] gives the profile's
+//!   [`Post`], which writes a [`Program`] (files, figures per feature, warnings) for a [`Job`].
 //! - [`toolpath`]: the planned path the posts consume ([`ToolPath`] of [`PathPoint`]s), from the
-//!   slicer (re-exported).
+//!   `toolpath` crate (re-exported).
 //! - [`marlin`](mod@marlin): 3-axis Marlin G-code for paths whose tool axis is +Z throughout.
+//! - [`delta5`](mod@delta5): 5-axis G-code for a printer with a tilting and rotating bed.
+//! - [`kuka`](mod@kuka): KRL programs for a KUKA robot cell; [`krl`] reads them back.
+//! - [`placement`]: where a post puts the part on the machine.
 //!
 //! Every fallible function returns a [`PostError`] whose message is one line.
 
+#![warn(missing_docs)]
+
 pub mod delta5;
 pub mod error;
+mod gcode;
+mod kind;
 pub mod krl;
 pub mod kuka;
 pub mod machine;
 pub mod marlin;
-pub use slicer::toolpath;
+pub mod placement;
+pub mod post;
+pub use toolpath;
 
 pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;
 pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
 pub use marlin::marlin;
+pub use post::{Job, Post, PostFigures, Program, ProgramFile};
 pub use toolpath::{MoveKind, PathPoint, ToolPath};

@@ -2,9 +2,9 @@
 //! read from TOML. The built-in profiles are the commented files in the repository's
 //! `profiles/` folder, compiled in with `include_str!`, so a user can copy one and edit it.
 
-use std::fmt;
-
+pub use crate::kind::MachineKind;
 use crate::PostError;
+use toolpath::Bead;
 
 /// The bundled `profiles/marlin.toml`: a generic 220x220x250 mm Marlin printer.
 pub const MARLIN_TOML: &str = include_str!("../../../profiles/marlin.toml");
@@ -15,44 +15,6 @@ pub const KUKA_TOML: &str = include_str!("../../../profiles/kuka.toml");
 /// The bundled `profiles/process.toml`: the process file format (`[defaults]` and
 /// `[features.<id>]` tables) with its default values, for the planner and for users to copy.
 pub const PROCESS_TOML: &str = include_str!("../../../profiles/process.toml");
-
-/// Which post writes the program, and so which motions the machine has.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MachineKind {
-    /// A 3-axis Marlin printer: tool axis +Z only.
-    Marlin,
-    /// A 5-axis printer (three linear axes and a tilting/rotary table).
-    Delta5,
-    /// A KUKA robot deposition cell.
-    Kuka,
-}
-
-impl MachineKind {
-    /// Every kind, in declaration order.
-    pub const ALL: [MachineKind; 3] = [MachineKind::Marlin, MachineKind::Delta5, MachineKind::Kuka];
-
-    /// The kind's name as written in profiles and on the command line (`marlin`, `delta5`,
-    /// `kuka`).
-    pub fn as_str(self) -> &'static str {
-        match self {
-            MachineKind::Marlin => "marlin",
-            MachineKind::Delta5 => "delta5",
-            MachineKind::Kuka => "kuka",
-        }
-    }
-
-    /// The kind named `name` (as [`MachineKind::as_str`] writes it), if any.
-    pub fn from_name(name: &str) -> Option<MachineKind> {
-        MachineKind::ALL.into_iter().find(|k| k.as_str() == name)
-    }
-}
-
-impl fmt::Display for MachineKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
 
 /// A machine profile. Lengths in mm, speeds in mm/s, temperatures in °C. The TOML form has
 /// exactly these keys (unknown keys are refused); see `profiles/marlin.toml` for each key's
@@ -94,10 +56,10 @@ pub struct MachineProfile {
     pub z_hop: f64,
     /// The bed's kinematics (`[delta5]` table); required when `kind = "delta5"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub delta5: Option<crate::delta5::Delta5Geometry>,
+    pub delta5: Option<crate::delta5::geometry::Delta5Geometry>,
     /// The robot cell (`[kuka]` table); required when `kind = "kuka"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kuka: Option<crate::kuka::KukaCell>,
+    pub kuka: Option<crate::kuka::cell::KukaCell>,
 }
 
 impl MachineProfile {
@@ -239,7 +201,7 @@ impl MachineProfile {
     }
 
     /// [`MachineProfile::check_for`] a `delta5` profile, and its `[delta5]` table.
-    pub fn delta5_table(&self) -> Result<&crate::delta5::Delta5Geometry, PostError> {
+    pub fn delta5_table(&self) -> Result<&crate::delta5::geometry::Delta5Geometry, PostError> {
         self.check_for(MachineKind::Delta5)?;
         self.delta5
             .as_ref()
@@ -247,7 +209,7 @@ impl MachineProfile {
     }
 
     /// [`MachineProfile::check_for`] a `kuka` profile, and its `[kuka]` table.
-    pub fn kuka_table(&self) -> Result<&crate::kuka::KukaCell, PostError> {
+    pub fn kuka_table(&self) -> Result<&crate::kuka::cell::KukaCell, PostError> {
         self.check_for(MachineKind::Kuka)?;
         self.kuka
             .as_ref()
@@ -258,8 +220,15 @@ impl MachineProfile {
     /// `4·w·dl·len / (π·D²)` with this profile's filament diameter D (Isa & Lazoglu 2019,
     /// Eq. 1). For planners; the posts only write the `e` the planner computed.
     pub fn filament_length(&self, w: f64, dl: f64, len: f64) -> f64 {
-        4.0 * w * dl * len
-            / (std::f64::consts::PI * self.filament_diameter * self.filament_diameter)
+        self.bead().filament_length(w, dl, len)
+    }
+
+    /// The profile's bead: its `bead_width` and `filament_diameter`.
+    pub fn bead(&self) -> Bead {
+        Bead {
+            width: self.bead_width,
+            filament_diameter: self.filament_diameter,
+        }
     }
 }
 

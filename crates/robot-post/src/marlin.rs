@@ -4,14 +4,16 @@
 //! comments, relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
 //! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
 
-use crate::{MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
-use slicer::toolpath::fixed;
+use crate::gcode::{comment_text, push_line, LayerMarks};
+use crate::kind::MachineKind;
+use crate::machine::MachineProfile;
+use crate::placement::bed_offset;
+use crate::PostError;
+use toolpath::fixed;
+use toolpath::{MoveKind, PathPoint, ToolPath};
 
 /// Largest deviation of a tool axis component from +Z (0, 0, 1) that Marlin accepts.
 pub const AXIS_TOLERANCE: f64 = 1e-6;
-
-/// Slack (mm) allowed when checking that the path fits the bed.
-const FIT_TOLERANCE: f64 = 1e-6;
 
 /// Lift of the nozzle at the end of the program (mm), kept within the bed height.
 const END_LIFT: f64 = 10.0;
@@ -71,119 +73,7 @@ fn is_plus_z(axis: [f64; 3]) -> bool {
         && (axis[2] - 1.0).abs() <= AXIS_TOLERANCE
 }
 
-/// The offset (mm, rounded to 0.001) added to part coordinates to get machine coordinates:
-/// the XY bounding-box centre of the print points goes to the bed centre (`bed_size / 2`, or
-/// X0 Y0 when `bed_origin_centre`), and the lowest bead bottom (`z − thickness` over print
-/// points) to Z0. A path without print points is placed by its travel points; an empty path
-/// gets the bed centre.
-///
-/// Errors with [`PostError::DoesNotFit`] when any point (print points with half their bead
-/// width and their thickness) lies outside the bed volume, saying by how much per axis.
-pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostError> {
-    let half = [m.bed_size[0] / 2.0, m.bed_size[1] / 2.0];
-    let centre = if m.bed_origin_centre {
-        [0.0, 0.0]
-    } else {
-        half
-    };
-    let placed = placed_points(path);
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for q in &placed {
-        let bottom = match q.kind {
-            MoveKind::Print => q.p[2] - q.thickness.max(0.0),
-            MoveKind::Travel => q.p[2],
-        };
-        for k in 0..2 {
-            lo[k] = lo[k].min(q.p[k]);
-            hi[k] = hi[k].max(q.p[k]);
-        }
-        lo[2] = lo[2].min(bottom);
-    }
-    let offset = if placed.is_empty() {
-        [centre[0], centre[1], 0.0]
-    } else {
-        [
-            round3(centre[0] - (lo[0] / 2.0 + hi[0] / 2.0)),
-            round3(centre[1] - (lo[1] / 2.0 + hi[1] / 2.0)),
-            // Up, never down: the lowest bead must not end below the plate.
-            ((-lo[2] - 1e-9) * 1000.0).ceil() / 1000.0,
-        ]
-    };
-
-    // Extent of everything the nozzle and the beads occupy, in machine coordinates.
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for q in &path.points {
-        let (r, bottom) = match q.kind {
-            MoveKind::Print => (q.width.max(0.0) / 2.0, q.p[2] - q.thickness.max(0.0)),
-            MoveKind::Travel => (0.0, q.p[2]),
-        };
-        for k in 0..2 {
-            lo[k] = lo[k].min(q.p[k] + offset[k] - r);
-            hi[k] = hi[k].max(q.p[k] + offset[k] + r);
-        }
-        lo[2] = lo[2].min(bottom + offset[2]);
-        hi[2] = hi[2].max(q.p[2] + offset[2]);
-    }
-    let bed_lo = [centre[0] - half[0], centre[1] - half[1], 0.0];
-    let bed_hi = [centre[0] + half[0], centre[1] + half[1], m.bed_size[2]];
-    let mut excess = Vec::new();
-    if !path.points.is_empty() {
-        for (k, letter) in ["X", "Y", "Z"].iter().enumerate() {
-            let over = (bed_lo[k] - lo[k]).max(0.0) + (hi[k] - bed_hi[k]).max(0.0);
-            // NaN (from overflowing coordinates) counts as not fitting.
-            let fits = over <= FIT_TOLERANCE && offset[k].is_finite();
-            if !fits {
-                excess.push(format!("{letter} {} mm", fixed(over, 3)));
-            }
-        }
-    }
-    if !excess.is_empty() {
-        return Err(PostError::DoesNotFit {
-            name: m.name.clone(),
-            bed: m.bed_size.map(|v| fixed(v, 0)).join("x"),
-            excess: excess.join(", "),
-        });
-    }
-    Ok(offset)
-}
-
-/// `v` rounded to 0.001, so the offset written in the header is exact.
-fn round3(v: f64) -> f64 {
-    (v * 1000.0).round() / 1000.0
-}
-
-/// `s` with line breaks and other control characters replaced by spaces, for comments.
-fn comment_text(s: &str) -> String {
-    s.chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect()
-}
-
 /// The program being written and the machine state it leaves.
-/// The `;LAYER:` and `;FEATURE:` comments of a G-code program: written where the point's
-/// layer or feature changes (shared by the Marlin and delta5 posts).
-#[derive(Debug, Default)]
-pub(crate) struct LayerMarks {
-    layer: Option<usize>,
-    feature: Option<usize>,
-}
-
-impl LayerMarks {
-    /// Appends the comment lines `q` starts to `out`.
-    pub(crate) fn write(&mut self, q: &PathPoint, out: &mut String) {
-        if self.layer != Some(q.layer) {
-            self.layer = Some(q.layer);
-            out.push_str(&format!(";LAYER:{}\n", q.layer));
-        }
-        if self.feature != Some(q.feature) {
-            self.feature = Some(q.feature);
-            out.push_str(&format!(";FEATURE:{}\n", q.feature));
-        }
-    }
-}
-
 struct Writer {
     out: String,
     /// Nozzle position (machine coordinates) the last move ended at, the hop excluded.
@@ -225,8 +115,7 @@ impl Writer {
     }
 
     fn line(&mut self, s: &str) {
-        self.out.push_str(s);
-        self.out.push('\n');
+        push_line(&mut self.out, s);
     }
 
     fn header(&mut self, m: &MachineProfile, source: &str, offset: [f64; 3]) {
@@ -354,20 +243,5 @@ impl Writer {
         }
         self.line("G28 X0 Y0 ; home X and Y");
         self.line("M84 ; motors off");
-    }
-}
-
-/// The points a post places the part by: the print points, or every point of a path without
-/// any (travel only).
-pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
-    let prints: Vec<&PathPoint> = path
-        .points
-        .iter()
-        .filter(|q| q.kind == MoveKind::Print)
-        .collect();
-    if prints.is_empty() {
-        path.points.iter().collect()
-    } else {
-        prints
     }
 }

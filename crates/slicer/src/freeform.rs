@@ -32,9 +32,7 @@
 use crate::fill::{regions_from_loops, Point2, Region};
 use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
 use crate::params::{LayerParams, PathMode};
-use crate::planar::{
-    feature_mesh, filament_length, slicing_tolerance, Bead, FeatureFigures, PlanError,
-};
+use crate::planar::{feature_mesh, slicing_tolerance, Bead, FeatureFigures, PlanError};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
@@ -1695,7 +1693,7 @@ pub fn plan_freeform(
             for w in pts.windows(2) {
                 let l = (w[1].p - w[0].p).norm();
                 let width = 0.5 * (w[0].w + w[1].w);
-                let e = filament_length(width, dl, l, bead.filament_diameter);
+                let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
                 out.push(PathPoint {

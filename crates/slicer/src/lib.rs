@@ -8,8 +8,10 @@
 //!   spatial slicing, paths spaced by geodesic distance ([`geodesic`]);
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
-//! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume;
-//! - [`vec3`]: arithmetic on the `[f64; 3]` positions and axes of planned points.
+//! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
+//!   re-exported);
+//! - [`vec3`]: arithmetic on the `[f64; 3]` positions and axes of planned points (from
+//!   `toolpath`).
 //!
 //! Polygon offsets and booleans come from the `i_overlay` crate.
 
@@ -19,9 +21,10 @@ pub mod geodesic;
 pub mod orient;
 pub mod params;
 pub mod planar;
-pub mod toolpath;
-pub mod vec3;
 pub mod verify;
+
+pub use toolpath;
+pub use toolpath::vec3;
 
 pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
 pub use params::{LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

@@ -16,14 +16,7 @@ use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
-/// What the planner needs to know about the machine's bead.
-#[derive(Debug, Clone, Copy)]
-pub struct Bead {
-    /// Bead width `w`, mm.
-    pub width: f64,
-    /// Filament diameter `D`, mm.
-    pub filament_diameter: f64,
-}
+pub use toolpath::Bead;
 
 /// Why a feature could not be planned.
 #[derive(Debug, thiserror::Error)]
@@ -71,12 +64,6 @@ pub enum PlanError {
         /// Cause.
         msg: String,
     },
-}
-
-/// Eq. 1 (Isa & Lazoglu 2019): filament length fed for a bead of width `w`, layer thickness
-/// `dl` and length `l`, from filament of diameter `d`: `4·w·Δl·L / (π·D²)`.
-pub fn filament_length(w: f64, dl: f64, l: f64, d: f64) -> f64 {
-    4.0 * w * dl * l / (std::f64::consts::PI * d * d)
 }
 
 /// Figures of one planned feature.
@@ -337,7 +324,7 @@ pub fn plan_two5d(
                 let l = (w[1] - w[0]).norm();
                 // Eq. 1 with the bead's width along the segment.
                 let width = 0.5 * (path.widths[i] + path.widths[i + 1]);
-                let e = filament_length(width, dl, l, bead.filament_diameter);
+                let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
                 out.push(PathPoint {

@@ -1,4 +1,4 @@
-//! Arithmetic on the `[f64; 3]` triples a [`crate::toolpath::PathPoint`] carries (positions,
+//! Arithmetic on the `[f64; 3]` triples a [`crate::PathPoint`] carries (positions,
 //! tool axes), for the stages that work on planned points: smoothing and the posts.
 
 /// A point or direction as a path point stores it.

@@ -1,0 +1,201 @@
+//! The 5-axis printer post: a delta (or Cartesian) printer whose nozzle stays pointing down
+//! (−Z) while the bed tilts (B) and rotates (C) so that each point's tool axis becomes machine
+//! +Z (Isa & Lazoglu 2019, §4, Eq. 9–12, the singularity cone with C-axis patching, and the
+//! kinematic error of their Fig. 16).
+//!
+//! # Conventions
+//!
+//! - The B axis is parallel to machine Y, at height `b_axis_z`, and crosses the C axis, which
+//!   stands vertical at `c_axis_xy` when B = 0. The table surface is `table_above_b_axis` above
+//!   the B axis along the C axis. The part is placed in the table frame (origin where the C axis
+//!   meets the table surface) with its XY bounding-box centre on the C axis and its lowest bead
+//!   bottom on the table surface: table = part + offset, the offset written in the header.
+//! - B and C are the paper's φ and θ: the tool axis in the part is
+//!   `n_b = R_z(C)·R_y(B)·(0,0,1) = (cos C sin B, sin C sin B, cos B)`. As ISO 841 has it for axes
+//!   that move the workpiece, positive B and C turn the tool relative to the part, so the bed
+//!   itself turns by −C about its axis and tilts by −B: a table-frame point `t` is at machine
+//!   `Q + R_y(−B)·R_z(−C)·(t + h·ẑ)` with `Q` the crossing of the axes and `h` =
+//!   `table_above_b_axis` ([`forward`] is the inverse of that).
+//! - The paper prints Eq. 9 with minus signs on the first two components; its Eqs. 10–11 and
+//!   its text (θ₁ = atan2(n_y, n_x) is the solution with φ > 0) hold for the signs above, which
+//!   are those of the standard rotation matrices, so we use those.
+//!
+//! # Moves
+//!
+//! Print moves are `G1 X Y Z B C E F`, travels `G0`. XYZ have 3 decimals, B and C 4 (degrees),
+//! E 5 (relative extrusion, `M83`), F 3 (mm/min: a move that hardly moves X, Y and Z while the
+//! bed turns gets a small F). C is unwrapped (it never jumps by 360°) unless
+//! the profile limits it, in which case every path is shifted by whole turns to fit the limits.
+//! Each planned print segment may be split into equal sub-moves (positions on the planned
+//! segment, B and C linear along it, as the controller would move them) so that no move turns C
+//! by more than `max_c_step_deg` and the kinematic error stays within its goal.
+//!
+//! Travels: after printing the filament is retracted and the nozzle lifted by `z_hop` along the
+//! current tool axis (machine +Z). A travel that turns B or C by more than `reorient_lift_deg`
+//! first goes up to the safe height (above the sphere the part sweeps about the B/C crossing,
+//! plus `z_hop` and `reorient_clearance`), turns the bed there, moves over the next point and
+//! comes down; a smaller one goes straight to the next point at hop height. Then the nozzle
+//! lowers by the hop (along the new tool axis) and un-retracts.
+//!
+//! # Feed
+//!
+//! The controller (Marlin with rotary axes) takes F as the speed along the machine XYZ path of a
+//! move, or along the rotary axes (degrees) when XYZ do not move. F is scaled by that distance
+//! over the move's length along the part, so the nozzle moves over the part at the planned
+//! deposition speed (`first_layer_speed` for beads on the table, `print_speed` otherwise).
+
+mod figures;
+pub(crate) mod geometry;
+mod kinematics;
+mod motion;
+mod text;
+
+use std::collections::BTreeMap;
+
+pub use figures::KinematicFigures;
+pub use geometry::Delta5Geometry;
+pub use kinematics::{forward, inverse, tilt_for, to_machine};
+pub use motion::MAX_SUBDIVISION;
+
+use crate::machine::MachineProfile;
+use crate::placement::table_offset;
+use crate::PostError;
+use figures::error_plot;
+use geometry::FIT_TOLERANCE;
+use kinematics::plan_poses;
+use motion::Writer;
+use text::header;
+use toolpath::vec3::norm;
+use toolpath::{fixed, MoveKind, ToolPath};
+
+/// A 5-axis program and what the post measured of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Delta5Program {
+    /// The G-code.
+    pub gcode: String,
+    /// Kinematic figures per feature id (features with print moves only).
+    pub figures: BTreeMap<usize, KinematicFigures>,
+    /// The kinematic error along the printed path as a stand-alone SVG: one colour per
+    /// feature, axes labelled, the goal as a dashed line.
+    pub error_plot_svg: String,
+    /// table = part + offset (mm), as in the header.
+    pub offset: [f64; 3],
+    /// Machine Z of the safe height used for large reorientations.
+    pub safe_z: f64,
+}
+
+/// A 5-axis program for the path on a `delta5` machine, with its kinematic figures and error
+/// plot.
+///
+/// Every point goes through the same bed kinematics in the path's (build) order: `two5d`
+/// features, whose axis is their reference plane's normal, print with the bed held at that
+/// plane's angles (B = 0, C unchanged for +Z). `source` (the STEP file's name) is written in
+/// the first comment line.
+///
+/// The kinematic error (paper Fig. 16) of a print move is measured as the controller would
+/// run it: X, Y, Z, B and C interpolated linearly in as many steps as the coarsest of the
+/// resolutions needs, each step transformed back to the part ([`forward`]) and its distance to
+/// the planned segment taken. A planned segment is split into equal sub-moves (on the planned
+/// segment, B and C linear along it) until no move turns C by more than `max_c_step_deg` and
+/// the error stays within `kinematic_error_goal` (or [`MAX_SUBDIVISION`] moves are reached;
+/// the figures then show it).
+///
+/// Errors: the profile is not a valid `delta5` profile; a point holds a NaN or infinite number;
+/// a tool axis is not a direction or needs a B outside the B limits (naming the feature); a
+/// path cannot fit the C limits; a move leaves the work envelope (X and Y within `bed_size`
+/// around the bed centre, Z within `z_min`..`bed_size` Z) or a point lies below the table
+/// surface (naming the feature and by how much).
+pub fn delta5(
+    path: &ToolPath,
+    m: &MachineProfile,
+    source: &str,
+) -> Result<Delta5Program, PostError> {
+    let g = m.delta5_table()?;
+    if g.z_min >= m.bed_size[2] {
+        return Err(PostError::ProfileValue {
+            name: m.name.clone(),
+            field: "delta5.z_min",
+            reason: format!(
+                "must be below the bed_size Z {}, got {}",
+                m.bed_size[2], g.z_min
+            ),
+        });
+    }
+    path.check_finite()?;
+    let offset = table_offset(path);
+    for q in &path.points {
+        let below = -(q.p[2] + offset[2]);
+        if below > FIT_TOLERANCE {
+            return Err(PostError::Delta5Envelope {
+                feature: q.feature,
+                name: m.name.clone(),
+                excess: format!(
+                    "a point lies {} mm below the table surface",
+                    fixed(below, 3)
+                ),
+            });
+        }
+    }
+    let poses = plan_poses(&path.points, g, &m.name)?;
+
+    // The sphere the part sweeps about the axes' crossing, for the safe height.
+    let swing = path
+        .points
+        .iter()
+        .map(|q| {
+            let t = [
+                q.p[0] + offset[0],
+                q.p[1] + offset[1],
+                q.p[2] + offset[2] + g.table_above_b_axis,
+            ];
+            norm(t) + q.width.max(0.0) / 2.0
+        })
+        .fold(0.0, f64::max);
+    let wanted_safe = g.b_axis_z + swing + m.z_hop + g.reorient_clearance;
+    let safe_z = wanted_safe.min(m.bed_size[2]);
+
+    let mut w = Writer::new(m, g, offset, safe_z);
+    let mut previous: Option<usize> = None;
+    for (i, q) in path.points.iter().enumerate() {
+        w.comments(q);
+        match q.kind {
+            MoveKind::Travel => w.travel(q, &poses[i])?,
+            MoveKind::Print => {
+                let from = match previous {
+                    Some(j) if w.at.is_some() => j,
+                    _ => {
+                        w.travel(q, &poses[i])?;
+                        i
+                    }
+                };
+                w.print(&path.points[from], &poses[from], q, &poses[i])?;
+            }
+        }
+        previous = Some(i);
+    }
+    w.footer()?;
+
+    let figures: BTreeMap<usize, KinematicFigures> = w
+        .figures
+        .iter()
+        .map(|(&f, a)| {
+            let mut k = a.figures.clone();
+            k.mean_mm = if k.samples > 0 {
+                a.sum / k.samples as f64
+            } else {
+                0.0
+            };
+            (f, k)
+        })
+        .collect();
+    let mut gcode = header(m, g, source, offset, safe_z, wanted_safe, &figures);
+    gcode.push_str(&w.out);
+    let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
+    Ok(Delta5Program {
+        gcode,
+        figures,
+        error_plot_svg,
+        offset,
+        safe_z,
+    })
+}

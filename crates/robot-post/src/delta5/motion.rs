@@ -1,0 +1,412 @@
+//! The moves of a 5-axis program: travels (retract, hop, reorientation at the safe height),
+//! print moves split into sub-moves for the C step and the kinematic error goal, the work
+//! envelope check, and the kinematic error measured as the controller runs each move.
+
+use std::collections::BTreeMap;
+
+use super::figures::KinematicFigures;
+use super::geometry::{Delta5Geometry, FIT_TOLERANCE};
+use super::kinematics::{
+    angle_deg, distance_to_segment, forward, lerp, machine_to_bed, to_machine, Pose,
+};
+use super::text::e_text;
+use crate::gcode::{push_line, LayerMarks};
+use crate::machine::MachineProfile;
+use crate::PostError;
+use toolpath::vec3::{norm, sub, unit};
+use toolpath::{fixed, PathPoint};
+
+/// Most sub-moves one planned segment is split into.
+pub const MAX_SUBDIVISION: usize = 1024;
+
+/// Machine joints `[X, Y, Z, B, C]` rounded as written: XYZ to 0.001 mm, B and C to 0.0001°.
+type Joints = [f64; 5];
+
+fn rounded(xyz: [f64; 3], b: f64, c: f64) -> Joints {
+    let r3 = |v: f64| (v * 1e3).round() / 1e3;
+    let r4 = |v: f64| (v * 1e4).round() / 1e4;
+    [r3(xyz[0]), r3(xyz[1]), r3(xyz[2]), r4(b), r4(c)]
+}
+
+/// Running kinematic figures of one feature.
+#[derive(Default)]
+pub(super) struct Accumulator {
+    pub(super) figures: KinematicFigures,
+    pub(super) sum: f64,
+}
+
+/// The program being written and the machine state it leaves.
+pub(super) struct Writer<'a> {
+    pub(super) out: String,
+    m: &'a MachineProfile,
+    g: &'a Delta5Geometry,
+    offset: [f64; 3],
+    /// Joints the last move ended at, the hop excluded.
+    pub(super) at: Option<Joints>,
+    retracted: bool,
+    printing: bool,
+    hopped: bool,
+    marks: LayerMarks,
+    /// The feature being written, for envelope errors.
+    current: usize,
+    safe_z: f64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    travel_f: String,
+    retraction_f: String,
+    /// Filament written so far on print moves, in 0.00001 mm.
+    e_written: i64,
+    /// Filament planned so far on print moves (mm).
+    e_planned: f64,
+    pub(super) figures: BTreeMap<usize, Accumulator>,
+    /// (feature, length along the printed path, largest error of the move) per print move.
+    pub(super) plot: Vec<(usize, f64, f64)>,
+    printed_length: f64,
+}
+
+impl<'a> Writer<'a> {
+    pub(super) fn new(
+        m: &'a MachineProfile,
+        g: &'a Delta5Geometry,
+        offset: [f64; 3],
+        safe_z: f64,
+    ) -> Writer<'a> {
+        let (x0, y0) = if m.bed_origin_centre {
+            (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
+        } else {
+            (0.0, 0.0)
+        };
+        Writer {
+            out: String::new(),
+            m,
+            g,
+            offset,
+            at: None,
+            retracted: false,
+            printing: false,
+            hopped: false,
+            marks: LayerMarks::default(),
+            current: 0,
+            safe_z,
+            lo: [x0, y0, g.z_min],
+            hi: [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]],
+            travel_f: fixed(m.travel_speed * 60.0, 0),
+            retraction_f: fixed(m.retraction_speed * 60.0, 0),
+            e_written: 0,
+            e_planned: 0.0,
+            figures: BTreeMap::new(),
+            plot: Vec::new(),
+            printed_length: 0.0,
+        }
+    }
+
+    fn line(&mut self, s: &str) {
+        push_line(&mut self.out, s);
+    }
+
+    /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
+    pub(super) fn comments(&mut self, q: &PathPoint) {
+        self.current = q.feature;
+        self.marks.write(q, &mut self.out);
+    }
+
+    /// Refuses a nozzle position outside the work envelope.
+    fn check(&self, xyz: [f64; 3]) -> Result<(), PostError> {
+        let mut excess = Vec::new();
+        for (k, letter) in ["X", "Y", "Z"].iter().enumerate() {
+            if xyz[k] < self.lo[k] - FIT_TOLERANCE {
+                excess.push(format!(
+                    "{letter} {} is {} mm below {}",
+                    fixed(xyz[k], 3),
+                    fixed(self.lo[k] - xyz[k], 3),
+                    fixed(self.lo[k], 3)
+                ));
+            } else if xyz[k] > self.hi[k] + FIT_TOLERANCE || xyz[k].is_nan() {
+                excess.push(format!(
+                    "{letter} {} is {} mm above {}",
+                    fixed(xyz[k], 3),
+                    fixed(xyz[k] - self.hi[k], 3),
+                    fixed(self.hi[k], 3)
+                ));
+            }
+        }
+        if excess.is_empty() {
+            Ok(())
+        } else {
+            Err(PostError::Delta5Envelope {
+                feature: self.current,
+                name: self.m.name.clone(),
+                excess: excess.join(", "),
+            })
+        }
+    }
+
+    fn joints(&self, p: [f64; 3], b: f64, c: f64) -> Joints {
+        rounded(to_machine(p, b, c, self.g, self.offset), b, c)
+    }
+
+    fn hop_z(&self, z: f64) -> f64 {
+        (z + self.m.z_hop).min(self.hi[2]).max(z)
+    }
+
+    fn retract(&mut self) {
+        if self.m.retraction_length > 0.0 && !self.retracted {
+            let line = format!(
+                "G1 E-{} F{}",
+                fixed(self.m.retraction_length, 5),
+                self.retraction_f
+            );
+            self.line(&line);
+            self.retracted = true;
+        }
+    }
+
+    fn g0_z(&mut self, at: Joints, z: f64) -> Result<(), PostError> {
+        self.check([at[0], at[1], z])?;
+        let line = format!("G0 Z{} F{}", fixed(z, 3), self.travel_f);
+        self.line(&line);
+        Ok(())
+    }
+
+    /// To the point `q` (bed at `pose`) at hop height; see the module documentation.
+    pub(super) fn travel(&mut self, q: &PathPoint, pose: &Pose) -> Result<(), PostError> {
+        if self.printing {
+            self.retract();
+        }
+        self.printing = false;
+        let target = self.joints(q.p, pose.b, pose.c);
+        self.check([target[0], target[1], target[2]])?;
+        let hop = self.hop_z(target[2]);
+        let reorient = match self.at {
+            Some(at) => {
+                (target[3] - at[3]).abs() > self.g.reorient_lift_deg
+                    || (target[4] - at[4]).abs() > self.g.reorient_lift_deg
+            }
+            None => true,
+        };
+        if let Some(at) = self.at {
+            if !self.hopped {
+                if self.m.z_hop > 0.0 {
+                    self.g0_z(at, self.hop_z(at[2]))?;
+                }
+                self.hopped = true;
+            }
+        }
+        if reorient {
+            let (x, y) = self.at.map_or((target[0], target[1]), |at| (at[0], at[1]));
+            self.check([x, y, self.safe_z])?;
+            let lines = [
+                format!("G0 Z{} F{}", fixed(self.safe_z, 3), self.travel_f),
+                format!(
+                    "G0 B{} C{} F{} ; reorient at the safe height",
+                    fixed(target[3], 4),
+                    fixed(target[4], 4),
+                    self.travel_f
+                ),
+                format!(
+                    "G0 X{} Y{} F{}",
+                    fixed(target[0], 3),
+                    fixed(target[1], 3),
+                    self.travel_f
+                ),
+                format!("G0 Z{} F{}", fixed(hop, 3), self.travel_f),
+            ];
+            self.check([target[0], target[1], self.safe_z])?;
+            for l in &lines {
+                self.line(l);
+            }
+        } else {
+            self.check([target[0], target[1], hop])?;
+            let line = format!(
+                "G0 X{} Y{} Z{} B{} C{} F{}",
+                fixed(target[0], 3),
+                fixed(target[1], 3),
+                fixed(hop, 3),
+                fixed(target[3], 4),
+                fixed(target[4], 4),
+                self.travel_f
+            );
+            self.line(&line);
+        }
+        self.hopped = true;
+        self.at = Some(target);
+        Ok(())
+    }
+
+    /// The planned segment from `a` (bed at `pa`, where the machine is) to `q` (bed at `pq`),
+    /// as one or more `G1` moves.
+    pub(super) fn print(
+        &mut self,
+        a: &PathPoint,
+        pa: &Pose,
+        q: &PathPoint,
+        pq: &Pose,
+    ) -> Result<(), PostError> {
+        let Some(start) = self.at else {
+            return Ok(());
+        };
+        if self.hopped {
+            self.g0_z(start, start[2])?;
+            self.hopped = false;
+        }
+        if self.retracted {
+            let line = format!(
+                "G1 E{} F{}",
+                fixed(self.m.retraction_length, 5),
+                self.retraction_f
+            );
+            self.line(&line);
+            self.retracted = false;
+        }
+        let g = self.g;
+        let dc = (pq.c - pa.c).abs();
+        let mut n = ((dc / g.max_c_step_deg - 1e-9).ceil().max(1.0) as usize).min(MAX_SUBDIVISION);
+        let length = norm(sub(q.p, a.p));
+        let (moves, errors) = loop {
+            let moves: Vec<Joints> = (1..=n)
+                .map(|k| {
+                    if k == n {
+                        self.joints(q.p, pq.b, pq.c)
+                    } else {
+                        let f = k as f64 / n as f64;
+                        let b = pa.b + (pq.b - pa.b) * f;
+                        let c = pa.c + (pq.c - pa.c) * f;
+                        self.joints(lerp(a.p, q.p, f), b, c)
+                    }
+                })
+                .collect();
+            let mut from = start;
+            let mut errors = Vec::with_capacity(n);
+            for &to in &moves {
+                errors.push(self.move_error(from, to, a.p, q.p));
+                from = to;
+            }
+            let worst = errors.iter().map(|e| e.0).fold(0.0, f64::max);
+            if worst <= g.kinematic_error_goal || n >= MAX_SUBDIVISION || length / (n as f64) < 1e-3
+            {
+                break (moves, errors);
+            }
+            // The error of a turning move shrinks with the square of its length.
+            let grow = (n as f64 * (worst / g.kinematic_error_goal).sqrt() * 1.1).ceil() as usize;
+            n = grow.max(n + 1).min(MAX_SUBDIVISION);
+        };
+
+        // Planned deposition speed along the part.
+        let bottom = match unit(q.axis) {
+            Some(ax) => q.p[2] - q.thickness.max(0.0) * ax[2],
+            None => q.p[2],
+        };
+        let on_table = bottom + self.offset[2] <= 0.01;
+        let v = if on_table {
+            self.m.first_layer_speed
+        } else {
+            self.m.print_speed
+        };
+        let part_step = length / n as f64;
+        let mut from = start;
+        let acc = self.figures.entry(q.feature).or_default();
+        acc.figures.print_moves += n;
+        if n > 1 {
+            acc.figures.subdivided_segments += 1;
+        }
+        if pq.patched {
+            acc.figures.singular_points += 1;
+        }
+        let realised = machine_to_bed([0.0, 0.0, 1.0], pq.b.to_radians(), pq.c.to_radians());
+        if let Some(planned) = unit(q.axis) {
+            let dev = angle_deg(planned, realised);
+            acc.figures.max_axis_deviation_deg = acc.figures.max_axis_deviation_deg.max(dev);
+        }
+        let mut lines = Vec::with_capacity(n);
+        for (&to, &(worst, sum, count)) in moves.iter().zip(&errors) {
+            let xyz = norm(sub([to[0], to[1], to[2]], [from[0], from[1], from[2]]));
+            let rotary = (to[3] - from[3]).hypot(to[4] - from[4]);
+            let distance = if xyz > 1e-9 { xyz } else { rotary };
+            let f = if part_step > 1e-9 && distance > 0.0 {
+                60.0 * v * distance / part_step
+            } else {
+                60.0 * v
+            };
+            let f = f.max(0.001);
+            self.e_planned += q.e / n as f64;
+            // Cumulative rounding: the E written adds up to the planned total.
+            let target = (self.e_planned * 1e5).round() as i64;
+            let de = target - self.e_written;
+            self.e_written = target;
+            acc.figures.max_c_step_deg = acc.figures.max_c_step_deg.max((to[4] - from[4]).abs());
+            acc.figures.max_mm = acc.figures.max_mm.max(worst);
+            acc.sum += sum;
+            acc.figures.samples += count;
+            self.printed_length += part_step;
+            self.plot.push((q.feature, self.printed_length, worst));
+            lines.push(format!(
+                "G1 X{} Y{} Z{} B{} C{} E{} F{}",
+                fixed(to[0], 3),
+                fixed(to[1], 3),
+                fixed(to[2], 3),
+                fixed(to[3], 4),
+                fixed(to[4], 4),
+                e_text(de),
+                fixed(f, 3)
+            ));
+            from = to;
+        }
+        for (to, l) in moves.iter().zip(&lines) {
+            self.check([to[0], to[1], to[2]])?;
+            self.line(l);
+        }
+        self.printing = true;
+        self.at = moves.last().copied();
+        Ok(())
+    }
+
+    /// Kinematic error of the move `from` → `to` against the planned segment `p0`–`p1`: the
+    /// controller's linear interpolation of the joints in steps of the resolutions, each step
+    /// transformed back to the part (Isa & Lazoglu 2019, Fig. 16, after Makhanov). Returns the
+    /// largest distance, the sum of the distances and the number of steps.
+    fn move_error(
+        &self,
+        from: Joints,
+        to: Joints,
+        p0: [f64; 3],
+        p1: [f64; 3],
+    ) -> (f64, f64, usize) {
+        let g = self.g;
+        let steps = [
+            (to[0] - from[0]).abs() / g.resolution_xyz,
+            (to[1] - from[1]).abs() / g.resolution_xyz,
+            (to[2] - from[2]).abs() / g.resolution_xyz,
+            (to[3] - from[3]).abs() / g.resolution_b_deg,
+            (to[4] - from[4]).abs() / g.resolution_c_deg,
+        ]
+        .into_iter()
+        .fold(1.0, f64::max)
+        .ceil()
+        .min(1e6) as usize;
+        let (mut worst, mut sum) = (0.0f64, 0.0);
+        for k in 1..=steps {
+            let f = k as f64 / steps as f64;
+            let j: Joints = std::array::from_fn(|i| from[i] + (to[i] - from[i]) * f);
+            let (p, _) = forward(j, g, self.offset);
+            let d = distance_to_segment(p, p0, p1);
+            worst = worst.max(d);
+            sum += d;
+        }
+        (worst, sum, steps)
+    }
+
+    pub(super) fn footer(&mut self) -> Result<(), PostError> {
+        self.line("; end");
+        self.retract();
+        self.line("M104 S0 ; nozzle off");
+        self.line("M140 S0 ; bed off");
+        if let Some(at) = self.at {
+            self.g0_z(at, self.safe_z.max(at[2]).min(self.hi[2]))?;
+            let line = format!("G0 B0.0000 F{} ; level the bed", self.travel_f);
+            self.line(&line);
+        }
+        self.line("G28 ; home");
+        self.line("M84 ; motors off");
+        Ok(())
+    }
+}

@@ -1,0 +1,372 @@
+//! The KRL text of a program: the `.src` and `.dat` files (split into parts when long), KRL
+//! names and frame aggregates.
+
+use super::cell::{ExtruderSwitch, KukaCell};
+use super::checks::Checked;
+use super::motion::Step;
+use crate::gcode::comment_text;
+use crate::machine::MachineProfile;
+use toolpath::vec3::{norm, sub};
+use toolpath::{fixed, MoveKind, ToolPath};
+
+/// Longest KRL name (identifiers and module names).
+pub const KRL_NAME_MAX: usize = 24;
+
+/// Name of the home position declared in the main program's `.dat`.
+pub const HOME_NAME: &str = "XHOME_PRINT";
+
+/// `s` as a KRL identifier of at most `max` characters: ASCII letters, digits and `_`
+/// (others become `_`), starting with a letter, lower case, not a KRL keyword; `features`
+/// when nothing is left.
+pub fn krl_name(s: &str, max: usize) -> String {
+    let mut name: String = s
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if name.trim_matches('_').is_empty() {
+        name = "features".into();
+    }
+    if !name.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        name.insert_str(0, "p_");
+    }
+    const KEYWORDS: &[&str] = &[
+        "and",
+        "anin",
+        "anout",
+        "axis",
+        "b_and",
+        "b_exor",
+        "b_not",
+        "b_or",
+        "bool",
+        "brake",
+        "c_dis",
+        "c_ori",
+        "c_ptp",
+        "c_vel",
+        "case",
+        "char",
+        "circ",
+        "circ_rel",
+        "const",
+        "continue",
+        "decl",
+        "def",
+        "default",
+        "defdat",
+        "deffct",
+        "delay",
+        "distance",
+        "do",
+        "e6axis",
+        "e6pos",
+        "else",
+        "end",
+        "enddat",
+        "endfct",
+        "endfor",
+        "endif",
+        "endloop",
+        "endswitch",
+        "endwhile",
+        "enum",
+        "exit",
+        "exor",
+        "ext",
+        "extfct",
+        "false",
+        "for",
+        "frame",
+        "global",
+        "goto",
+        "halt",
+        "if",
+        "import",
+        "int",
+        "interrupt",
+        "is",
+        "lin",
+        "lin_rel",
+        "loop",
+        "main",
+        "not",
+        "or",
+        "pos",
+        "prio",
+        "ptp",
+        "ptp_rel",
+        "public",
+        "pulse",
+        "real",
+        "repeat",
+        "resume",
+        "return",
+        "sec",
+        "signal",
+        "struc",
+        "switch",
+        "then",
+        "to",
+        "trigger",
+        "true",
+        "until",
+        "wait",
+        "when",
+        "while",
+        "xhome_print",
+    ];
+    if KEYWORDS.contains(&name.as_str()) {
+        name.push_str("_prg");
+    }
+    name.truncate(max.max(1));
+    name
+}
+
+/// A KRL frame aggregate `{X .., Y .., Z .., A .., B .., C ..}`: mm with 3 decimals, degrees
+/// with 4.
+pub fn frame_text(f: &[f64; 6]) -> String {
+    format!(
+        "{{X {}, Y {}, Z {}, A {}, B {}, C {}}}",
+        fixed(f[0], 3),
+        fixed(f[1], 3),
+        fixed(f[2], 3),
+        fixed(f[3], 4),
+        fixed(f[4], 4),
+        fixed(f[5], 4)
+    )
+}
+
+/// The `.src` and `.dat` files.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn write_files(
+    path: &ToolPath,
+    m: &MachineProfile,
+    cell: &KukaCell,
+    steps: &[Step],
+    checked: &Checked,
+    offset: [f64; 3],
+    program_name: &str,
+    source: &str,
+) -> Vec<(String, String)> {
+    let out = cell.extruder_output;
+    // Lines grouped by motion: each group ends with one motion; the lines before it (comments,
+    // speeds, extruder switching) go with it, so a TRIGGER stays with its motion.
+    let mut groups: Vec<Vec<String>> = Vec::new();
+    let mut pending: Vec<String> = Vec::new();
+    let mut vel_before: Vec<Option<f64>> = Vec::new();
+    let mut vel = None;
+    let mut k = 0;
+    for step in steps {
+        match step {
+            Step::Comment(c) => pending.push(format!("; {}", comment_text(c))),
+            Step::Vel(v) => {
+                pending.push(format!("$VEL.CP = {}", fixed(*v, 4)));
+            }
+            Step::Extruder(on) => {
+                let state = if *on { "TRUE" } else { "FALSE" };
+                pending.push(match cell.extruder_switch {
+                    ExtruderSwitch::Out => format!("$OUT[{out}] = {state}"),
+                    ExtruderSwitch::Trigger => {
+                        format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out}]={state}")
+                    }
+                });
+            }
+            Step::Move { ptp, .. } => {
+                let f = &checked.frames[k];
+                let mut line = if *ptp {
+                    format!("PTP {}", frame_text(f))
+                } else {
+                    format!("LIN {} C_DIS", frame_text(f))
+                };
+                if let Some(note) = checked.notes[k] {
+                    line.push_str(" ; ");
+                    line.push_str(note);
+                }
+                k += 1;
+                pending.push(line);
+                vel_before.push(vel);
+                groups.push(std::mem::take(&mut pending));
+            }
+        }
+        if let Step::Vel(v) = step {
+            vel = Some(*v);
+        }
+    }
+    let trailing = pending;
+
+    let moves = groups.len();
+    let per = cell.max_moves_per_file.max(1);
+    let parts = if moves > per { moves.div_ceil(per) } else { 0 };
+    let digits = parts.to_string().len().max(3);
+    let name = if parts > 0 {
+        krl_name(program_name, KRL_NAME_MAX - 2 - digits)
+    } else {
+        krl_name(program_name, KRL_NAME_MAX)
+    };
+    let part_name = |i: usize| format!("{name}_p{:0digits$}", i + 1);
+
+    let src = comment_text(source);
+    let print_len: f64 = path
+        .points
+        .windows(2)
+        .filter(|w| w[1].kind == MoveKind::Print)
+        .map(|w| norm(sub(w[1].p, w[0].p)))
+        .sum();
+    let filament: f64 = path
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .map(|q| q.e)
+        .sum();
+    let feed = if print_len > 0.0 {
+        filament / print_len
+    } else {
+        0.0
+    };
+    let switch = match cell.extruder_switch {
+        ExtruderSwitch::Out => format!("$OUT[{out}] between motions (exact stop)"),
+        ExtruderSwitch::Trigger => format!("$OUT[{out}] by TRIGGER at the motion's start"),
+    };
+
+    let mut main: Vec<String> = vec![
+        "&ACCESS RVP".into(),
+        "&REL 1".into(),
+        format!("DEF {name}( )"),
+        format!("; generated by features from {src}"),
+        format!("; machine: {} (kuka)", comment_text(&m.name)),
+        format!(
+            "; part offset X{} Y{} Z{} (base = part + offset)",
+            fixed(offset[0], 3),
+            fixed(offset[1], 3),
+            fixed(offset[2], 3)
+        ),
+        "; tool: Z along the nozzle into the deposit (the tool path axis is -Z of $TOOL)".into(),
+        format!(
+            "; extruder: {switch}; set on its controller: nozzle {} C, bed {} C, filament {} mm fed {} mm per mm of bead",
+            fixed(m.nozzle_temperature, 0),
+            fixed(m.bed_temperature, 0),
+            fixed(m.filament_diameter, 2),
+            fixed(feed, 5)
+        ),
+        format!(
+            "; {moves} motions{}",
+            if parts > 0 {
+                format!(" in {parts} parts of at most {per}")
+            } else {
+                String::new()
+            }
+        ),
+        ";FOLD INI".into(),
+        "  ;FOLD BASISTECH INI".into(),
+        "    GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )".into(),
+        "    INTERRUPT ON 3".into(),
+        "    BAS (#INITMOV,0 )".into(),
+        "  ;ENDFOLD (BASISTECH INI)".into(),
+        ";ENDFOLD (INI)".into(),
+        ";FOLD FRAMES AND SPEEDS".into(),
+        format!("$BASE = {}", frame_text(&cell.base.to_array())),
+        format!("$TOOL = {}", frame_text(&cell.tool.to_array())),
+        "$ADVANCE = 3".into(),
+        format!("$APO.CDIS = {}", fixed(cell.apo_cdis, 3)),
+        ";ENDFOLD (FRAMES AND SPEEDS)".into(),
+        format!("$OUT[{out}] = FALSE"),
+        format!("PTP {HOME_NAME}"),
+    ];
+    let mut files = Vec::new();
+    let mut part_files = Vec::new();
+    if parts == 0 {
+        for g in &groups {
+            main.extend(g.iter().cloned());
+        }
+        main.extend(trailing.iter().cloned());
+    } else {
+        for (i, chunk) in groups.chunks(per).enumerate() {
+            let pname = part_name(i);
+            main.push(format!("{pname}( )"));
+            let mut lines: Vec<String> = vec![
+                "&ACCESS RVP".into(),
+                "&REL 1".into(),
+                format!("DEF {pname}( )"),
+                format!(
+                    "; part {} of {parts} of {name}, generated by features from {src}",
+                    i + 1
+                ),
+            ];
+            // The speed in force, unless the part's first motion sets its own.
+            let sets_vel = chunk
+                .first()
+                .is_some_and(|g| g.iter().any(|l| l.starts_with("$VEL.CP")));
+            if let (Some(Some(v)), false) = (vel_before.get(i * per), sets_vel) {
+                lines.push(format!("$VEL.CP = {}", fixed(*v, 4)));
+            }
+            for g in chunk {
+                lines.extend(g.iter().cloned());
+            }
+            if i + 1 == parts {
+                lines.extend(trailing.iter().cloned());
+            }
+            lines.push("END".into());
+            let dat = vec![
+                "&ACCESS RVP".into(),
+                "&REL 1".into(),
+                format!("DEFDAT {pname}"),
+                format!("; part {} of {parts} of {name}", i + 1),
+                "ENDDAT".into(),
+            ];
+            part_files.push((format!("{pname}.src"), join(&lines)));
+            part_files.push((format!("{pname}.dat"), join(&dat)));
+        }
+    }
+    main.push(format!("$OUT[{out}] = FALSE"));
+    main.push(format!("PTP {HOME_NAME}"));
+    main.push("END".into());
+    let h = cell.home;
+    let dat = vec![
+        "&ACCESS RVP".into(),
+        "&REL 1".into(),
+        format!("DEFDAT {name}"),
+        format!("; generated by features from {src}"),
+        format!(
+            "DECL AXIS {HOME_NAME} = {{A1 {}, A2 {}, A3 {}, A4 {}, A5 {}, A6 {}}}",
+            fixed(h[0], 3),
+            fixed(h[1], 3),
+            fixed(h[2], 3),
+            fixed(h[3], 3),
+            fixed(h[4], 3),
+            fixed(h[5], 3)
+        ),
+        "ENDDAT".into(),
+    ];
+    files.push((format!("{name}.src"), join(&main)));
+    files.push((format!("{name}.dat"), join(&dat)));
+    files.extend(part_files);
+    files
+}
+
+/// Lines joined with `\n`, ending with one.
+pub(super) fn join(lines: &[String]) -> String {
+    let mut s = lines.join("\n");
+    s.push('\n');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn krl_names() {
+        assert_eq!(krl_name("impeller", 24), "impeller");
+        assert_eq!(krl_name("My Part-2.step", 24), "my_part_2_step");
+        assert_eq!(krl_name("3d", 24), "p_3d");
+        assert_eq!(krl_name("", 24), "features");
+        assert_eq!(krl_name("LIN", 24), "lin_prg");
+        assert_eq!(krl_name("a_very_long_name_for_a_program", 19).len(), 19);
+    }
+}

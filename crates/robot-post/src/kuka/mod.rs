@@ -1,0 +1,147 @@
+//! The KUKA robot post: KRL `.src`/`.dat` programs for a 6-axis arm carrying the extruder over
+//! a fixed work table.
+//!
+//! Conventions, used by [`kuka`] and read back by [`crate::krl`]:
+//!
+//! - **Frames.** `$BASE` is the work table's frame in the robot's base frame (`$WORLD`, with a
+//!   null `$ROBROOT`): the profile's `[kuka.base]`, Z up from the table top. The part is placed
+//!   on the table by the rule of [`crate::placement::bed_offset`] (XY bounding-box centre on the
+//!   table centre, lowest bead bottom on the table top); LIN targets are tool poses in `$BASE`,
+//!   part point + offset, and the offset is written in a header comment
+//!   `; part offset X.. Y.. Z.. (base = part + offset)`. `$TOOL` is the nozzle tip in the
+//!   flange frame (`[kuka.tool]`), with its Z axis along the nozzle, out of the extruder into
+//!   the deposit: the tool path's axis (deposit → nozzle) is the tool's −Z.
+//! - **Orientation.** KUKA's A, B, C: R = R_z(A)·R_y(B)·R_x(C) (degrees), B within ±90°
+//!   ([`abc_from_matrix`]). A and C are unwrapped: each is the value nearest the previous LIN's
+//!   (they may leave ±180°), and at gimbal lock (B = ±90°, the tool's X axis along `$BASE` Z)
+//!   A keeps its previous value and C takes the rest.
+//! - **Rotation about the tool axis.** The axis fixes two angles. At the start of every path
+//!   (a travel point, or the first point) the tool's X axis is the horizontal direction from
+//!   the nozzle back to the robot's A1 axis, projected onto the plane normal to the tool axis
+//!   (so A6 starts near its middle); along the path the frame is carried forward by the
+//!   minimal rotation that turns one tool axis into the next (parallel transport), so the
+//!   tool never spins about its own axis while printing.
+//! - **Travel.** A travel point is visited where a path starts (a print point follows it); the
+//!   planner's other travel points (lifts, waypoints) are superseded by this safe travel: from
+//!   the end of a path, extruder off, retreat `travel_clearance` along the tool axis, rise
+//!   straight up to the travel height (the highest point visited so far within about
+//!   [`HEIGHT_CELL`] of the route, plus the clearance; no rise over planar layers), move
+//!   across at that height while the orientation turns to the next path's (slerp, at most
+//!   [`TRAVEL_ROTATION_STEP_DEG`] per LIN), go down to the approach point (`travel_clearance`
+//!   out along the next tool axis) and approach along the axis to the path's first point. The
+//!   first approach is a `PTP` from home; the program ends with the same retreat and a rise to
+//!   the clearance over the part's top, then `PTP` home. Rising straight up assumes no
+//!   material above the retreat point (no printing under an overhang).
+//! - **Extruder.** One digital output, on for the LINs that print. With `extruder_switch =
+//!   "trigger"` a `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[n]=...` before the first print LIN
+//!   (on) and before the retreat (off) switches it where those motions start, without
+//!   stopping the advance run; with `"out"` a plain `$OUT[n]=...` between the motions stops
+//!   the robot there (exact stop) and switches. Temperatures and the filament feed are the
+//!   extruder controller's; the header states them.
+//! - **Files.** `<name>.src` holds header comments (source, machine, part offset, tool and
+//!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE`, `$TOOL`,
+//!   `$ADVANCE`, `$APO.CDIS`, extruder off and `PTP` home (`DECL AXIS XHOME_PRINT` in
+//!   `<name>.dat`), the motions (`$VEL.CP` in m/s where the speed changes, `LIN {X, Y, Z, A,
+//!   B, C} C_DIS` per pose), then extruder off and `PTP` home. A program of more than
+//!   `max_moves_per_file` motions keeps only the calls in the main program: the motions go to
+//!   parts `<name>_p001.src` ... (each with its `.dat`), called in order.
+//! - **Reach.** Every pose is checked against the arm model of `[kuka.arm]` (OPW kinematics,
+//!   Brandstötter et al. 2014): the flange pose `$BASE · target · $TOOL⁻¹` must have an
+//!   inverse-kinematics solution within the joint limits; the solution followed is the one
+//!   nearest the previous pose's, in the same configuration when there is one. Unreachable
+//!   poses and poses within `wrist_singularity_deg` of a stretched wrist (|A5| small) are
+//!   reported ([`KukaFigures`], warnings, and a comment on the LIN), not refused.
+
+pub(crate) mod cell;
+mod checks;
+mod krl_text;
+mod motion;
+mod opw;
+mod rotation;
+
+use std::collections::BTreeMap;
+
+pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KukaCell};
+pub use checks::KukaFigures;
+pub use krl_text::{frame_text, krl_name, HOME_NAME, KRL_NAME_MAX};
+pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
+pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
+
+use crate::machine::MachineProfile;
+use crate::PostError;
+use checks::check;
+use krl_text::write_files;
+use motion::{placement, plan_motion};
+use toolpath::vec3::{norm, scale};
+use toolpath::ToolPath;
+
+/// Largest deviation of a tool axis's length from 1 accepted (the axis is then normalised).
+pub const AXIS_LENGTH_TOLERANCE: f64 = 1e-3;
+
+/// A KRL program: the files, what the reach check found per feature, and warnings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KrlProgram {
+    /// `(file name, text)`: the main `<name>.src` and `<name>.dat` first, then the parts
+    /// `<name>_p001.src`, `<name>_p001.dat`, ... when the program is split.
+    pub files: Vec<(String, String)>,
+    /// Per feature id.
+    pub figures: BTreeMap<usize, KukaFigures>,
+    /// One line each: the part overhanging the table, unreachable points, wrist
+    /// singularities, configuration changes, gimbal crossings.
+    pub warnings: Vec<String>,
+}
+
+/// A KRL program for the path, with every pose checked against the arm model.
+///
+/// `program_name` becomes the module name, made a KRL identifier by [`krl_name`]; `source`
+/// (the STEP file's name) is written in the header. See the module documentation for the
+/// frames, orientation, travel and extruder conventions.
+///
+/// Errors: the profile is not a `kuka` profile or is invalid, a point holds a NaN or infinite
+/// number, or a tool axis is not a unit vector (within [`AXIS_LENGTH_TOLERANCE`]). Points the
+/// arm cannot reach, and poses near the wrist singularity, are reported in
+/// [`KrlProgram::figures`] and [`KrlProgram::warnings`] and marked on their LIN; so is a part
+/// larger than the table (`bed_size`).
+pub fn kuka(
+    path: &ToolPath,
+    m: &MachineProfile,
+    program_name: &str,
+    source: &str,
+) -> Result<KrlProgram, PostError> {
+    let cell = m.kuka_table()?;
+    path.check_finite()?;
+    let mut axes = Vec::with_capacity(path.points.len());
+    for (index, q) in path.points.iter().enumerate() {
+        let n = norm(q.axis);
+        if n.is_nan() || (n - 1.0).abs() > AXIS_LENGTH_TOLERANCE {
+            return Err(PostError::KukaAxisNotUnit {
+                index,
+                feature: q.feature,
+                i: q.axis[0],
+                j: q.axis[1],
+                k: q.axis[2],
+            });
+        }
+        axes.push(scale(q.axis, 1.0 / n));
+    }
+    let mut warnings = Vec::new();
+    let offset = placement(path, m, &mut warnings)?;
+    let base = cell.base.pose();
+    let steps = plan_motion(path, &axes, offset, m, cell, &base);
+    let checked = check(path, &steps, cell, &base, &mut warnings);
+    let files = write_files(
+        path,
+        m,
+        cell,
+        &steps,
+        &checked,
+        offset,
+        program_name,
+        source,
+    );
+    Ok(KrlProgram {
+        files,
+        figures: checked.figures,
+        warnings,
+    })
+}

@@ -1,0 +1,365 @@
+//! The motions of a KRL program: the part's placement on the table, the travels (retreat,
+//! rise, move across, approach) and print moves, speeds and extruder switching, as steps.
+
+use super::cell::KukaCell;
+use super::rotation::{
+    apply, col, exp_rot, frame_from_zx, log_rot, mul, rotation_angle_deg, transport, transpose,
+    Mat3, Pose, IDENTITY,
+};
+use crate::machine::MachineProfile;
+use crate::placement::bed_offset;
+use crate::PostError;
+use toolpath::vec3::{add, cross, norm, scale, sub, V3};
+use toolpath::{MoveKind, ToolPath};
+
+/// Largest orientation change of one LIN of a travel (degrees): a travel that turns the tool
+/// further is split into several LINs.
+pub const TRAVEL_ROTATION_STEP_DEG: f64 = 5.0;
+
+/// Cell size (mm) of the height map that sets travel heights.
+pub const HEIGHT_CELL: f64 = 2.0;
+
+/// One step of the program, in order.
+#[derive(Debug, Clone)]
+pub(super) enum Step {
+    Comment(String),
+    /// `$VEL.CP` (m/s).
+    Vel(f64),
+    Extruder(bool),
+    /// A motion to a tool pose in `$BASE`, for path point `point`.
+    Move {
+        ptp: bool,
+        pose: Pose,
+        point: usize,
+    },
+}
+
+/// The part offset (part + offset = `$BASE` coordinates): [`bed_offset`]'s placement; a part
+/// larger than the table is placed the same way, with a warning.
+pub(super) fn placement(
+    path: &ToolPath,
+    m: &MachineProfile,
+    warnings: &mut Vec<String>,
+) -> Result<[f64; 3], PostError> {
+    match bed_offset(path, m) {
+        Ok(o) => Ok(o),
+        Err(e @ PostError::DoesNotFit { .. }) => {
+            warnings.push(format!("{e} (written anyway: the arm's reach decides)"));
+            let mut open = m.clone();
+            open.bed_origin_centre = true;
+            open.bed_size = [f64::INFINITY; 3];
+            let o = bed_offset(path, &open)?;
+            let shift = if m.bed_origin_centre {
+                [0.0, 0.0]
+            } else {
+                [m.bed_size[0] / 2.0, m.bed_size[1] / 2.0]
+            };
+            Ok([o[0] + shift[0], o[1] + shift[1], o[2]])
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// The motions of the program: travels, print moves, speeds and extruder switching.
+pub(super) fn plan_motion(
+    path: &ToolPath,
+    axes: &[V3],
+    offset: [f64; 3],
+    m: &MachineProfile,
+    cell: &KukaCell,
+    base: &Pose,
+) -> Vec<Step> {
+    let (print_v, first_v) = if cell.print_vel_cp > 0.0 {
+        (
+            cell.print_vel_cp,
+            cell.print_vel_cp * m.first_layer_speed / m.print_speed,
+        )
+    } else {
+        (m.print_speed / 1000.0, m.first_layer_speed / 1000.0)
+    };
+    let travel_v = if cell.travel_vel_cp > 0.0 {
+        cell.travel_vel_cp
+    } else {
+        m.travel_speed / 1000.0
+    };
+    let mut w = Motion {
+        steps: Vec::new(),
+        vel: None,
+        on: false,
+        clearance: cell.travel_clearance,
+        z_top: f64::NEG_INFINITY,
+        height: HeightMap {
+            cell: HEIGHT_CELL,
+            z: Default::default(),
+        },
+    };
+    let (mut layer, mut feature) = (None, None);
+    let mut cur: Option<(Pose, usize)> = None;
+    for (i, q) in path.points.iter().enumerate() {
+        let p = add(q.p, offset);
+        let z = scale(axes[i], -1.0);
+        w.z_top = w.z_top.max(p[2]);
+        // A travel point goes only where a path starts (a print point follows): the
+        // planner's other travel points (lifts, waypoints) are superseded by the safe travel.
+        let starts_path = path
+            .points
+            .get(i + 1)
+            .is_some_and(|n| n.kind == MoveKind::Print);
+        if q.kind == MoveKind::Travel && !starts_path {
+            continue;
+        }
+        if layer != Some(q.layer) || feature != Some(q.feature) {
+            layer = Some(q.layer);
+            feature = Some(q.feature);
+            w.steps.push(Step::Comment(format!(
+                "FEATURE {} LAYER {}",
+                q.feature, q.layer
+            )));
+        }
+        let next = match (q.kind, cur) {
+            (MoveKind::Print, Some((prev, _))) => {
+                let pose = Pose {
+                    r: transport(&prev.r, z),
+                    t: p,
+                };
+                // A print move that goes nowhere (the nozzle is already there) is dropped,
+                // with its switching. Speed first: a TRIGGER goes right before its motion.
+                if w.goes_nowhere(&pose) {
+                    cur = Some((pose, i));
+                    continue;
+                }
+                let on_plate = p[2] - q.thickness.max(0.0) <= 0.01;
+                w.vel(if on_plate { first_v } else { print_v });
+                if !w.on {
+                    w.extruder(true);
+                }
+                w.motion(false, pose, i);
+                pose
+            }
+            _ => {
+                let pose = Pose {
+                    r: start_frame(z, p, base),
+                    t: p,
+                };
+                w.travel(cur.map(|c| c.0), pose, i, travel_v);
+                pose
+            }
+        };
+        // The bead just laid (or the path's start) is material the travels must clear.
+        match (q.kind, cur) {
+            (MoveKind::Print, Some((prev, _))) => w.height.add_segment(prev.t, p),
+            _ => w.height.add(p),
+        }
+        cur = Some((next, i));
+    }
+    if let Some((end, i)) = cur {
+        w.leave(&end, i, travel_v);
+    }
+    w.steps
+}
+
+/// The highest point visited so far over each cell of a square grid of the table (`$BASE`
+/// X, Y), for travel heights.
+pub(super) struct HeightMap {
+    cell: f64,
+    z: std::collections::HashMap<(i64, i64), f64>,
+}
+
+impl HeightMap {
+    fn key(&self, x: f64, y: f64) -> (i64, i64) {
+        (
+            (x / self.cell).floor() as i64,
+            (y / self.cell).floor() as i64,
+        )
+    }
+
+    fn add(&mut self, p: V3) {
+        let k = self.key(p[0], p[1]);
+        let z = self.z.entry(k).or_insert(f64::NEG_INFINITY);
+        *z = z.max(p[2]);
+    }
+
+    /// Every point of the segment from `a` to `b`, sampled at half a cell.
+    fn add_segment(&mut self, a: V3, b: V3) {
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let n = ((2.0 * len / self.cell).ceil() as usize).clamp(1, 1_000_000);
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            self.add(add(scale(a, 1.0 - t), scale(b, t)));
+        }
+    }
+
+    /// The highest point visited within about a cell of the XY segment from `a` to `b`
+    /// (−∞ when none).
+    fn max_along(&self, a: V3, b: V3) -> f64 {
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let n = ((2.0 * len / self.cell).ceil() as usize).clamp(1, 1_000_000);
+        let mut top = f64::NEG_INFINITY;
+        let mut last = None;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            let (cx, cy) = self.key(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+            if last == Some((cx, cy)) {
+                continue;
+            }
+            last = Some((cx, cy));
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    if let Some(z) = self.z.get(&(cx + dx, cy + dy)) {
+                        top = top.max(*z);
+                    }
+                }
+            }
+        }
+        top
+    }
+}
+
+/// The tool frame at the start of a path: Z along `z` (unit, `$BASE`), X the horizontal
+/// direction from the nozzle at `p` back to the robot's A1 axis made normal to Z (or, when
+/// the tool points along that direction, the horizontal normal to it).
+pub(super) fn start_frame(z: V3, p: V3, base: &Pose) -> Mat3 {
+    let world = base.apply(p);
+    let back = [-world[0], -world[1], 0.0];
+    let back = if norm(back) < 1.0 {
+        [-1.0, 0.0, 0.0]
+    } else {
+        scale(back, 1.0 / norm(back))
+    };
+    let to_base = transpose(&base.r);
+    let d = apply(&to_base, back);
+    let side = apply(&to_base, cross([0.0, 0.0, 1.0], back));
+    frame_from_zx(z, d, 0.2)
+        .or_else(|| frame_from_zx(z, side, 1e-6))
+        .or_else(|| frame_from_zx(z, [1.0, 0.0, 0.0], 1e-6))
+        .or_else(|| frame_from_zx(z, [0.0, 1.0, 0.0], 1e-6))
+        .unwrap_or(IDENTITY)
+}
+
+/// The steps being planned and the state they leave.
+pub(super) struct Motion {
+    steps: Vec<Step>,
+    vel: Option<f64>,
+    on: bool,
+    clearance: f64,
+    /// Highest point of the path so far ($BASE Z, mm).
+    z_top: f64,
+    /// The points visited so far.
+    height: HeightMap,
+}
+
+impl Motion {
+    fn vel(&mut self, v: f64) {
+        if self.vel != Some(v) {
+            self.vel = Some(v);
+            self.steps.push(Step::Vel(v));
+        }
+    }
+
+    fn extruder(&mut self, on: bool) {
+        self.on = on;
+        self.steps.push(Step::Extruder(on));
+    }
+
+    /// Whether `pose` is the previous motion's (within 1e-9 mm and 1e-9°).
+    fn goes_nowhere(&self, pose: &Pose) -> bool {
+        let last = self.steps.iter().rev().find_map(|s| match s {
+            Step::Move { pose, .. } => Some(*pose),
+            _ => None,
+        });
+        last.is_some_and(|last| {
+            norm(sub(last.t, pose.t)) < 1e-9 && rotation_angle_deg(&last.r, &pose.r) < 1e-9
+        })
+    }
+
+    /// A motion, unless it would go nowhere.
+    fn motion(&mut self, ptp: bool, pose: Pose, point: usize) {
+        if !self.goes_nowhere(&pose) {
+            self.steps.push(Step::Move { ptp, pose, point });
+        }
+    }
+
+    /// Travel speed, extruder off, and back off `from` along the tool axis by the clearance;
+    /// returns where it backed off to.
+    fn retreat(&mut self, from: &Pose, point: usize, travel_v: f64) -> [f64; 3] {
+        self.vel(travel_v);
+        if self.on {
+            self.extruder(false);
+        }
+        let retreat = add(from.t, scale(col(&from.r, 2), -self.clearance));
+        self.motion(
+            false,
+            Pose {
+                r: from.r,
+                t: retreat,
+            },
+            point,
+        );
+        retreat
+    }
+
+    /// Travel from `cur` (or from home) to the path start `to` (point `point`).
+    fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64) {
+        let c = self.clearance;
+        let approach = add(to.t, scale(col(&to.r, 2), -c));
+        let Some(from) = cur else {
+            self.vel(travel_v);
+            self.motion(
+                true,
+                Pose {
+                    r: to.r,
+                    t: approach,
+                },
+                point,
+            );
+            self.motion(false, to, point);
+            return;
+        };
+        let retreat = self.retreat(&from, point, travel_v);
+        let h = (self.height.max_along(retreat, approach) + c)
+            .max(retreat[2])
+            .max(approach[2]);
+        let up = [retreat[0], retreat[1], h];
+        self.motion(false, Pose { r: from.r, t: up }, point);
+        let over = [approach[0], approach[1], h];
+        let turn = log_rot(&mul(&transpose(&from.r), &to.r));
+        let angle = norm(turn).to_degrees();
+        let n = ((angle / TRAVEL_ROTATION_STEP_DEG).ceil() as usize).max(1);
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let pose = if k == n {
+                Pose { r: to.r, t: over }
+            } else {
+                Pose {
+                    r: mul(&from.r, &exp_rot(scale(turn, t))),
+                    t: add(scale(up, 1.0 - t), scale(over, t)),
+                }
+            };
+            self.motion(false, pose, point);
+        }
+        self.motion(
+            false,
+            Pose {
+                r: to.r,
+                t: approach,
+            },
+            point,
+        );
+        self.motion(false, to, point);
+    }
+
+    /// The end: extruder off, retreat along the tool axis and rise to the safe height.
+    fn leave(&mut self, from: &Pose, point: usize, travel_v: f64) {
+        let c = self.clearance;
+        let retreat = self.retreat(from, point, travel_v);
+        let h = (self.z_top + c).max(retreat[2]);
+        self.motion(
+            false,
+            Pose {
+                r: from.r,
+                t: [retreat[0], retreat[1], h],
+            },
+            point,
+        );
+    }
+}

@@ -1,0 +1,138 @@
+//! Where a post puts the part: the machine coordinates of the planned (part) coordinates.
+
+use crate::machine::MachineProfile;
+use crate::PostError;
+use toolpath::vec3::unit;
+use toolpath::{fixed, MoveKind, PathPoint, ToolPath};
+
+/// Slack (mm) allowed when checking that the path fits the bed.
+const FIT_TOLERANCE: f64 = 1e-6;
+
+/// The offset (mm, rounded to 0.001) added to part coordinates to get machine coordinates:
+/// the XY bounding-box centre of the print points goes to the bed centre (`bed_size / 2`, or
+/// X0 Y0 when `bed_origin_centre`), and the lowest bead bottom (`z − thickness` over print
+/// points) to Z0. A path without print points is placed by its travel points; an empty path
+/// gets the bed centre.
+///
+/// Errors with [`PostError::DoesNotFit`] when any point (print points with half their bead
+/// width and their thickness) lies outside the bed volume, saying by how much per axis.
+pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostError> {
+    let half = [m.bed_size[0] / 2.0, m.bed_size[1] / 2.0];
+    let centre = if m.bed_origin_centre {
+        [0.0, 0.0]
+    } else {
+        half
+    };
+    let placed = placed_points(path);
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for q in &placed {
+        let bottom = match q.kind {
+            MoveKind::Print => q.p[2] - q.thickness.max(0.0),
+            MoveKind::Travel => q.p[2],
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(q.p[k]);
+            hi[k] = hi[k].max(q.p[k]);
+        }
+        lo[2] = lo[2].min(bottom);
+    }
+    let offset = if placed.is_empty() {
+        [centre[0], centre[1], 0.0]
+    } else {
+        [
+            round3(centre[0] - (lo[0] / 2.0 + hi[0] / 2.0)),
+            round3(centre[1] - (lo[1] / 2.0 + hi[1] / 2.0)),
+            // Up, never down: the lowest bead must not end below the plate.
+            ((-lo[2] - 1e-9) * 1000.0).ceil() / 1000.0,
+        ]
+    };
+
+    // Extent of everything the nozzle and the beads occupy, in machine coordinates.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for q in &path.points {
+        let (r, bottom) = match q.kind {
+            MoveKind::Print => (q.width.max(0.0) / 2.0, q.p[2] - q.thickness.max(0.0)),
+            MoveKind::Travel => (0.0, q.p[2]),
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(q.p[k] + offset[k] - r);
+            hi[k] = hi[k].max(q.p[k] + offset[k] + r);
+        }
+        lo[2] = lo[2].min(bottom + offset[2]);
+        hi[2] = hi[2].max(q.p[2] + offset[2]);
+    }
+    let bed_lo = [centre[0] - half[0], centre[1] - half[1], 0.0];
+    let bed_hi = [centre[0] + half[0], centre[1] + half[1], m.bed_size[2]];
+    let mut excess = Vec::new();
+    if !path.points.is_empty() {
+        for (k, letter) in ["X", "Y", "Z"].iter().enumerate() {
+            let over = (bed_lo[k] - lo[k]).max(0.0) + (hi[k] - bed_hi[k]).max(0.0);
+            // NaN (from overflowing coordinates) counts as not fitting.
+            let fits = over <= FIT_TOLERANCE && offset[k].is_finite();
+            if !fits {
+                excess.push(format!("{letter} {} mm", fixed(over, 3)));
+            }
+        }
+    }
+    if !excess.is_empty() {
+        return Err(PostError::DoesNotFit {
+            name: m.name.clone(),
+            bed: m.bed_size.map(|v| fixed(v, 0)).join("x"),
+            excess: excess.join(", "),
+        });
+    }
+    Ok(offset)
+}
+
+/// `v` rounded to 0.001, so the offset written in the header is exact.
+fn round3(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0
+}
+
+/// The points a post places the part by: the print points, or every point of a path without
+/// any (travel only).
+pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
+    let prints: Vec<&PathPoint> = path
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .collect();
+    if prints.is_empty() {
+        path.points.iter().collect()
+    } else {
+        prints
+    }
+}
+
+/// The offset (mm, rounded to 0.001) from part to table coordinates: the XY bounding-box
+/// centre of the print points on the C axis, the lowest bead bottom (`p − thickness·axis` over
+/// print points) on the table surface. A path without print points is placed by its travel
+/// points; an empty path gets no offset.
+pub(crate) fn table_offset(path: &ToolPath) -> [f64; 3] {
+    let placed = placed_points(path);
+    if placed.is_empty() {
+        return [0.0; 3];
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for q in &placed {
+        let bottom = match (q.kind, unit(q.axis)) {
+            (MoveKind::Print, Some(a)) => q.p[2] - q.thickness.max(0.0) * a[2],
+            _ => q.p[2],
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(q.p[k]);
+            hi[k] = hi[k].max(q.p[k]);
+        }
+        lo[2] = lo[2].min(bottom);
+    }
+    let round3 = |v: f64| (v * 1000.0).round() / 1000.0;
+    [
+        round3(-(lo[0] / 2.0 + hi[0] / 2.0)),
+        round3(-(lo[1] / 2.0 + hi[1] / 2.0)),
+        // Up, never down: the lowest bead must not end below the table.
+        ((-lo[2] - 1e-9) * 1000.0).ceil() / 1000.0,
+    ]
+}

@@ -1,0 +1,183 @@
+//! One way to run every post: a machine profile gives its [`Post`]
+//! ([`MachineProfile::post`]), which writes a [`Program`] (the files to save, figures per
+//! feature, warnings) for a tool path, so a caller never matches on machine kinds.
+
+use std::collections::BTreeMap;
+
+use crate::delta5::{delta5, KinematicFigures};
+use crate::kind::MachineKind;
+use crate::kuka::{kuka, KukaFigures};
+use crate::machine::MachineProfile;
+use crate::marlin::marlin;
+use crate::PostError;
+use toolpath::ToolPath;
+
+/// What the programs name: the part they are for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Job<'a> {
+    /// The source (the STEP file's name), written in every program's header.
+    pub source: &'a str,
+    /// The part's stem, for posts whose programs carry a name (KRL modules).
+    pub stem: &'a str,
+}
+
+/// A post: writes a machine's program for a tool path.
+pub trait Post {
+    /// The program for `path`, or why it cannot be written.
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError>;
+}
+
+/// A written program: its files in the order they are saved, what the post measured per
+/// feature, and warnings (one line each).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Program {
+    /// The files, in order.
+    pub files: Vec<ProgramFile>,
+    /// Figures per feature id (the features the post measured).
+    pub figures: BTreeMap<usize, PostFigures>,
+    /// Things to know, one line each.
+    pub warnings: Vec<String>,
+}
+
+/// One file of a [`Program`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProgramFile {
+    /// File name, without a folder.
+    pub name: String,
+    /// Contents.
+    pub bytes: Vec<u8>,
+}
+
+impl ProgramFile {
+    fn text(name: &str, text: String) -> ProgramFile {
+        ProgramFile {
+            name: name.to_string(),
+            bytes: text.into_bytes(),
+        }
+    }
+}
+
+/// What a post measured of one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PostFigures {
+    /// The delta5 post's kinematic figures.
+    Delta5(KinematicFigures),
+    /// The KUKA post's reach figures.
+    Kuka(KukaFigures),
+}
+
+/// The Marlin post ([`marlin`]): `program.gcode`.
+#[derive(Debug, Clone, Copy)]
+pub struct MarlinPost<'a>(pub &'a MachineProfile);
+
+impl Post for MarlinPost<'_> {
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+        let gcode = marlin(path, self.0, job.source)?;
+        Ok(Program {
+            files: vec![ProgramFile::text("program.gcode", gcode)],
+            ..Program::default()
+        })
+    }
+}
+
+/// The 5-axis post ([`delta5`]): `program.gcode` and `kinematic_error.svg`, kinematic figures
+/// per feature.
+#[derive(Debug, Clone, Copy)]
+pub struct Delta5Post<'a>(pub &'a MachineProfile);
+
+impl Post for Delta5Post<'_> {
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+        let program = delta5(path, self.0, job.source)?;
+        Ok(Program {
+            files: vec![
+                ProgramFile::text("program.gcode", program.gcode),
+                ProgramFile::text("kinematic_error.svg", program.error_plot_svg),
+            ],
+            figures: program
+                .figures
+                .into_iter()
+                .map(|(id, k)| (id, PostFigures::Delta5(k)))
+                .collect(),
+            warnings: Vec::new(),
+        })
+    }
+}
+
+/// The KUKA post ([`kuka`]): the KRL files named after the job's stem, reach figures per
+/// feature, and its warnings.
+#[derive(Debug, Clone, Copy)]
+pub struct KukaPost<'a>(pub &'a MachineProfile);
+
+impl Post for KukaPost<'_> {
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+        let program = kuka(path, self.0, job.stem, job.source)?;
+        Ok(Program {
+            files: program
+                .files
+                .into_iter()
+                .map(|(name, text)| ProgramFile {
+                    name,
+                    bytes: text.into_bytes(),
+                })
+                .collect(),
+            figures: program
+                .figures
+                .into_iter()
+                .map(|(id, k)| (id, PostFigures::Kuka(k)))
+                .collect(),
+            warnings: program.warnings,
+        })
+    }
+}
+
+impl MachineProfile {
+    /// The post of this profile's kind, writing with this profile.
+    pub fn post(&self) -> Box<dyn Post + '_> {
+        match self.kind {
+            MachineKind::Marlin => Box::new(MarlinPost(self)),
+            MachineKind::Delta5 => Box::new(Delta5Post(self)),
+            MachineKind::Kuka => Box::new(KukaPost(self)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use toolpath::{MoveKind, PathPoint};
+
+    #[test]
+    fn every_kind_posts_its_files() {
+        let q = |x: f64, kind| PathPoint {
+            feature: 0,
+            layer: 1,
+            kind,
+            p: [x, 0.0, 0.2],
+            axis: [0.0, 0.0, 1.0],
+            e: 0.1,
+            thickness: 0.2,
+            width: 0.45,
+        };
+        let path = ToolPath {
+            points: vec![q(0.0, MoveKind::Travel), q(5.0, MoveKind::Print)],
+        };
+        let job = Job {
+            source: "part.step",
+            stem: "part",
+        };
+        for (kind, names) in [
+            (MachineKind::Marlin, vec!["program.gcode"]),
+            (
+                MachineKind::Delta5,
+                vec!["program.gcode", "kinematic_error.svg"],
+            ),
+            (MachineKind::Kuka, vec!["part.src", "part.dat"]),
+        ] {
+            let m = MachineProfile::builtin(kind);
+            let program = m.post().post(&path, &job).unwrap();
+            let got: Vec<&str> = program.files.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(got, names, "{kind}");
+            assert_eq!(program.figures.is_empty(), kind == MachineKind::Marlin);
+        }
+    }
+}
