@@ -65,7 +65,7 @@ fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
         assert!(p
             .program
             .iter()
-            .any(|(n, b)| n == "program.gcode" && !b.is_empty()));
+            .any(|f| f.name == "program.gcode" && !f.bytes.is_empty()));
     }
 }
 
