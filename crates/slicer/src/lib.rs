@@ -13,12 +13,20 @@
 //!
 //! Polygon offsets and booleans come from the `i_overlay` crate.
 
+mod chart;
+pub mod error;
+mod feature_mesh;
+pub mod figures;
 pub mod fill;
+mod fold;
 pub mod freeform;
 pub mod geodesic;
+pub mod geom2d;
+mod lift;
 pub mod orient;
 pub mod params;
 pub mod planar;
+mod region_fill;
 pub mod toolpath;
 pub mod vec3;
 pub mod verify;
