@@ -29,11 +29,13 @@
 //!   axis is N (or `fixed_tool_axis`); extrusion follows Isa & Lazoglu 2019, Eq. 1 with the
 //!   layer's thickness and each point's bead width.
 
-use crate::chart::{choose_chart, mapped_mesh, refined, ChartKind, MAX_MAPPED_EDGE};
+use crate::chart::{choose_chart, mapped_mesh, refined, MAX_MAPPED_EDGE};
+use crate::error::PlanError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::figures::FeatureFigures;
 use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
-use crate::geom2d::{Point2, Region};
+use crate::geom2d::{dist2, segment_foot, Point2, Region};
 use crate::lift::lift;
 use crate::params::{LayerParams, PathMode};
 use crate::planar::{filament_length, Bead};
@@ -44,9 +46,7 @@ use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
-pub use crate::chart::Chart;
-pub use crate::error::PlanError;
-pub use crate::figures::FeatureFigures;
+pub use crate::chart::{Chart, ChartKind};
 pub use crate::region_fill::{fill_flat_region, Boundary, FillPath};
 
 /// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
@@ -68,10 +68,7 @@ pub struct FreeformFigures {
 
 /// Whether chart point `q` lies in one of `regions` or within `reach` (chart units) of one.
 fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
-    if regions
-        .iter()
-        .any(|r| crate::geodesic::region_contains(r, q))
-    {
+    if regions.iter().any(|r| crate::geom2d::region_contains(r, q)) {
         return true;
     }
     let r2 = reach * reach;
@@ -79,16 +76,8 @@ fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
         std::iter::once(&r.outer).chain(r.holes.iter()).any(|ring| {
             let n = ring.len();
             (0..n).any(|i| {
-                let (a, b) = (ring[i], ring[(i + 1) % n]);
-                let ab = [b[0] - a[0], b[1] - a[1]];
-                let l2 = ab[0] * ab[0] + ab[1] * ab[1];
-                let t = if l2 > 0.0 {
-                    (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let x = [a[0] + ab[0] * t - q[0], a[1] + ab[1] * t - q[1]];
-                x[0] * x[0] + x[1] * x[1] <= r2
+                let x = segment_foot(q, ring[i], ring[(i + 1) % n]).1;
+                dist2(x, q) <= r2
             })
         })
     })
@@ -260,7 +249,7 @@ pub fn plan_freeform(
             if let Some(c) = *cursor {
                 if let Some((qc, dc)) = chart.inverse(&c) {
                     let hz = lift_to.max(dc + dl);
-                    let span = ((first.q[0] - qc[0]).powi(2) + (first.q[1] - qc[1]).powi(2)).sqrt();
+                    let span = dist2(first.q, qc).sqrt();
                     let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
                     for i in 0..=n {
                         let t = i as f64 / n as f64;

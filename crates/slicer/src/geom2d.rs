@@ -82,6 +82,12 @@ pub fn region_contains(region: &Region, q: Point2) -> bool {
 
 /// Distance from `p` to the segment `a`–`b`.
 pub(crate) fn seg_dist(p: Point2, a: Point2, b: Point2) -> f64 {
+    dist(p, segment_foot(p, a, b).1)
+}
+
+/// The point of the segment `a`–`b` nearest `p`: its parameter `t` along the segment (0 at
+/// `a`, 1 at `b`; 0 when the segment is a point), the point, and the segment's squared length.
+pub(crate) fn segment_foot(p: Point2, a: Point2, b: Point2) -> (f64, Point2, f64) {
     let d = [b[0] - a[0], b[1] - a[1]];
     let l2 = d[0] * d[0] + d[1] * d[1];
     let t = if l2 > 0.0 {
@@ -89,7 +95,7 @@ pub(crate) fn seg_dist(p: Point2, a: Point2, b: Point2) -> f64 {
     } else {
         0.0
     };
-    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
+    (t, [a[0] + t * d[0], a[1] + t * d[1]], l2)
 }
 
 pub(crate) fn on_boundary(p: Point2, poly: &[Point2], eps: f64) -> bool {

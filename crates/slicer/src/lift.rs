@@ -2,6 +2,7 @@
 //! tolerance of the surface, then the ones not needed for that dropped.
 
 use crate::chart::Chart;
+use crate::geodesic::segment_distance;
 use crate::geom2d::Point2;
 use crate::region_fill::FillPath;
 use brep::math::{P3, V3};
@@ -70,16 +71,9 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
             continue;
         }
         let (a, b) = (dense[i].p, dense[j].p);
-        let ab = b - a;
-        let l2 = ab.norm_squared();
         let (mut worst, mut at) = (0.0f64, i);
         for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
-            let t = if l2 > 0.0 {
-                ((x.p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let d = (x.p - (a + ab * t)).norm();
+            let d = segment_distance(&x.p, &a, &b);
             if d > worst {
                 worst = d;
                 at = k;

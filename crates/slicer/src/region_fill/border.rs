@@ -1,6 +1,6 @@
 //! The infill boundary's rings, along which zig-zag connectors run.
 
-use crate::geom2d::Point2;
+use crate::geom2d::{dist2, segment_foot, Point2};
 
 /// The infill boundary's rings, to run zig-zag connectors along.
 pub(super) struct Border<'a> {
@@ -16,7 +16,7 @@ impl<'a> Border<'a> {
             .map(|r| {
                 let mut a = vec![0.0];
                 for w in r.q.windows(2) {
-                    let l = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+                    let l = dist2(w[1], w[0]).sqrt();
                     a.push(a[a.len() - 1] + l);
                 }
                 a
@@ -30,16 +30,8 @@ impl<'a> Border<'a> {
         let mut best: Option<(usize, usize, f64, f64)> = None;
         for (r, ring) in self.rings.iter().enumerate() {
             for (i, w) in ring.q.windows(2).enumerate() {
-                let (a, b) = (w[0], w[1]);
-                let ab = [b[0] - a[0], b[1] - a[1]];
-                let l2 = ab[0] * ab[0] + ab[1] * ab[1];
-                let t = if l2 > 0.0 {
-                    (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let x = [a[0] + ab[0] * t, a[1] + ab[1] * t];
-                let d = ((q[0] - x[0]).powi(2) + (q[1] - x[1]).powi(2)).sqrt();
+                let (t, x, l2) = segment_foot(q, w[0], w[1]);
+                let d = dist2(q, x).sqrt();
                 if best.is_none_or(|b| d < b.3) {
                     best = Some((r, i, self.arc[r][i] + t * l2.sqrt(), d));
                 }

@@ -134,7 +134,7 @@ pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -
                 let rho = rho_e + (rho_s - rho_e) * k as f64 / steps as f64;
                 let f = rho / (2.0 * cs);
                 let q = [qc[0] + b[0] * f, qc[1] + b[1] * f];
-                if !crate::geodesic::region_contains(region, q) {
+                if !crate::geom2d::region_contains(region, q) {
                     break;
                 }
                 let Some((p, _)) = chart.at(q, z) else { break };
