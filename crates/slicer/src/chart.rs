@@ -8,6 +8,7 @@
 
 use crate::error::PlanError;
 use crate::geom2d::{Point2, Region};
+use crate::tolerance::{DEGENERATE_LENGTH, SINGULAR_DET};
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
 use brep::surface::Surface;
@@ -206,7 +207,7 @@ impl<'a> Chart<'a> {
                     let r = p - e;
                     let g = [[a.dot(&a), a.dot(&b)], [a.dot(&b), b.dot(&b)]];
                     let det = g[0][0] * g[1][1] - g[0][1] * g[1][0];
-                    if det.abs() < 1e-18 {
+                    if det.abs() < SINGULAR_DET {
                         break;
                     }
                     let (ra, rb) = (a.dot(&r), b.dot(&r));
@@ -248,7 +249,7 @@ impl<'a> Chart<'a> {
         // Least squares W with [ks kt] = [js jt]·W, then its eigenvalues.
         let g = [[js.dot(&js), js.dot(&jt)], [js.dot(&jt), jt.dot(&jt)]];
         let det = g[0][0] * g[1][1] - g[0][1] * g[1][0];
-        if det.abs() < 1e-18 {
+        if det.abs() < SINGULAR_DET {
             return None;
         }
         let gi = [
@@ -294,7 +295,7 @@ pub(crate) fn choose_chart<'a>(
     let a0 = area(u0, v0);
     // Native when the parameters stay regular under the whole feature.
     let stride = (mesh.positions.len() / 400).max(1);
-    let mut native = a0 > 1e-12 && su.norm() > 1e-9 && sv.norm() > 1e-9;
+    let mut native = a0 > 1e-12 && su.norm() > DEGENERATE_LENGTH && sv.norm() > DEGENERATE_LENGTH;
     if native {
         let (mut ulo, mut uhi) = (f64::INFINITY, f64::NEG_INFINITY);
         for p in mesh.positions.iter().step_by(stride) {

@@ -2,6 +2,7 @@
 
 use crate::error::PlanError;
 use crate::params::LayerParams;
+use crate::tolerance::MICROMETRE;
 use brep::mesh::{mesh_faces, MeshOptions};
 use features::{Feature, FeatureTree};
 
@@ -10,7 +11,7 @@ use features::{Feature, FeatureTree};
 pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
     (params.tolerance * 0.25)
         .min(0.25 * params.uniform_layer_height)
-        .max(1e-3)
+        .max(MICROMETRE)
 }
 
 /// The mesh of a feature's shell and its voids, at chord tolerance `tol`.

@@ -4,6 +4,7 @@
 use crate::chart::{Chart, ChartKind};
 use crate::error::PlanError;
 use crate::params::LayerParams;
+use crate::tolerance::{DEGENERATE_LENGTH, FLAT_CURVATURE, MICROMETRE};
 use brep::math::{P3, V3};
 use brep::mesh::Mesh;
 use brep::surface::Surface;
@@ -39,7 +40,7 @@ pub(crate) fn fold_check(
     let Some(n0) = surf.normal(u0, v0).map(|n| n * sign) else {
         return Ok(());
     };
-    if su.norm() < 1e-9 || sv.norm() < 1e-9 {
+    if su.norm() < DEGENERATE_LENGTH || sv.norm() < DEGENERATE_LENGTH {
         return Ok(());
     }
     let flip = if su.cross(&sv).dot(&n0) < 0.0 {
@@ -59,7 +60,7 @@ pub(crate) fn fold_check(
         .iter()
         .map(|p| (p - f0).dot(&n0))
         .fold(0.0f64, f64::max);
-    let step = (0.5 * params.uniform_layer_height).max(1e-3);
+    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
     let mut lambda = 0.0f64;
     for r in roots.iter().step_by((roots.len() / 300).max(1)) {
         let (u, v) = surf.unwrap_near((r.0, r.1), (u0, v0));
@@ -67,7 +68,7 @@ pub(crate) fn fold_check(
             lambda = lambda.min(l);
         }
     }
-    if lambda < -1e-9 {
+    if lambda < -FLAT_CURVATURE {
         check_folds(id, &params.layer_heights(height), -1.0 / lambda)?;
     }
     Ok(())

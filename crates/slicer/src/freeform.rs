@@ -40,6 +40,7 @@ use crate::lift::lift;
 use crate::params::{LayerParams, PathMode};
 use crate::planar::{filament_length, Bead};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
+use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
 use brep::section::{section, Plane};
@@ -133,14 +134,14 @@ pub fn plan_freeform(
     let heights = params.layer_heights(top);
     // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature.
     let stride = (mapped.positions.len() / 300).max(1);
-    let step = (0.5 * params.uniform_layer_height).max(1e-3);
+    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
     let mut lambda = 0.0f64;
     for p in mapped.positions.iter().step_by(stride) {
         if let Some(l) = chart.min_curvature([p.x, p.y], step) {
             lambda = lambda.min(l);
         }
     }
-    let concave_radius = if lambda < -1e-9 {
+    let concave_radius = if lambda < -FLAT_CURVATURE {
         -1.0 / lambda
     } else {
         f64::INFINITY
@@ -183,8 +184,8 @@ pub fn plan_freeform(
             let regions = regions_from_loops(&loops);
             let spacing = params
                 .spacing_for_layer(bead.width, layer)
-                .max(1e-3)
-                .min(spacing.max(1e-3) * 1e3);
+                .max(MICROMETRE)
+                .min(spacing.max(MICROMETRE) * 1e3);
             let mut paths = vec![];
             for r in &regions {
                 paths.extend(fill_region(

@@ -27,6 +27,7 @@ pub mod orient;
 pub mod params;
 pub mod planar;
 mod region_fill;
+mod tolerance;
 pub mod toolpath;
 pub mod vec3;
 pub mod verify;

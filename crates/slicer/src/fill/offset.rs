@@ -5,6 +5,7 @@ use super::pattern::bounds;
 use super::region::region_shapes;
 use super::{Contour, Shapes};
 use crate::geom2d::{area2, dist, perimeter, seg_dist, Point2, Region};
+use crate::tolerance::ROUND_OFF;
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 use i_overlay::mesh::math::MathMode;
@@ -43,7 +44,7 @@ pub(super) fn erode(base: &Shapes, d: f64, join: &LineJoin<f64>) -> Shapes {
         .filter(|shape| {
             shape
                 .first()
-                .is_some_and(|outer| min_width(outer) > 2.0 * d * (1.0 + 1e-9))
+                .is_some_and(|outer| min_width(outer) > 2.0 * d * (1.0 + ROUND_OFF))
         })
         .cloned()
         .collect();

@@ -6,6 +6,7 @@ use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
 use crate::geom2d::{area2, dist, perimeter, Point2};
+use crate::tolerance::ROUND_OFF;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
@@ -304,7 +305,7 @@ pub(super) fn scan_fill(
         rings.push(Ring { pts, cum, len: l });
     }
     let h = ymax - ymin;
-    let eps = 1e-9 * (1.0 + ymin.abs().max(ymax.abs()));
+    let eps = ROUND_OFF * (1.0 + ymin.abs().max(ymax.abs()));
     let lines = h / spacing;
     if h.is_nan() || h <= 2.0 * eps || lines.is_nan() || lines >= MAX_LINES {
         return;
@@ -484,7 +485,7 @@ pub(super) fn scan_fill(
 /// ring (forward or backward).
 fn connector(r: &Ring, e: End, len: f64, forward: bool, pts: &mut Vec<Point2>) {
     let m = r.pts.len();
-    let tiny = 1e-9 * (1.0 + r.len);
+    let tiny = ROUND_OFF * (1.0 + r.len);
     let mut idx = if forward { (e.edge + 1) % m } else { e.edge };
     for _ in 0..m {
         let d = if forward {

@@ -2,6 +2,7 @@
 
 use super::{Contour, Shape, Shapes, MAX_COORD};
 use crate::geom2d::{area2, inside, on_boundary, perimeter, Point2, Region};
+use crate::tolerance::ROUND_OFF;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
@@ -80,7 +81,7 @@ pub fn regions_from_loops(loops: &[Vec<Point2>]) -> Vec<Region> {
         if i[0] < o[0] || i[1] < o[1] || i[2] > o[2] || i[3] > o[3] {
             return false;
         }
-        let eps = 1e-9 * (1.0 + (o[2] - o[0]).max(o[3] - o[1]));
+        let eps = ROUND_OFF * (1.0 + (o[2] - o[0]).max(o[3] - o[1]));
         match inner
             .pts
             .iter()

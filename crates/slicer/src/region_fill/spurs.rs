@@ -4,6 +4,7 @@
 use super::FillPath;
 use crate::chart::Chart;
 use crate::geom2d::{Point2, Region};
+use crate::tolerance::DEGENERATE_LENGTH;
 use brep::math::P3;
 
 /// A corner spur is laid only at a convex corner of the layer region sharper than this
@@ -110,7 +111,7 @@ pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -
             };
             let (qc, pc) = (ring[i], lp[i]);
             let (l1, l2) = ((p1 - pc).norm(), (p2 - pc).norm());
-            if l1 < 1e-9 || l2 < 1e-9 {
+            if l1 < DEGENERATE_LENGTH || l2 < DEGENERATE_LENGTH {
                 continue;
             }
             // The bisector in the chart: the chart is linear over the corner's neighbourhood,
