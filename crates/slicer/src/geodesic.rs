@@ -330,14 +330,6 @@ impl LayerMesh {
         m
     }
 
-    /// [`LayerMesh::build`] in the frame `y = M·q` of the chart metric at the region: `M` is
-    /// upper triangular with `|M·dq|² = dqᵀ·G·dq`, G the first fundamental form of the layer
-    /// surface in the chart (`g[0][0] = |p_s|²`, `g[0][1] = p_s·p_t`, `g[1][1] = |p_t|²`). The
-    /// lattice is then equilateral on the surface, not in the chart, so `step` is in mm and
-    /// the triangles stay acute where the chart stretches the layer (an offset far from a
-    /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
-    /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
-    /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
     /// The area on the layer surface (the lifted vertices `p`) of the part of the region
     /// where the piecewise-linear field `f` is at least `level`.
     pub fn area_above(&self, f: &[f64], level: f64) -> f64 {
@@ -370,6 +362,14 @@ impl LayerMesh {
         sum
     }
 
+    /// [`LayerMesh::build`] in the frame `y = M·q` of the chart metric at the region: `M` is
+    /// upper triangular with `|M·dq|² = dqᵀ·G·dq`, G the first fundamental form of the layer
+    /// surface in the chart (`g[0][0] = |p_s|²`, `g[0][1] = p_s·p_t`, `g[1][1] = |p_t|²`). The
+    /// lattice is then equilateral on the surface, not in the chart, so `step` is in mm and
+    /// the triangles stay acute where the chart stretches the layer (an offset far from a
+    /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
+    /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
+    /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
     pub fn build_with_metric(region: &Region, step: f64, g: [[f64; 2]; 2]) -> LayerMesh {
         let a = g[0][0];
         let m = if a > 1e-12 {

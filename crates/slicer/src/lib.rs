@@ -13,6 +13,8 @@
 //!
 //! Polygon offsets and booleans come from the `i_overlay` crate.
 
+#![warn(missing_docs)]
+
 mod chart;
 pub mod error;
 mod feature_mesh;

@@ -8,7 +8,7 @@ use crate::geom2d::{dist, Point2};
 ///
 /// Closed paths are entered at their first point and kept as they are; empty paths go last.
 /// Reversing open paths means raster lines no longer all run the same way: keep
-/// [`fill_layer`]'s order for raster when that matters.
+/// [`super::fill_layer`]'s order for raster when that matters.
 pub fn order_paths(paths: Vec<Path2>, start: Point2) -> Vec<Path2> {
     let (todo, empty): (Vec<Path2>, Vec<Path2>) =
         paths.into_iter().partition(|p| !p.points.is_empty());
