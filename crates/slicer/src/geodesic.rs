@@ -14,7 +14,10 @@
 //! boundary; raster and zig-zag lines are iso-lines of the signed distance to a seed curve, so
 //! neighbouring lines are one spacing apart measured on the surface, not in the chart.
 
-use crate::fill::{bead_end_reach, Point2, Region, MAX_END_REACH};
+use crate::fill::{bead_end_reach, MAX_END_REACH};
+use crate::geom2d::{dist2, Point2, Region};
+
+pub use crate::geom2d::region_contains;
 use brep::math::P3;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 use std::cmp::Ordering;
@@ -49,28 +52,6 @@ pub struct IsoLine {
     pub other: Vec<f64>,
     /// The line is a closed ring (the first point is repeated at the end).
     pub closed: bool,
-}
-
-fn dist2(a: Point2, b: Point2) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
-}
-
-/// Even-odd inside test against every ring of a region.
-pub fn region_contains(region: &Region, q: Point2) -> bool {
-    let mut inside = false;
-    for ring in std::iter::once(&region.outer).chain(region.holes.iter()) {
-        let n = ring.len();
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if (a[1] > q[1]) != (b[1] > q[1]) {
-                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-                if x > q[0] {
-                    inside = !inside;
-                }
-            }
-        }
-    }
-    inside
 }
 
 /// Distance from `p` to the segment `a`–`b` in 3-D.
@@ -349,14 +330,6 @@ impl LayerMesh {
         m
     }
 
-    /// [`LayerMesh::build`] in the frame `y = M·q` of the chart metric at the region: `M` is
-    /// upper triangular with `|M·dq|² = dqᵀ·G·dq`, G the first fundamental form of the layer
-    /// surface in the chart (`g[0][0] = |p_s|²`, `g[0][1] = p_s·p_t`, `g[1][1] = |p_t|²`). The
-    /// lattice is then equilateral on the surface, not in the chart, so `step` is in mm and
-    /// the triangles stay acute where the chart stretches the layer (an offset far from a
-    /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
-    /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
-    /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
     /// The area on the layer surface (the lifted vertices `p`) of the part of the region
     /// where the piecewise-linear field `f` is at least `level`.
     pub fn area_above(&self, f: &[f64], level: f64) -> f64 {
@@ -389,6 +362,14 @@ impl LayerMesh {
         sum
     }
 
+    /// [`LayerMesh::build`] in the frame `y = M·q` of the chart metric at the region: `M` is
+    /// upper triangular with `|M·dq|² = dqᵀ·G·dq`, G the first fundamental form of the layer
+    /// surface in the chart (`g[0][0] = |p_s|²`, `g[0][1] = p_s·p_t`, `g[1][1] = |p_t|²`). The
+    /// lattice is then equilateral on the surface, not in the chart, so `step` is in mm and
+    /// the triangles stay acute where the chart stretches the layer (an offset far from a
+    /// cylinder's axis): fast marching's planar-wavefront update needs acute triangles, and
+    /// over long obtuse ones it overestimates the distance. Chart coordinates come back in
+    /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
     pub fn build_with_metric(region: &Region, step: f64, g: [[f64; 2]; 2]) -> LayerMesh {
         let a = g[0][0];
         let m = if a > 1e-12 {

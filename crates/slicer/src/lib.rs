@@ -6,6 +6,12 @@
 //!   contour-zig-zag) and ordering the paths for print;
 //! - [`freeform`]: curved layers of `freeform` features: offsets of the reference surface,
 //!   spatial slicing, paths spaced by geodesic distance ([`geodesic`]);
+//! - [`geom2d`]: points, regions, distances, areas and point-in-polygon tests of the plane;
+//! - [`error`], [`figures`]: why a feature could not be planned, and the figures of one that
+//!   was (both planners);
+//! - private: `chart` (the chart of a reference surface), `fold` (offset folds), `region_fill`
+//!   (one region of a curved or thin planar layer filled with beads of varying width, shared
+//!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`;
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
@@ -15,12 +21,23 @@
 //!
 //! Polygon offsets and booleans come from the `i_overlay` crate.
 
+#![warn(missing_docs)]
+
+mod chart;
+pub mod error;
+mod feature_mesh;
+pub mod figures;
 pub mod fill;
+mod fold;
 pub mod freeform;
 pub mod geodesic;
+pub mod geom2d;
+mod lift;
 pub mod orient;
 pub mod params;
 pub mod planar;
+mod region_fill;
+mod tolerance;
 pub mod verify;
 
 pub use toolpath;

@@ -6,9 +6,10 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
+use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
-use crate::freeform::{fill_flat_region, Boundary, FillPath};
 use crate::params::{LayerParams, PathMode};
+use crate::region_fill::{fill_flat_region, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
@@ -16,98 +17,9 @@ use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
+pub use crate::error::PlanError;
+pub use crate::figures::FeatureFigures;
 pub use toolpath::Bead;
-
-/// Why a feature could not be planned.
-#[derive(Debug, thiserror::Error)]
-pub enum PlanError {
-    /// The feature is freeform: [`crate::freeform::plan_freeform`] plans it.
-    #[error("feature {0} is freeform, not two5d")]
-    NotTwo5d(usize),
-    /// A freeform feature cannot be planned on offsets of its reference surface.
-    #[error("feature {id}: {msg}")]
-    Freeform {
-        /// Feature id.
-        id: usize,
-        /// Cause.
-        msg: String,
-    },
-    /// The offset of a freeform feature's reference surface folds over itself (feature-based
-    /// AM paper, Fig. 9: a concave valley narrower than the offset).
-    #[error("feature {id}: layer {layer} would lie {offset:.3} mm off its reference surface, past the {radius:.3} mm radius of a concave valley of it, where the offset surface folds over itself; split the feature at the valley (paper, Fig. 9) or build it from another reference")]
-    OffsetFolds {
-        /// Feature id.
-        id: usize,
-        /// First layer (1-based) that folds.
-        layer: usize,
-        /// Its offset, mm.
-        offset: f64,
-        /// Smallest concave radius of the reference under the feature, mm.
-        radius: f64,
-    },
-    /// The feature has no reference plane.
-    #[error("feature {0} has no reference plane")]
-    NoPlane(usize),
-    /// Meshing the feature failed.
-    #[error("feature {id}: {msg}")]
-    Mesh {
-        /// Feature id.
-        id: usize,
-        /// Cause.
-        msg: String,
-    },
-    /// Bad layer parameters.
-    #[error("feature {id}: {msg}")]
-    Params {
-        /// Feature id.
-        id: usize,
-        /// Cause.
-        msg: String,
-    },
-}
-
-/// Figures of one planned feature.
-#[derive(Debug, Clone, Default)]
-pub struct FeatureFigures {
-    /// Layers planned.
-    pub layers: usize,
-    /// Path points written.
-    pub points: usize,
-    /// Printed length, mm.
-    pub print_length: f64,
-    /// Travel length, mm.
-    pub travel_length: f64,
-    /// Filament fed, mm.
-    pub filament: f64,
-    /// Thinnest, mean and thickest layer, mm.
-    pub thickness: (f64, f64, f64),
-    /// Things to know.
-    pub warnings: Vec<String>,
-}
-
-impl FeatureFigures {
-    /// Closes feature `id`'s figures: its points in `out`, and its layers from the thicknesses
-    /// of the layers that printed (thinnest, mean, thickest; zeros and a warning when none did).
-    pub(crate) fn finish(&mut self, id: usize, out: &[PathPoint], printed: &[f64]) {
-        self.points = out.iter().filter(|p| p.feature == id).count();
-        self.layers = printed.len();
-        self.thickness = if printed.is_empty() {
-            (0.0, 0.0, 0.0)
-        } else {
-            let (lo, hi, sum) = printed
-                .iter()
-                .fold((f64::INFINITY, 0.0f64, 0.0), |(lo, hi, sum), &t| {
-                    (lo.min(t), hi.max(t), sum + t)
-                });
-            (lo, sum / printed.len() as f64, hi)
-        };
-        if printed.is_empty() {
-            self.warnings.push(format!(
-                "feature {id} has no printable layer (thinner than a bead?)"
-            ));
-        }
-    }
-}
 
 /// The reference plane of a two5d feature: through its healing faces (or build-plate face),
 /// normal pointing into the feature.
@@ -221,30 +133,6 @@ pub fn fill_regions(
         ));
     }
     paths
-}
-
-/// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
-/// chords are what the sections see.
-pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
-    (params.tolerance * 0.25)
-        .min(0.25 * params.uniform_layer_height)
-        .max(1e-3)
-}
-
-/// The mesh of a feature's shell and its voids, at chord tolerance `tol`.
-pub(crate) fn feature_mesh(
-    tree: &FeatureTree,
-    f: &Feature,
-    tol: f64,
-) -> Result<brep::mesh::Mesh, PlanError> {
-    let mut faces = f.faces.clone();
-    for v in &f.voids {
-        faces.extend(v.iter().copied());
-    }
-    mesh_faces(&tree.brep, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
-        id: f.id,
-        msg: e.to_string(),
-    })
 }
 
 /// Plans one two5d feature, appending its points to `out` (travel from `cursor`, which is left at

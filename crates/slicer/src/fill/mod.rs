@@ -1,0 +1,280 @@
+//! Filling one planar layer with extrusion paths.
+//!
+//! A layer's cross-section arrives as closed loops ([`regions_from_loops`] groups them into
+//! [`Region`]s); [`fill_layer`] turns the regions into bead centre lines by the feature's
+//! [`PathMode`], and [`order_paths`] puts them in a print order with short travels.
+//!
+//! Geometry: every bead centre line lies half a bead width or more inside the region, but
+//! for the free ends of raster and zig-zag lines. The first perimeter is the region offset
+//! inward by `width / 2`, each further one by another `spacing`; infill lines are `spacing`
+//! apart and end on the boundary of the infill area (the region offset inward by
+//! `width / 2`, plus `perimeters · spacing` for contour-zig-zag), where connectors join them.
+//! A line end that nothing joins and no ring surrounds (every raster end, the first and last
+//! end of a zig-zag chain) runs on to the region's boundary ([`bead_end_reach`]). Offsets are
+//! Euclidean: around a reflex corner (a hole's polygon, an inner corner) the offset is an
+//! arc, chorded within 1 % of the width, so there a centre line may come that much closer
+//! than `width / 2`; convex corners and straight edges are exact.
+//! Offsets and booleans are i_overlay's (`OutlineOffset`, `overlay`); offsets use its float
+//! arithmetic and are made from contours rid of vertices too flat for its integer grid (the
+//! collinear points a mesh's cross-section has on every chord of a curved face), on which its
+//! construction leaves a spike from the offset out to the boundary. The infill lines are cut
+//! against the (clean, non-self-intersecting) polygons i_overlay returns with an even-odd
+//! scan, which also tells on which boundary ring, and where along it, each line ends — what
+//! zig-zag needs to join neighbouring lines along the boundary.
+//!
+//! Where successive rings leave a strip narrower than a bead uncovered (the middle of a
+//! rectangle whose width is not a multiple of the spacing, the neck between a hole and the
+//! outside), that strip gets a gap-fill line along its length (kind [`PathKind::Infill`]).
+//! Where a part of the region is too narrow for a ring's beads from both sides, or for the
+//! first ring at all, that part is handed back ([`FilledLayer::gaps`]) to be filled with beads
+//! as wide as it is. So contour fills cover the region without laying any of it twice.
+
+mod offset;
+mod order;
+mod pattern;
+mod region;
+
+use crate::geom2d::{area2, dist};
+use crate::params::{LayerParams, PathMode};
+use i_overlay::mesh::float::style::LineJoin;
+use offset::{erode, offset, round_join};
+use pattern::{bounds, drop_short_segments, rings, scan_fill, Reach};
+use region::{region_shapes, shape_region};
+
+pub use crate::geom2d::{Point2, Region};
+pub use offset::thinner_than;
+pub use order::{order_greedy, order_paths};
+pub use region::regions_from_loops;
+
+/// One continuous extrusion path (an open polyline; a closed perimeter repeats its first point
+/// at the end).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Path2 {
+    /// Bead centre line, mm.
+    pub points: Vec<Point2>,
+    /// What the path is.
+    pub kind: PathKind,
+}
+
+/// What a path is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathKind {
+    /// A closed ring following the boundary (perimeters, and every ring of contour fill).
+    Perimeter,
+    /// Raster or zig-zag lines, and gap fill between rings.
+    Infill,
+}
+
+impl Path2 {
+    /// True when the path ends where it starts (a ring).
+    pub fn is_closed(&self) -> bool {
+        self.points.len() > 2 && self.points.first() == self.points.last()
+    }
+
+    /// Length of the polyline, mm.
+    pub fn length(&self) -> f64 {
+        self.points.windows(2).map(|w| dist(w[0], w[1])).sum()
+    }
+}
+
+// i_overlay's nested-vector polygon types.
+type Contour = Vec<Point2>;
+type Shape = Vec<Contour>;
+type Shapes = Vec<Shape>;
+
+/// Coordinates beyond this (mm) are treated as garbage: the loop is dropped.
+const MAX_COORD: f64 = 1e9;
+/// Most scan lines one fill may use (a spacing far too small for the part gives nothing).
+const MAX_LINES: f64 = 1e6;
+/// Most rings contour fill makes.
+const MAX_RINGS: usize = 100_000;
+/// Path segments shorter than this (mm) are dropped: nothing to print.
+const MIN_SEGMENT: f64 = 1e-6;
+
+fn shapes_area(s: &Shapes) -> f64 {
+    s.iter().flatten().map(|c| 0.5 * area2(c)).sum()
+}
+
+/// What one fill call needs to know.
+#[derive(Debug, Clone)]
+struct Ctx {
+    width: f64,
+    spacing: f64,
+    /// Join of inward offsets (arcs at reflex corners).
+    join: LineJoin<f64>,
+    /// How far contour fill's inner rings may be simplified, mm: the feature's tolerance, at
+    /// most 0.25 % of the width (small, because each ring is offset from the simplified one
+    /// before it and the error adds up).
+    tol: f64,
+}
+
+/// Paths filling `regions` for layer number `layer` (for zig-zag angle alternation), bead width
+/// `width`, spacing `spacing` between neighbouring path centre lines.
+///
+/// - raster: lines at `raster_angle_deg`, each a separate path, all printed in the same
+///   direction, cut by the region offset inward by `width / 2` and then run on to the
+///   region's boundary ([`bead_end_reach`]);
+/// - zigzag: the same lines (at `raster_angle_deg + 90°` on odd layers), neighbours within a
+///   connected piece joined by a connector along the infill boundary when no other line ends
+///   on the boundary between them (and the connector is shorter than ten spacings); the
+///   first and last end of each chain run on to the boundary as raster ends do;
+/// - contour: rings offset inward by `width / 2`, `width / 2 + spacing`, ... until nothing is
+///   left, plus gap-fill lines in strips the rings leave uncovered (parts too narrow for a
+///   ring go to [`FilledLayer::gaps`]);
+/// - contour_zigzag: `perimeters` rings, then zig-zag inside the region offset inward by
+///   `width / 2 + perimeters · spacing`.
+///
+/// Rings are [`PathKind::Perimeter`] and closed (first point repeated); lines are
+/// [`PathKind::Infill`]. Paths come region by region, rings outermost first (a gap-fill line
+/// right after the ring it lies inside), infill last; use [`order_paths`] for a print order. No
+/// path has a segment shorter than a micrometre (none of zero length). Degenerate input (no
+/// regions, slivers, a region narrower than a bead, width or spacing not positive) gives fewer
+/// paths or none, never a panic.
+pub fn fill_layer(
+    regions: &[Region],
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+) -> FilledLayer {
+    let mut out = Vec::new();
+    let mut gaps: Shapes = Vec::new();
+    if !(width.is_finite() && width > 0.0 && spacing.is_finite() && spacing > 0.0) {
+        return FilledLayer::default();
+    }
+    let tol = if params.tolerance.is_finite() && params.tolerance > 0.0 {
+        params.tolerance
+    } else {
+        0.05
+    };
+    let base_angle = if params.raster_angle_deg.is_finite() {
+        params.raster_angle_deg
+    } else {
+        0.0
+    };
+    let zigzag_angle = if layer % 2 == 1 {
+        base_angle + 90.0
+    } else {
+        base_angle
+    }
+    .to_radians();
+    for region in regions {
+        let base = region_shapes(region);
+        if base.is_empty() {
+            continue;
+        }
+        // Too many lines or rings for this spacing: the parameters are wrong, fill nothing.
+        let (lo, hi) = bounds(&base);
+        let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+        if size / spacing > MAX_LINES {
+            continue;
+        }
+        // Arcs grow as rings move inward: chord them for the deepest offset this fill makes.
+        let deepest = 0.5 * width
+            + spacing
+                * match params.path_mode {
+                    PathMode::Raster | PathMode::Zigzag => 0.0,
+                    PathMode::Contour => f64::INFINITY,
+                    PathMode::ContourZigzag => params.perimeters as f64,
+                };
+        let ctx = Ctx {
+            width,
+            spacing,
+            join: round_join(tol.min(0.01 * width), deepest.min(0.5 * size)),
+            tol: tol.min(0.0025 * width),
+        };
+        match params.path_mode {
+            PathMode::Raster => {
+                let area = erode(&base, 0.5 * width, &ctx.join);
+                let reach = Some(Reach { base: &base, width });
+                scan_fill(
+                    &area,
+                    base_angle.to_radians(),
+                    spacing,
+                    false,
+                    reach,
+                    &mut out,
+                );
+            }
+            PathMode::Zigzag => {
+                let area = erode(&base, 0.5 * width, &ctx.join);
+                let reach = Some(Reach { base: &base, width });
+                scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
+            }
+            PathMode::Contour => {
+                rings(&base, &ctx, MAX_RINGS, true, &mut out, &mut gaps);
+            }
+            PathMode::ContourZigzag => {
+                let area = rings(
+                    &base,
+                    &ctx,
+                    params.perimeters.min(MAX_RINGS),
+                    false,
+                    &mut out,
+                    &mut gaps,
+                );
+                // Free chain ends run on to the inner edge of the last ring's bead: the
+                // infill area grown back by half a spacing (not the ring itself eroded, which
+                // would take in the strips left to the gaps).
+                let edge = offset(&area, 0.5 * spacing, &ctx.join, 1.0);
+                let reach = Some(Reach { base: &edge, width });
+                scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
+            }
+        }
+    }
+    for p in &mut out {
+        drop_short_segments(&mut p.points);
+    }
+    out.retain(|p| {
+        let n = p.points.len();
+        n >= 2 && (p.kind != PathKind::Perimeter || (n >= 4 && p.is_closed()))
+    });
+    FilledLayer {
+        paths: out,
+        gaps: gaps.into_iter().filter_map(shape_region).collect(),
+    }
+}
+
+/// The paths of a layer's regions, and the strips they leave for beads as wide as each strip.
+#[derive(Debug, Clone, Default)]
+pub struct FilledLayer {
+    /// Paths of one bead width.
+    pub paths: Vec<Path2>,
+    /// Parts of the regions too narrow for a ring (where its beads would meet from both
+    /// sides, or the first ring cannot reach): each is to be filled with beads as wide as it
+    /// is there (`freeform::fill_flat_region`; `planar::fill_regions` does so).
+    pub gaps: Vec<Region>,
+}
+
+/// The part of a bead width by which a free line end stops short of the boundary it runs
+/// towards: a hundredth, so that no print point lies on the boundary
+/// itself.
+pub const END_MARGIN: f64 = 0.01;
+
+/// The most, in bead widths, a free line end runs on past the edge of the infill area: a line
+/// nearly parallel to the boundary meets it only far on.
+pub const MAX_END_REACH: f64 = 4.0;
+
+/// How far (mm) a free line end (one that no connector joins and no ring surrounds: every
+/// raster end, the first and last of a zig-zag chain) runs on past the edge of the infill
+/// area where it was cut, half a bead inside the region, for beads `width` wide: to [`END_MARGIN`] of a bead
+/// before the boundary, which lies `boundary` mm on along the line; no more than `room`
+/// (half the way to the next piece of the same line) nor [`MAX_END_REACH`] beads.
+///
+/// Eq. 1 lays a bead `w` wide and `h` high along its centre line: the line's share of the
+/// region is the strip `w` wide about it, and where a straight boundary cuts that strip, at
+/// any angle, the strip holds `w` times the centre line's length up to the boundary. An end
+/// that stops on the infill area instead leaves `w/2 · w` unfilled at a square end and more
+/// at a slanting one (where a connector joins two ends, it puts that volume down along the
+/// boundary): raster fills lost 2–9 % of a small feature's volume so, and zig-zag fills of
+/// thin blades, whose slanting lines few connectors join, up to 7 %.
+pub fn bead_end_reach(width: f64, boundary: f64, room: f64) -> f64 {
+    let r = (boundary - END_MARGIN * width)
+        .min(MAX_END_REACH * width)
+        .min(room);
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        0.0
+    }
+}

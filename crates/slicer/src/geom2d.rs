@@ -1,0 +1,104 @@
+//! Plane geometry shared by the planar fill ([`crate::fill`]), the region filler of curved and
+//! thin layers and the lattice of [`crate::geodesic`]: points, regions, lengths, areas,
+//! distances to segments and even-odd point-in-polygon tests.
+
+/// A point of the layer plane, mm.
+pub type Point2 = [f64; 2];
+
+/// A region: an outer boundary (counter-clockwise) and holes (clockwise), closed implicitly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Region {
+    /// Outer boundary, counter-clockwise, first point not repeated.
+    pub outer: Vec<Point2>,
+    /// Holes, each clockwise, first point not repeated.
+    pub holes: Vec<Vec<Point2>>,
+}
+
+/// Distance between two points.
+pub(crate) fn dist(a: Point2, b: Point2) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+pub(crate) fn dist2(a: Point2, b: Point2) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Twice the signed area of a closed polygon (positive when counter-clockwise).
+pub(crate) fn area2(pts: &[Point2]) -> f64 {
+    let n = pts.len();
+    if n < 3 {
+        return 0.0;
+    }
+    // Relative to the first point, for accuracy far from the origin.
+    let o = pts[0];
+    let mut s = 0.0;
+    for i in 1..n - 1 {
+        let a = [pts[i][0] - o[0], pts[i][1] - o[1]];
+        let b = [pts[i + 1][0] - o[0], pts[i + 1][1] - o[1]];
+        s += a[0] * b[1] - a[1] * b[0];
+    }
+    s
+}
+
+pub(crate) fn perimeter(pts: &[Point2]) -> f64 {
+    let n = pts.len();
+    (0..n).map(|i| dist(pts[i], pts[(i + 1) % n])).sum()
+}
+
+/// Even-odd point in polygon (points on the boundary may go either way).
+pub(crate) fn inside(p: Point2, poly: &[Point2]) -> bool {
+    let n = poly.len();
+    let mut c = false;
+    let mut j = n.wrapping_sub(1);
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+        {
+            c = !c;
+        }
+        j = i;
+    }
+    c
+}
+
+/// Even-odd inside test against every ring of a region.
+pub fn region_contains(region: &Region, q: Point2) -> bool {
+    let mut inside = false;
+    for ring in std::iter::once(&region.outer).chain(region.holes.iter()) {
+        let n = ring.len();
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if (a[1] > q[1]) != (b[1] > q[1]) {
+                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > q[0] {
+                    inside = !inside;
+                }
+            }
+        }
+    }
+    inside
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+pub(crate) fn seg_dist(p: Point2, a: Point2, b: Point2) -> f64 {
+    dist(p, segment_foot(p, a, b).1)
+}
+
+/// The point of the segment `a`–`b` nearest `p`: its parameter `t` along the segment (0 at
+/// `a`, 1 at `b`; 0 when the segment is a point), the point, and the segment's squared length.
+pub(crate) fn segment_foot(p: Point2, a: Point2, b: Point2) -> (f64, Point2, f64) {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (t, [a[0] + t * d[0], a[1] + t * d[1]], l2)
+}
+
+pub(crate) fn on_boundary(p: Point2, poly: &[Point2], eps: f64) -> bool {
+    let n = poly.len();
+    (0..n).any(|i| seg_dist(p, poly[i], poly[(i + 1) % n]) <= eps)
+}

@@ -1,0 +1,93 @@
+//! Lifting a chart path onto a curved layer: points inserted until every chord is within the
+//! tolerance of the surface, then the ones not needed for that dropped.
+
+use crate::chart::Chart;
+use crate::geodesic::segment_distance;
+use crate::geom2d::Point2;
+use crate::region_fill::FillPath;
+use brep::math::{P3, V3};
+
+/// A lifted path point: chart coordinates, position and unit normal.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Lifted {
+    pub(crate) q: Point2,
+    pub(crate) p: P3,
+    pub(crate) n: V3,
+    /// Bead width here.
+    pub(crate) w: f64,
+}
+
+/// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
+/// is within `tol` of the surface, then dropping points whose removal keeps the polyline
+/// within `tol / 2` of the dense one (Douglas–Peucker in 3-D).
+pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lifted> {
+    fn refine(
+        chart: &Chart,
+        a: Lifted,
+        b: Lifted,
+        z: f64,
+        tol: f64,
+        depth: u32,
+        out: &mut Vec<Lifted>,
+    ) {
+        if depth < 10 {
+            let qm = [0.5 * (a.q[0] + b.q[0]), 0.5 * (a.q[1] + b.q[1])];
+            if let Some((p, n)) = chart.at(qm, z) {
+                let mid = Lifted {
+                    q: qm,
+                    p,
+                    n,
+                    w: 0.5 * (a.w + b.w),
+                };
+                if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
+                    refine(chart, a, mid, z, tol, depth + 1, out);
+                    refine(chart, mid, b, z, tol, depth + 1, out);
+                    return;
+                }
+            }
+        }
+        out.push(b);
+    }
+    let mut dense: Vec<Lifted> = vec![];
+    for (q, w) in path.points.iter().zip(&path.widths) {
+        let Some((p, n)) = chart.at(*q, z) else {
+            continue;
+        };
+        let cur = Lifted { q: *q, p, n, w: *w };
+        match dense.last().copied() {
+            Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
+            None => dense.push(cur),
+        }
+    }
+    if dense.len() <= 2 {
+        return dense;
+    }
+    let mut keep = vec![false; dense.len()];
+    keep[0] = true;
+    keep[dense.len() - 1] = true;
+    let mut stack = vec![(0usize, dense.len() - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let (a, b) = (dense[i].p, dense[j].p);
+        let (mut worst, mut at) = (0.0f64, i);
+        for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
+            let d = segment_distance(&x.p, &a, &b);
+            if d > worst {
+                worst = d;
+                at = k;
+            }
+        }
+        if worst > 0.5 * tol {
+            keep[at] = true;
+            stack.push((i, at));
+            stack.push((at, j));
+        }
+    }
+    dense
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(x, k)| k.then_some(x))
+        .collect()
+}

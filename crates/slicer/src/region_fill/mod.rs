@@ -1,0 +1,499 @@
+//! Filling one region of a layer, curved (in the chart of its reference surface) or planar
+//! (thin regions and the strips rings leave): rings and lines as iso-lines of geodesic
+//! distances on the layer surface ([`crate::geodesic`]), gap fill of strips too narrow for a
+//! bead ([`gap`]), spurs into sharp corners ([`spurs`]), zig-zag connectors along the infill
+//! boundary ([`border`]).
+
+mod border;
+mod gap;
+mod spurs;
+#[cfg(test)]
+mod tests;
+
+use crate::chart::Chart;
+use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
+use crate::geom2d::{Point2, Region};
+use crate::params::{LayerParams, PathMode};
+use border::Border;
+use brep::math::{P3, V3};
+use brep::surface::Surface;
+use gap::{crossing_vertices, gap_fill, ridge_for, Gap};
+
+pub(crate) use spurs::corner_spurs;
+
+/// One path of a curved layer in chart coordinates (or of a planar layer in its plane's),
+/// with the bead width at each point.
+#[derive(Debug, Clone, Default)]
+pub struct FillPath {
+    /// Bead centre line.
+    pub points: Vec<Point2>,
+    /// Bead width at each point, mm.
+    pub widths: Vec<f64>,
+}
+
+impl FillPath {
+    /// A path of one bead width throughout.
+    pub fn uniform(points: Vec<Point2>, width: f64) -> Self {
+        let widths = vec![width; points.len()];
+        FillPath { points, widths }
+    }
+
+    /// The same path run the other way.
+    pub fn reverse(&mut self) {
+        self.points.reverse();
+        self.widths.reverse();
+    }
+}
+
+/// Paths of a region of a planar layer (in its plane's 2-D coordinates) filled as the regions
+/// of curved layers are: rings and raster lines as iso-lines of the exact distance to the
+/// boundary, where rings leave a strip narrower than a bead a gap fill as wide as the strip
+/// at each point, and spurs into sharp corners. The planar planner fills its thin regions so
+/// (a blade's or a rib's section), where offsetting rings of one width would overlap their
+/// own beads or drop what is narrower than a bead.
+///
+/// `boundary` says what the region's boundary is: the part's surface, which a bead's middle
+/// stays a tenth of a bead inside in a region too thin for a ring, or the edge of beads laid
+/// around it (a strip rings leave), which the beads may reach within a fiftieth.
+pub fn fill_flat_region(
+    region: &Region,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+    boundary: Boundary,
+) -> Vec<FillPath> {
+    let plane = Surface::Plane {
+        frame: brep::math::Frame::world(P3::origin()),
+    };
+    // The plane's own (u, v) at scale 1 is the identity on the layer's 2-D coordinates.
+    let chart = Chart::unit(&plane);
+    let sliver_inset = match boundary {
+        Boundary::Part => SLIVER_INSET,
+        Boundary::Beads => GAP_INSET,
+    } * width;
+    let mut paths = fill_region(
+        &chart,
+        region,
+        0.0,
+        params,
+        layer,
+        width,
+        spacing,
+        sliver_inset,
+    );
+    paths.extend(corner_spurs(&chart, region, 0.0, width));
+    paths.retain(|p| p.points.len() >= 2);
+    paths
+}
+
+/// What bounds a region filled by [`fill_flat_region`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Boundary {
+    /// The part's surface (a layer's section).
+    Part,
+    /// The edges of beads laid around it (a strip the rings of `fill::fill_layer` leave).
+    Beads,
+}
+
+/// How far inside a region too thin for a ring its gap fill's bead middles stay, in bead
+/// widths, where the boundary is the part's: clear of the region's sampling error.
+pub(crate) const SLIVER_INSET: f64 = 0.1;
+/// The same where the boundary is a bead's edge (or the strip the last ring leaves).
+const GAP_INSET: f64 = 0.02;
+
+/// Paths of one region of a curved layer at offset `z`, in chart coordinates. Where the region
+/// is too thin for a ring, the gap fill's bead middles stay `sliver_inset` inside it.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fill_region(
+    chart: &Chart,
+    region: &Region,
+    z: f64,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+    sliver_inset: f64,
+) -> Vec<FillPath> {
+    let mut out = vec![];
+    let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
+    if lm.tris.is_empty() {
+        return out;
+    }
+    let mut pts = Vec::with_capacity(lm.q.len());
+    for q in &lm.q {
+        match chart.at(*q, z) {
+            Some((p, _)) => pts.push(p),
+            None => return out,
+        }
+    }
+    lm.p = pts;
+    // Exact distances (to the lifted boundary) three spacings deep: the rings of the default
+    // contour-zig-zag, the infill's edge and a thin blade's ridge all lie there, so they do
+    // not depend on how well the front is marched over the lattice.
+    let db = lm.march(&lm.boundary_seeds(SEED_DEPTH * spacing));
+    let (deep, dmax) = db.iter().enumerate().filter(|(_, d)| d.is_finite()).fold(
+        (0usize, 0.0f64),
+        |a, (i, &d)| if d > a.1 { (i, d) } else { a },
+    );
+    // Rings: iso-lines of the distance to the boundary, half a bead in, then a spacing apart.
+    // Where the region is too narrow for a ring's bead and its mirror image from the other
+    // side (the ridge of the distance, the region's half width R there, is less than the
+    // ring's inner bead edge), the ring narrows to what is left between its outer bead edge
+    // and the ridge, `R − (c − w/2)`, extruded for that width by Eq. 1: the two sides then
+    // put down the strip's volume instead of overlapping (a blade section 0.8 mm wide took
+    // two full 0.45 mm beads). Where what is left is wider than a bead by less than the gap
+    // fill's narrowest bead, the ring widens to take it. A ring less than a tenth of a bead
+    // below the deepest point is left out.
+    let rings = match params.path_mode {
+        PathMode::Raster | PathMode::Zigzag => 0,
+        PathMode::Contour => usize::MAX,
+        PathMode::ContourZigzag => params.perimeters,
+    };
+    let levels: Vec<f64> = (0..rings)
+        .map(|j| 0.5 * width + j as f64 * spacing)
+        .take_while(|c| *c <= dmax - 0.1 * width)
+        .collect();
+    let gap_inset = 0.02 * width;
+    // The ridge is needed only where the rings' iso-lines and the gap fills between them run:
+    // at both ends of each lattice edge those levels cross.
+    let ridge = if levels.is_empty() {
+        vec![]
+    } else {
+        let wanted: Vec<f64> = levels
+            .iter()
+            .copied()
+            .chain(levels.iter().skip(1).map(|c| c - 0.5 * width + gap_inset))
+            .collect();
+        let mask = crossing_vertices(&lm, &db, &wanted);
+        lm.local_max(&db, 1.5 * spacing, &mask)
+    };
+    let mut last_ring = None;
+    for (j, &c) in levels.iter().enumerate() {
+        let edge = c - 0.5 * width;
+        if j > 0 {
+            // Where this ring does not reach (the region's half width is under `c` there),
+            // the strip the ring before leaves along the ridge gets its gap fill.
+            let gap = Gap {
+                edge,
+                inset: gap_inset,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: c,
+            };
+            out.extend(gap_fill(&lm, &db, &ridge, gap, width));
+        }
+        for line in lm.iso_lines(&db, c, &ridge) {
+            let widths = line
+                .other
+                .iter()
+                .map(|r| {
+                    let room = r - edge;
+                    if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
+                        room.max(0.2 * width)
+                    } else {
+                        width
+                    }
+                })
+                .collect();
+            out.push(FillPath {
+                points: line.q,
+                widths,
+            });
+        }
+        last_ring = Some(c);
+    }
+    // Infill where the rings stop: lines end a spacing past the last ring, joined along that
+    // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
+    // the rings leave only a strip narrower than that (a thin blade), the lines cross the strip
+    // from the edge of the last ring's bead instead, filling the gap.
+    // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
+    // it), within what that core holds.
+    let core_fill = |gap: Gap| {
+        let ridge = ridge_for(&lm, &db, gap, spacing);
+        conserved(
+            gap_fill(&lm, &db, &ridge, gap, width),
+            &lm,
+            &db,
+            gap.edge,
+            |a, b| surface_length(chart, z, a, b),
+        )
+    };
+    let inner = match last_ring {
+        Some(c) if dmax > c + 1.5 * spacing => c + spacing,
+        Some(c) => {
+            // The strip along the ridge that the last ring's bead leaves.
+            let edge = c + 0.5 * width;
+            let gap = Gap {
+                edge,
+                inset: GAP_INSET * width,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: f64::INFINITY,
+            };
+            out.extend(core_fill(gap));
+            return out;
+        }
+        // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
+        // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
+        // inside it, down to a fifth of a bead wide.
+        None if rings > 0 || dmax <= 0.5 * width => {
+            let gap = Gap {
+                edge: 0.0,
+                inset: sliver_inset,
+                min_width: 0.2 * width,
+                below: f64::INFINITY,
+            };
+            out.extend(core_fill(gap));
+            return out;
+        }
+        None => 0.5 * width,
+    };
+    let zig = params.path_mode != PathMode::Raster;
+    let angle = if zig && layer % 2 == 1 {
+        params.raster_angle_deg + 90.0
+    } else {
+        params.raster_angle_deg
+    }
+    .to_radians();
+    let dir = [angle.cos(), angle.sin()];
+    let nrm = [-dir[1], dir[0]];
+    // The seed curve: the chart line along `dir` through the deepest point; the field is the
+    // signed geodesic distance to it, so its iso-lines are geodesic parallels.
+    let q0 = lm.q[deep];
+    let l: Vec<f64> =
+        lm.q.iter()
+            .map(|q| (q[0] - q0[0]) * nrm[0] + (q[1] - q0[1]) * nrm[1])
+            .collect();
+    // Vertices within a spacing of the seed line start at their distance across it: the
+    // chart offset times the surface's stretch across the line there, i.e. the part of the
+    // surface step along the chart normal that is square to the line's own surface direction
+    // (a sheared chart does not map the chart normal to the surface normal of the line).
+    let stretch = {
+        let e = 1e-3;
+        let step = |d: [f64; 2]| -> Option<V3> {
+            let a = chart.at([q0[0] + e * d[0], q0[1] + e * d[1]], z)?.0;
+            let b = chart.at([q0[0] - e * d[0], q0[1] - e * d[1]], z)?.0;
+            Some((a - b) / (2.0 * e))
+        };
+        match (step(dir), step(nrm)) {
+            (Some(t), Some(n)) if t.norm() > 1e-12 => {
+                let t = t / t.norm();
+                (n - t * n.dot(&t)).norm()
+            }
+            _ => 1.0,
+        }
+    };
+    let seeds: Vec<(u32, f64)> = l
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.abs() * stretch <= spacing)
+        .map(|(i, x)| (i as u32, x.abs() * stretch))
+        .collect();
+    let dist = lm.march(&seeds);
+    let phi: Vec<f64> = dist
+        .iter()
+        .zip(&l)
+        .map(|(d, l)| if *l < 0.0 { -d } else { *d })
+        .collect();
+    // The infill's area: inside the inner edge of the last ring's bead (half a spacing short
+    // of the infill boundary), or the whole region without rings.
+    let edge = if last_ring.is_some() {
+        inner - 0.5 * spacing
+    } else {
+        0.0
+    };
+    let Some((lo, hi)) = level_span(&lm, &phi, &db, edge) else {
+        return out;
+    };
+    if (hi - lo) / spacing > 1e5 {
+        return out;
+    }
+    // Lines a whole number of spacings across the infill area, centred on it: the spacing
+    // and the bead width with it (Eq. 1 extrudes for that width) stretch or shrink so that
+    // the beads' strips fill the area's extent across the lines exactly, as a planar
+    // slicer's solid infill does. At the nominal spacing a region a few beads across kept a
+    // strip up to a spacing wide unfilled beside its outer lines (7–10 % of a small boss's
+    // layer).
+    let n = ((hi - lo) / spacing).round().max(1.0);
+    let step = (hi - lo) / n;
+    let width = width * step / spacing;
+    if width < 0.2 * spacing {
+        return out;
+    }
+    let spacing = step;
+    let (j0, j1) = (0i64, n as i64 - 1);
+    // A line end with no connector to meet runs on to the boundary, or inside rings to the
+    // inner edge of the last ring's bead, so the line's strip of the region is filled up to
+    // it (`fill::bead_end_reach`, as on planar layers): every raster end, and the two free
+    // ends of each zig-zag chain.
+    let reach = RunOn { width, edge };
+    let mut pieces: Vec<(i64, Piece)> = vec![];
+    for j in j0..=j1 {
+        let level = lo + (j as f64 + 0.5) * spacing;
+        for line in lm.iso_lines(&phi, level, &db) {
+            let len = |a, b| surface_length(chart, z, a, b);
+            let mut cut = clip_reaching(&line, inner, reach, len);
+            if cut.is_empty() {
+                // A line beside the infill boundary's reach (in a small area, or one
+                // narrowing to a corner) crosses only the band between the last ring's bead
+                // and the boundary where connectors run: it fills its strip of that band
+                // from edge to edge, on its own.
+                cut = clip_reaching(&line, edge + crate::fill::END_MARGIN * width, reach, len);
+            }
+            for piece in cut {
+                let (a, b) = (piece.body[0], piece.body[piece.body.len() - 1]);
+                let piece = if (b[0] - a[0]) * dir[0] + (b[1] - a[1]) * dir[1] < 0.0 {
+                    piece.reversed()
+                } else {
+                    piece
+                };
+                pieces.push((j, piece));
+            }
+        }
+    }
+    if !zig {
+        out.extend(
+            pieces
+                .into_iter()
+                .map(|(_, p)| FillPath::uniform(p.reaching(), width)),
+        );
+        return out;
+    }
+    // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
+    // infill boundary (the iso-line where the lines were cut), when that way is short.
+    let border = lm.iso_lines(&db, inner, &db);
+    let along = Border::new(&border);
+    let mut used = vec![false; pieces.len()];
+    for s in 0..pieces.len() {
+        if used[s] {
+            continue;
+        }
+        used[s] = true;
+        let first = &pieces[s].1;
+        let (mut level, mut pts) = (pieces[s].0, first.body.clone());
+        pts.splice(0..0, first.head.iter().copied());
+        let mut tail = first.tail.clone();
+        loop {
+            let end = pts[pts.len() - 1];
+            let mut best: Option<(f64, usize, bool, Vec<Point2>)> = None;
+            for (i, (lv, p)) in pieces.iter().enumerate() {
+                if used[i] || *lv != level + 1 {
+                    continue;
+                }
+                let p = &p.body;
+                for (rev, q) in [(false, p[0]), (true, p[p.len() - 1])] {
+                    if let Some((len, way)) = along.connect(end, q, 2.5 * spacing) {
+                        if best.as_ref().is_none_or(|b| len < b.0) {
+                            best = Some((len, i, rev, way));
+                        }
+                    }
+                }
+            }
+            match best {
+                Some((_, i, rev, way)) => {
+                    used[i] = true;
+                    let next = if rev {
+                        pieces[i].1.clone().reversed()
+                    } else {
+                        pieces[i].1.clone()
+                    };
+                    pts.extend(way);
+                    pts.extend(next.body);
+                    tail = next.tail;
+                    level += 1;
+                }
+                None => break,
+            }
+        }
+        pts.extend(tail);
+        out.push(FillPath::uniform(pts, width));
+    }
+    out
+}
+
+/// The range of `phi` over the part of the lattice where `db` is at least `edge`, with the
+/// crossings of that level on the lattice's edges interpolated.
+fn level_span(lm: &LayerMesh, phi: &[f64], db: &[f64], edge: f64) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut take = |x: f64| {
+        if x.is_finite() {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    };
+    for t in &lm.tris {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let (da, db_) = (db[a], db[b]);
+            if da >= edge {
+                take(phi[a]);
+            }
+            if (da - edge) * (db_ - edge) < 0.0 {
+                let s = (edge - da) / (db_ - da);
+                take(phi[a] + (phi[b] - phi[a]) * s);
+            }
+        }
+    }
+    (lo < hi).then_some((lo, hi))
+}
+
+/// Gap fill of the whole core a region's rings leave (or of a region too thin for a ring),
+/// its widths scaled down where they would put down more than the core holds. The ridge
+/// height a gap fill takes as its width is right along a strip, whose two flanks meet at the
+/// ridge, but not where the core is compact (a small boss's square core, whose flanks are
+/// all four sides): there each side took the whole half width and the loop laid the core
+/// twice over (+5 % on a 3 mm pin). The core's area on the layer surface is exact (the
+/// lattice's triangles clipped at the core's edge), and so is each bead's strip by Eq. 1.
+fn conserved(
+    mut paths: Vec<FillPath>,
+    lm: &LayerMesh,
+    db: &[f64],
+    edge: f64,
+    len: impl Fn(Point2, Point2) -> f64,
+) -> Vec<FillPath> {
+    let covered: f64 = paths
+        .iter()
+        .map(|p| {
+            (1..p.points.len())
+                .map(|i| {
+                    let l = len(p.points[i - 1], p.points[i]);
+                    if l.is_finite() {
+                        0.5 * (p.widths[i - 1] + p.widths[i]) * l
+                    } else {
+                        0.0
+                    }
+                })
+                .sum::<f64>()
+        })
+        .sum();
+    let held = lm.area_above(db, edge);
+    if covered > held && covered > 0.0 {
+        let k = held / covered;
+        for p in &mut paths {
+            for w in &mut p.widths {
+                *w *= k;
+            }
+        }
+    }
+    paths
+}
+
+/// The length on the layer surface at `d` of the chart segment `a`–`b` (its chord there).
+fn surface_length(chart: &Chart, d: f64, a: Point2, b: Point2) -> f64 {
+    match (chart.at(a, d), chart.at(b, d)) {
+        (Some((p, _)), Some((q, _))) => (q - p).norm(),
+        _ => f64::NAN,
+    }
+}
+
+/// The narrowest gap fill between rings, in bead widths: a ring with less than this left
+/// beyond its bead widens to take it.
+const GAP_MIN_WIDTH_SHARE: f64 = 0.1;
+
+/// Distances to a layer region's boundary are exact (not marched) this many spacings deep.
+const SEED_DEPTH: f64 = 3.0;
+
+/// [`crate::fill::order_paths`] for paths that carry their bead widths.
+pub(crate) fn order_fill_paths(paths: Vec<FillPath>, start: Point2) -> Vec<FillPath> {
+    let paths = paths.into_iter().filter(|p| p.points.len() >= 2).collect();
+    crate::fill::order_greedy(paths, start, |p| &p.points, FillPath::reverse)
+}
