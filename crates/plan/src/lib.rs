@@ -16,6 +16,7 @@ pub mod report;
 pub use process::{Process, ProcessError};
 pub use report::{FeatureEntry, FeatureReport, PlanReport};
 
+use brep::math::P3;
 use features::{extract_all, ExtractOptions, FeatureKind};
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
@@ -23,6 +24,7 @@ use robot_post::{Job, PostFigures, ProgramFile};
 use slicer::freeform::plan_freeform;
 use slicer::orient::{smooth, OrientationFigures};
 use slicer::planar::plan_two5d;
+use slicer::sequence;
 use slicer::toolpath::ToolPath;
 use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
 
@@ -129,8 +131,8 @@ pub fn plan(
         features: trees.iter().map(|t| t.features.len() as u64).sum(),
     });
 
-    let mut points = vec![];
-    let mut cursor = None;
+    let mut plans = vec![];
+    let mut cursor: Option<P3> = None;
     let mut reports = vec![];
     let mut warnings: Vec<String> = vec![];
     let mut offset = 0usize;
@@ -145,20 +147,12 @@ pub fn plan(
             let id = offset + f.id;
             tell(Progress::Feature { id });
             let params = process.params_for(&base, id)?;
-            let start = points.len();
-            let (fig, freeform) = match f.kind {
-                FeatureKind::Two5d => (
-                    plan_two5d(t, f, &params, bead, &mut points, &mut cursor)?,
-                    None,
-                ),
-                FeatureKind::Freeform => {
-                    let (fig, ff) = plan_freeform(t, f, &params, bead, &mut points, &mut cursor)?;
-                    (fig, Some(ff))
-                }
+            let plan = match f.kind {
+                FeatureKind::Two5d => plan_two5d(t, f, &params, bead, cursor)?,
+                FeatureKind::Freeform => plan_freeform(t, f, &params, bead, cursor)?,
             };
-            for p in &mut points[start..] {
-                p.feature = id;
-            }
+            cursor = plan.exit().map(P3::from).or(cursor);
+            let fig = &plan.figures;
             let extruded = fig.filament * filament_area;
             planned.push(PlannedFeature {
                 id,
@@ -173,9 +167,9 @@ pub fn plan(
             // feature, planned or not (a planar layer starts at its reference plane, so what
             // lies below that is not printed).
             if let Some(plate) = &plate {
-                let planned = points[start..]
-                    .iter()
-                    .map(|q| -plate.height(&brep::math::P3::from(q.p)))
+                let planned = plan
+                    .points()
+                    .map(|q| -plate.height(&P3::from(q.p)))
                     .fold(0.0f64, f64::max);
                 let depth = planned.max(slicer::planar::depth_below(t, f, plate));
                 if depth > 1e-3 {
@@ -187,14 +181,14 @@ pub fn plan(
             reports.push(FeatureReport {
                 feature: FeatureEntry::new(t, f, offset),
                 layers: fig.layers,
-                points: points.len() - start,
+                points: fig.points,
                 print_length_mm: round(fig.print_length, 1e3),
                 travel_length_mm: round(fig.travel_length, 1e3),
                 extruded_volume_mm3: round(extruded, 1e3),
                 thickness_min_mm: round(fig.thickness.0, 1e6),
                 thickness_mean_mm: round(fig.thickness.1, 1e6),
                 thickness_max_mm: round(fig.thickness.2, 1e6),
-                freeform: freeform.map(|ff| FreeformEntry {
+                freeform: plan.freeform.map(|ff| FreeformEntry {
                     chart: ff.chart.to_string(),
                     overhang_points: ff.overhang_points,
                     concave_radius_mm: ff
@@ -206,13 +200,15 @@ pub fn plan(
                 orientation: None,
                 post: None,
             });
+            plans.push((id, plan));
             tell(Progress::FeatureDone);
         }
         offset += t.features.len();
     }
     warnings.extend(assembly.all_warnings());
     tell(Progress::Planned);
-    let mut toolpath = ToolPath { points };
+    // One tool path, features in build order with their file-wide ids.
+    let mut toolpath = sequence(plans);
     // Orientation smoothing between planning and posting.
     let orientation = smooth(&mut toolpath, &process.orientation);
     for r in &mut reports {

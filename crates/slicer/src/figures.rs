@@ -1,7 +1,5 @@
 //! Figures of a planned feature (layers, points, lengths, filament), shared by the planners.
 
-use crate::toolpath::PathPoint;
-
 /// Figures of one planned feature.
 #[derive(Debug, Clone, Default)]
 pub struct FeatureFigures {
@@ -22,10 +20,10 @@ pub struct FeatureFigures {
 }
 
 impl FeatureFigures {
-    /// Closes feature `id`'s figures: its points in `out`, and its layers from the thicknesses
-    /// of the layers that printed (thinnest, mean, thickest; zeros and a warning when none did).
-    pub(crate) fn finish(&mut self, id: usize, out: &[PathPoint], printed: &[f64]) {
-        self.points = out.iter().filter(|p| p.feature == id).count();
+    /// Closes feature `id`'s figures: its `points`, and its layers from the thicknesses of the
+    /// layers that printed (thinnest, mean, thickest; zeros and a warning when none did).
+    pub(crate) fn finish(&mut self, id: usize, points: usize, printed: &[f64]) {
+        self.points = points;
         self.layers = printed.len();
         self.thickness = if printed.is_empty() {
             (0.0, 0.0, 0.0)
@@ -43,4 +41,21 @@ impl FeatureFigures {
             ));
         }
     }
+}
+
+/// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FreeformFigures {
+    /// `native` (the surface's parameters) or `projection` (tangent-plane chart).
+    pub chart: &'static str,
+    /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
+    /// when it curves away from the feature everywhere).
+    pub concave_radius: f64,
+    /// Print points with nothing under them: on layer k ≥ 2 more than half a bead outside
+    /// layer k−1's region, or on layer 1 over the reference surface's continuation past its
+    /// face (overhangs the reference surface's offsets cannot avoid, e.g. a wall leaning
+    /// over the reference).
+    pub overhang_points: usize,
+    /// First and last layer (1-based) with such points.
+    pub overhang_layers: Option<(usize, usize)>,
 }

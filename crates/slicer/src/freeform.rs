@@ -32,7 +32,9 @@
 use crate::chart::{choose_chart, mapped_mesh, refined, MAX_MAPPED_EDGE};
 use crate::error::PlanError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 use crate::figures::FeatureFigures;
+pub use crate::figures::FreeformFigures;
 use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
@@ -48,23 +50,6 @@ use rayon::prelude::*;
 
 pub use crate::chart::{Chart, ChartKind};
 pub use crate::region_fill::{fill_flat_region, Boundary, FillPath};
-
-/// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FreeformFigures {
-    /// `native` (the surface's parameters) or `projection` (tangent-plane chart).
-    pub chart: &'static str,
-    /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
-    /// when it curves away from the feature everywhere).
-    pub concave_radius: f64,
-    /// Print points with nothing under them: on layer k ≥ 2 more than half a bead outside
-    /// layer k−1's region, or on layer 1 over the reference surface's continuation past its
-    /// face (overhangs the reference surface's offsets cannot avoid, e.g. a wall leaning
-    /// over the reference).
-    pub overhang_points: usize,
-    /// First and last layer (1-based) with such points.
-    pub overhang_layers: Option<(usize, usize)>,
-}
 
 /// Whether chart point `q` lies in one of `regions` or within `reach` (chart units) of one.
 fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
@@ -83,16 +68,17 @@ fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
     })
 }
 
-/// Plans one freeform feature on offsets of its reference surface, appending its points to
-/// `out` (travel from `cursor`, which is left at the last point).
+/// Plans one freeform feature on offsets of its reference surface; its first travel starts at
+/// `entry` (where the nozzle is, if anywhere).
 pub fn plan_freeform(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
     bead: Bead,
-    out: &mut Vec<PathPoint>,
-    cursor: &mut Option<P3>,
-) -> Result<(FeatureFigures, FreeformFigures), PlanError> {
+    entry: Option<P3>,
+) -> Result<FeaturePlan, PlanError> {
+    let mut cursor = entry;
+    let cursor = &mut cursor;
     let id = f.id;
     let err = |msg: String| PlanError::Freeform { id, msg };
     if f.kind != FeatureKind::Freeform {
@@ -158,6 +144,7 @@ pub fn plan_freeform(
     };
     let mut prev_regions: Vec<Region> = vec![];
     let mut printed_layers = vec![];
+    let mut layers = vec![];
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -214,7 +201,7 @@ pub fn plan_freeform(
         } else {
             order_fill_paths(paths, start)
         };
-        let mut printed = false;
+        let mut layer_paths: Vec<LayerPath> = vec![];
         for path in paths {
             let pts = lift(&chart, &path, z, params.tolerance);
             if pts.len() < 2 {
@@ -236,7 +223,7 @@ pub fn plan_freeform(
                     });
                 }
             }
-            printed = true;
+            let mut out = LayerPath::default();
             let axis = |n: V3| {
                 let a = fixed.unwrap_or(n);
                 [a.x, a.y, a.z]
@@ -268,7 +255,7 @@ pub fn plan_freeform(
                 if let Some(c) = *cursor {
                     fig.travel_length += (p - c).norm();
                 }
-                out.push(PathPoint {
+                out.travel.push(PathPoint {
                     feature: id,
                     layer,
                     kind: MoveKind::Travel,
@@ -286,7 +273,7 @@ pub fn plan_freeform(
                 let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
-                out.push(PathPoint {
+                out.print.push(PathPoint {
                     feature: id,
                     layer,
                     kind: MoveKind::Print,
@@ -298,17 +285,34 @@ pub fn plan_freeform(
                 });
             }
             *cursor = pts.last().map(|x| x.p);
+            layer_paths.push(out);
         }
-        if printed {
+        if !layer_paths.is_empty() {
             printed_layers.push(dl);
+            layers.push(Layer {
+                index: layer,
+                thickness: dl,
+                surface: LayerSurface::Offset { offset: z },
+                paths: layer_paths,
+            });
         }
     }
-    fig.finish(id, out, &printed_layers);
+    let points = layers
+        .iter()
+        .flat_map(|l| &l.paths)
+        .map(|p| p.travel.len() + p.print.len())
+        .sum();
+    fig.finish(id, points, &printed_layers);
     if let Some((a, b)) = ff.overhang_layers {
         fig.warnings.push(format!(
             "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
             ff.overhang_points
         ));
     }
-    Ok((fig, ff))
+    Ok(FeaturePlan {
+        feature: f.id,
+        layers,
+        figures: fig,
+        freeform: Some(ff),
+    })
 }

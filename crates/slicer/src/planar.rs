@@ -18,6 +18,7 @@ use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
 pub use crate::error::PlanError;
+use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FeatureFigures;
 pub use toolpath::Bead;
 
@@ -135,16 +136,16 @@ pub fn fill_regions(
     paths
 }
 
-/// Plans one two5d feature, appending its points to `out` (travel from `cursor`, which is left at
-/// the last point).
+/// Plans one two5d feature in planar layers; its first travel starts at `entry` (where the
+/// nozzle is, if anywhere).
 pub fn plan_two5d(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
     bead: Bead,
-    out: &mut Vec<PathPoint>,
-    cursor: &mut Option<P3>,
-) -> Result<FeatureFigures, PlanError> {
+    entry: Option<P3>,
+) -> Result<FeaturePlan, PlanError> {
+    let mut cursor = entry;
     if f.kind != FeatureKind::Two5d {
         return Err(PlanError::NotTwo5d(f.id));
     }
@@ -163,6 +164,7 @@ pub fn plan_two5d(
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
     let mut fig = FeatureFigures::default();
     let mut printed = vec![];
+    let mut layers = vec![];
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
     // ordered and joined by travel one layer after the other.
     let mut tops = Vec::with_capacity(heights.len());
@@ -191,14 +193,16 @@ pub fn plan_two5d(
             continue;
         }
         printed.push(dl);
+        let mut layer_paths = Vec::with_capacity(paths.len());
         for path in paths {
             let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
             let Some(first) = pts.first() else { continue };
             // Travel to the start of the path.
-            if let Some(c) = *cursor {
+            if let Some(c) = cursor {
                 fig.travel_length += (first - c).norm();
             }
-            out.push(PathPoint {
+            let mut out = LayerPath::default();
+            out.travel.push(PathPoint {
                 feature: f.id,
                 layer,
                 kind: MoveKind::Travel,
@@ -215,7 +219,7 @@ pub fn plan_two5d(
                 let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
-                out.push(PathPoint {
+                out.print.push(PathPoint {
                     feature: f.id,
                     layer,
                     kind: MoveKind::Print,
@@ -226,9 +230,26 @@ pub fn plan_two5d(
                     width: path.widths[i + 1],
                 });
             }
-            *cursor = pts.last().copied();
+            cursor = pts.last().copied();
+            layer_paths.push(out);
         }
+        layers.push(Layer {
+            index: layer,
+            thickness: dl,
+            surface: LayerSurface::Plane {
+                normal: axis,
+                height: z,
+            },
+            paths: layer_paths,
+        });
     }
-    fig.finish(f.id, out, &printed);
-    Ok(fig)
+    let mut plan = FeaturePlan {
+        feature: f.id,
+        layers,
+        figures: fig,
+        freeform: None,
+    };
+    let points = plan.points().count();
+    plan.figures.finish(f.id, points, &printed);
+    Ok(plan)
 }

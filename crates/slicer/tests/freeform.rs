@@ -122,10 +122,23 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
         if f.kind != FeatureKind::Freeform {
             continue;
         }
-        let mut pts = vec![];
-        let mut cursor = None;
-        let (fig, ff) = plan_freeform(&t, f, params, BEAD, &mut pts, &mut cursor)
+        let plan = plan_freeform(&t, f, params, BEAD, None)
             .unwrap_or_else(|e| panic!("{name} feature {k}: {e}"));
+        let pts: Vec<PathPoint> = plan.points().copied().collect();
+        let (fig, ff) = (&plan.figures, plan.freeform.expect("freeform figures"));
+        assert_eq!(fig.points, pts.len(), "{name} feature {k}");
+        assert_eq!(fig.layers, plan.layers.len(), "{name} feature {k}");
+        for l in &plan.layers {
+            assert!(
+                !l.paths.is_empty(),
+                "{name} feature {k}: layer {} without paths",
+                l.index
+            );
+            assert!(l.paths.iter().all(|p| p
+                .print
+                .iter()
+                .all(|q| q.layer == l.index && q.thickness == l.thickness)));
+        }
         let rf = f.reference.face.expect("reference face");
         let surf = t.brep.face_surface(rf);
         let mesh = mesh_of(&t, k);
@@ -339,18 +352,8 @@ fn every_path_mode_keeps_points_on_the_offsets_and_inside() {
 #[test]
 fn a_two5d_feature_is_refused_by_the_freeform_planner() {
     let t = tree("capsule");
-    let mut pts = vec![];
-    let e = plan_freeform(
-        &t,
-        &t.features[0],
-        &LayerParams::default(),
-        BEAD,
-        &mut pts,
-        &mut None,
-    )
-    .unwrap_err();
+    let e = plan_freeform(&t, &t.features[0], &LayerParams::default(), BEAD, None).unwrap_err();
     assert!(matches!(e, PlanError::Freeform { id: 0, .. }), "{e}");
-    assert!(pts.is_empty());
 }
 
 #[test]
@@ -360,10 +363,9 @@ fn a_fixed_tool_axis_holds_on_every_point_of_the_curved_layers() {
         fixed_tool_axis: Some([0.0, 0.0, 2.0]),
         ..LayerParams::default()
     };
-    let mut pts = vec![];
-    plan_freeform(&t, &t.features[2], &params, BEAD, &mut pts, &mut None).expect("plans");
-    assert!(pts.len() > 100);
-    for p in &pts {
+    let plan = plan_freeform(&t, &t.features[2], &params, BEAD, None).expect("plans");
+    assert!(plan.points().count() > 100);
+    for p in plan.points() {
         assert_eq!(p.axis, [0.0, 0.0, 1.0]);
     }
 }

@@ -1,0 +1,141 @@
+//! What a planner returns for one feature: its [`Layer`]s of bead paths, the surface each lies
+//! on and the feature's figures (as libslic3r's `Layer` → `ExtrusionEntity`). [`sequence`] joins
+//! the features' plans into the one [`ToolPath`] the posts read.
+
+use crate::figures::{FeatureFigures, FreeformFigures};
+use crate::toolpath::{PathPoint, ToolPath};
+
+/// The surface a layer's beads are laid on (their top, where the nozzle tip runs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LayerSurface {
+    /// A plane parallel to the feature's reference plane, `height` mm above it along `normal`.
+    Plane {
+        /// The reference plane's unit normal, into the feature.
+        normal: [f64; 3],
+        /// Height above the reference plane, mm.
+        height: f64,
+    },
+    /// The feature's reference surface offset by `offset` mm along its unit normal (feature-based
+    /// AM paper: offset surfaces `S_k(q) = S(q) + z_k·N(q)`).
+    Offset {
+        /// The offset `z_k`, mm.
+        offset: f64,
+    },
+}
+
+/// One bead path of a layer: the travel that reaches its start, then the beads it lays.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LayerPath {
+    /// Travel points, the last one the path's start.
+    pub travel: Vec<PathPoint>,
+    /// Print points: each lays a bead from the point before it.
+    pub print: Vec<PathPoint>,
+}
+
+/// One layer of a feature that prints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layer {
+    /// Index of the layer in its feature, from 0 at the reference (layers that print nothing
+    /// leave gaps in the numbering).
+    pub index: usize,
+    /// Thickness `Δl`, mm.
+    pub thickness: f64,
+    /// Where its beads are laid.
+    pub surface: LayerSurface,
+    /// Its paths in print order.
+    pub paths: Vec<LayerPath>,
+}
+
+/// The plan of one feature: its layers in print order and its figures.
+#[derive(Debug, Clone)]
+pub struct FeaturePlan {
+    /// The feature's index in its tree.
+    pub feature: usize,
+    /// The layers that print, bottom up.
+    pub layers: Vec<Layer>,
+    /// Lengths, filament, layer thicknesses, warnings.
+    pub figures: FeatureFigures,
+    /// The freeform planner's figures (curved features).
+    pub freeform: Option<FreeformFigures>,
+}
+
+impl FeaturePlan {
+    /// Every point of the plan in print order.
+    pub fn points(&self) -> impl Iterator<Item = &PathPoint> {
+        self.layers
+            .iter()
+            .flat_map(|l| &l.paths)
+            .flat_map(|p| p.travel.iter().chain(&p.print))
+    }
+
+    /// Where the nozzle is when the feature is done: its last point, if it has any.
+    pub fn exit(&self) -> Option<[f64; 3]> {
+        self.points().last().map(|q| q.p)
+    }
+}
+
+/// The tool path of a part: the features' points one plan after the other, each point tagged
+/// with its feature's file-wide id (the `usize` beside its plan). The travel into each feature
+/// is already in its plan (planned from the previous plan's [`FeaturePlan::exit`]).
+pub fn sequence(plans: impl IntoIterator<Item = (usize, FeaturePlan)>) -> ToolPath {
+    let mut points = vec![];
+    for (id, plan) in plans {
+        for layer in plan.layers {
+            for path in layer.paths {
+                for q in path.travel.into_iter().chain(path.print) {
+                    points.push(PathPoint { feature: id, ..q });
+                }
+            }
+        }
+    }
+    ToolPath { points }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::toolpath::MoveKind;
+
+    fn point(kind: MoveKind, x: f64) -> PathPoint {
+        PathPoint {
+            feature: 0,
+            layer: 0,
+            kind,
+            p: [x, 0.0, 0.0],
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.2,
+            width: 0.45,
+        }
+    }
+
+    fn plan(xs: &[f64]) -> FeaturePlan {
+        FeaturePlan {
+            feature: 0,
+            layers: vec![Layer {
+                index: 0,
+                thickness: 0.2,
+                surface: LayerSurface::Offset { offset: 0.2 },
+                paths: vec![LayerPath {
+                    travel: vec![point(MoveKind::Travel, xs[0])],
+                    print: xs[1..].iter().map(|&x| point(MoveKind::Print, x)).collect(),
+                }],
+            }],
+            figures: FeatureFigures::default(),
+            freeform: None,
+        }
+    }
+
+    #[test]
+    fn sequencing_keeps_every_point_in_order_under_its_file_wide_id() {
+        let a = plan(&[0.0, 1.0, 2.0]);
+        let b = plan(&[5.0, 6.0]);
+        assert_eq!(a.exit(), Some([2.0, 0.0, 0.0]));
+        let path = sequence([(3, a), (7, b)]);
+        let xs: Vec<f64> = path.points.iter().map(|q| q.p[0]).collect();
+        assert_eq!(xs, [0.0, 1.0, 2.0, 5.0, 6.0]);
+        let ids: Vec<usize> = path.points.iter().map(|q| q.feature).collect();
+        assert_eq!(ids, [3, 3, 3, 7, 7]);
+        assert_eq!(path.points[3].kind, MoveKind::Travel);
+    }
+}
