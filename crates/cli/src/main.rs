@@ -7,6 +7,7 @@ mod extract;
 mod inspect;
 mod mesh;
 mod plan;
+mod settings;
 
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;

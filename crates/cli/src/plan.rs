@@ -1,46 +1,17 @@
 //! `features plan`: reads the settings and the part, runs [`plan::plan`] and writes its files.
 
 use crate::mesh::write_atomic;
+use crate::settings::settings;
 use crate::{emit, Failure, PlanArgs};
-use plan::{Options, PlanError, Process, Progress};
-use robot_post::machine::{MachineKind, MachineProfile};
+use plan::{Options, PlanError, Progress};
 use std::io::Write as _;
 
 /// Runs the command.
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let path = &args.part;
     // Settings first: a bad process or machine file fails before any work.
+    let (process, machine) = settings(args)?;
     let settings = args.process.as_deref().unwrap_or(path);
-    let process = match &args.process {
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| Failure::new(p, format!("cannot read process file: {e}")))?;
-            Process::from_toml(&text).map_err(|e| Failure::new(p, e))?
-        }
-        None => Process::default(),
-    };
-    process
-        .validate_defaults()
-        .map_err(|e| Failure::new(settings, e))?;
-    let machine = match (&args.machine_profile, args.machine.as_deref()) {
-        (Some(p), _) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| Failure::new(p, format!("cannot read machine profile: {e}")))?;
-            MachineProfile::from_toml(&text).map_err(|e| Failure::new(p, e))?
-        }
-        (None, Some(name)) => {
-            MachineProfile::builtin(MachineKind::from_name(name).ok_or_else(|| {
-                Failure::new(
-                    path,
-                    format!("unknown machine `{name}` (marlin, delta5 or kuka)"),
-                )
-            })?)
-        }
-        (None, None) => MachineProfile::builtin(MachineKind::Marlin),
-    };
-    process
-        .validate_orientation()
-        .map_err(|e| Failure::new(settings, e))?;
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg}");
     let progress = |p: Progress| match p {

@@ -38,8 +38,8 @@ use crate::geom2d::{area2, dist};
 use crate::params::{LayerParams, PathMode};
 use i_overlay::mesh::float::style::LineJoin;
 use offset::{erode, offset, round_join};
-use pattern::{bounds, drop_short_segments, rings, scan_fill, Reach};
-use region::{region_shapes, shape_region};
+use pattern::{drop_short_segments, rings, scan_fill, Reach};
+use region::{bounds, region_shapes, shape_region};
 
 pub use crate::geom2d::{Point2, Region};
 pub use offset::thinner_than;

@@ -1,8 +1,7 @@
 //! Offsets of i_overlay shapes: inward (erosion) and outward, with round or sharp joins;
 //! simplification of the contours they give, and the check that an offset lost nothing.
 
-use super::pattern::bounds;
-use super::region::region_shapes;
+use super::region::{bounds, region_shapes};
 use super::{Contour, Shapes};
 use crate::geom2d::{area2, dist, perimeter, seg_dist, Point2, Region};
 use crate::tolerance::ROUND_OFF;

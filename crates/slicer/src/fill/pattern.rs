@@ -57,16 +57,6 @@ pub(super) fn drop_short_segments(pts: &mut Vec<Point2>) {
     }
 }
 
-pub(super) fn bounds(s: &Shapes) -> (Point2, Point2) {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [-f64::INFINITY; 2];
-    for p in s.iter().flatten().flatten() {
-        lo = [lo[0].min(p[0]), lo[1].min(p[1])];
-        hi = [hi[0].max(p[0]), hi[1].max(p[1])];
-    }
-    (lo, hi)
-}
-
 /// Up to `max` rings inward from `base` (the first at `width / 2`, then every `spacing`);
 /// returns the area inside the last ring, offset by one more spacing (the infill area of
 /// contour-zig-zag; empty once the region is used up). Strips narrower than a bead that the

@@ -157,3 +157,14 @@ pub(super) fn shape_region(shape: Shape) -> Option<Region> {
         .collect();
     Some(Region { outer, holes })
 }
+
+/// The box of a set of shapes: lowest and highest corner.
+pub(super) fn bounds(s: &Shapes) -> (Point2, Point2) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [-f64::INFINITY; 2];
+    for p in s.iter().flatten().flatten() {
+        lo = [lo[0].min(p[0]), lo[1].min(p[1])];
+        hi = [hi[0].max(p[0]), hi[1].max(p[1])];
+    }
+    (lo, hi)
+}
