@@ -17,11 +17,13 @@
 use crate::fill::{bead_end_reach, MAX_END_REACH};
 use crate::geom2d::{dist2, Point2, Region};
 
+use crate::fast_hash::{FastMap, FastSet};
 pub use crate::geom2d::region_contains;
+use crate::geom2d::RegionIndex;
 use brep::math::P3;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 /// A triangulated layer region: chart coordinates, 3-D points on the layer surface, triangles.
 #[derive(Debug, Clone, Default)]
@@ -220,7 +222,7 @@ impl LayerMesh {
                 ((q[1] - lo[1]) / step).floor() as i64,
             )
         };
-        let mut grid: HashMap<(i64, i64), Vec<Point2>> = HashMap::new();
+        let mut grid: FastMap<(i64, i64), Vec<Point2>> = FastMap::default();
         for q in rings.iter().flatten() {
             grid.entry(cell(*q)).or_default().push(*q);
         }
@@ -235,19 +237,26 @@ impl LayerMesh {
         };
         let mut cdt: ConstrainedDelaunayTriangulation<SPoint<f64>> =
             ConstrainedDelaunayTriangulation::new();
-        let mut index: HashMap<usize, u32> = HashMap::new();
+        // Our vertex of each triangulation vertex, by the triangulation's (dense) index.
+        let mut index: Vec<u32> = vec![];
         let mut add = |cdt: &mut ConstrainedDelaunayTriangulation<SPoint<f64>>,
                        m: &mut LayerMesh,
                        q: Point2,
                        on_boundary: bool| {
             let h = cdt.insert(SPoint::new(q[0], q[1])).ok()?;
-            index.entry(h.index()).or_insert_with(|| {
+            if index.len() <= h.index() {
+                index.resize(h.index() + 1, u32::MAX);
+            }
+            if index[h.index()] == u32::MAX {
                 m.q.push(q);
                 m.boundary.push(on_boundary);
-                (m.q.len() - 1) as u32
-            });
+                index[h.index()] = (m.q.len() - 1) as u32;
+            }
             Some(h)
         };
+        let ours = |index: &[u32], i: usize| index.get(i).copied().filter(|&v| v != u32::MAX);
+        // `region_contains` by horizontal bands of the region's edges.
+        let inside = RegionIndex::new(region);
         let mut ring_handles = vec![];
         for ring in &rings {
             let hs: Vec<_> = ring
@@ -270,7 +279,7 @@ impl LayerMesh {
             let shift = if r % 2 == 1 { 0.5 * step } else { 0.0 };
             for c in 0..=cols {
                 let q = [lo[0] + shift + c as f64 * step, y];
-                if region_contains(region, q) && !near_boundary(q, step) {
+                if inside.contains(q) && !near_boundary(q, step) {
                     add(&mut cdt, &mut m, q, false);
                 }
             }
@@ -289,10 +298,7 @@ impl LayerMesh {
                 let c1 = ((c[0] + span - lo[0] - shift) / fine).ceil().max(0.0) as usize;
                 for k in c0..=c1 {
                     let q = [lo[0] + shift + k as f64 * fine, y];
-                    if dist2(*c, q) <= reach2
-                        && region_contains(region, q)
-                        && !near_boundary(q, fine)
-                    {
+                    if dist2(*c, q) <= reach2 && inside.contains(q) && !near_boundary(q, fine) {
                         add(&mut cdt, &mut m, q, false);
                     }
                 }
@@ -300,24 +306,17 @@ impl LayerMesh {
         }
         m.rings = ring_handles
             .iter()
-            .map(|hs| {
-                hs.iter()
-                    .filter_map(|h| index.get(&h.index()).copied())
-                    .collect()
-            })
+            .map(|hs| hs.iter().filter_map(|h| ours(&index, h.index())).collect())
             .collect();
         for f in cdt.inner_faces() {
             let vs = f.vertices();
-            let ids: Option<Vec<u32>> = vs
-                .iter()
-                .map(|v| index.get(&v.fix().index()).copied())
-                .collect();
+            let ids: Option<Vec<u32>> = vs.iter().map(|v| ours(&index, v.fix().index())).collect();
             let Some(ids) = ids else { continue };
             let c = [
                 (m.q[ids[0] as usize][0] + m.q[ids[1] as usize][0] + m.q[ids[2] as usize][0]) / 3.0,
                 (m.q[ids[0] as usize][1] + m.q[ids[1] as usize][1] + m.q[ids[2] as usize][1]) / 3.0,
             ];
-            if region_contains(region, c) {
+            if inside.contains(c) {
                 m.tris.push([ids[0], ids[1], ids[2]]);
             }
         }
@@ -412,7 +411,7 @@ impl LayerMesh {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
             ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
         };
-        let mut grid: HashMap<(i64, i64), Vec<(u32, u32)>> = HashMap::new();
+        let mut grid: FastMap<(i64, i64), Vec<(u32, u32)>> = FastMap::default();
         for ring in &self.rings {
             let n = ring.len();
             for i in 0..n {
@@ -451,7 +450,12 @@ impl LayerMesh {
     /// of a ridge of `f` seen from its flanks.
     pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
         let mut out = f.to_vec();
-        // `seen[x] == v + 1`: x was reached from v (no clearing between vertices).
+        if !mask.iter().any(|&m| m) {
+            return out;
+        }
+        let (first, next) = self.neighbours();
+        // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
+        // between vertices; each vertex's distance is taken once per flood).
         let mut seen = vec![0u32; self.q.len()];
         let mut stack = vec![];
         for v in 0..self.q.len() {
@@ -463,16 +467,16 @@ impl LayerMesh {
             stack.push(v as u32);
             seen[v] = stamp;
             let mut best = f[v];
+            let pv = self.p[v];
             while let Some(u) = stack.pop() {
-                if f[u as usize].is_finite() {
-                    best = best.max(f[u as usize]);
+                let u = u as usize;
+                if f[u].is_finite() {
+                    best = best.max(f[u]);
                 }
-                for &t in &self.around[u as usize] {
-                    for &x in &self.tris[t as usize] {
-                        if seen[x as usize] != stamp
-                            && (self.p[x as usize] - self.p[v]).norm() <= radius
-                        {
-                            seen[x as usize] = stamp;
+                for &x in &next[first[u] as usize..first[u + 1] as usize] {
+                    if seen[x as usize] != stamp {
+                        seen[x as usize] = stamp;
+                        if (self.p[x as usize] - pv).norm() <= radius {
                             stack.push(x);
                         }
                     }
@@ -481,6 +485,27 @@ impl LayerMesh {
             out[v] = best;
         }
         out
+    }
+
+    /// The vertices joined to each vertex by an edge of a triangle, as offsets (`first[v]` ..
+    /// `first[v + 1]`) into one list.
+    fn neighbours(&self) -> (Vec<u32>, Vec<u32>) {
+        let n = self.q.len();
+        let mut first = Vec::with_capacity(n + 1);
+        let mut next = Vec::with_capacity(6 * n);
+        first.push(0u32);
+        for v in 0..n {
+            let start = next.len();
+            for &t in &self.around[v] {
+                for &x in &self.tris[t as usize] {
+                    if x as usize != v && !next[start..].contains(&x) {
+                        next.push(x);
+                    }
+                }
+            }
+            first.push(next.len() as u32);
+        }
+        (first, next)
     }
 
     /// Distances over the mesh's 3-D points from `seeds` (vertex, starting distance), by fast
@@ -538,8 +563,8 @@ impl LayerMesh {
     pub fn iso_lines(&self, f: &[f64], level: f64, other: &[f64]) -> Vec<IsoLine> {
         type Key = (u32, u32);
         let key = |a: u32, b: u32| (a.min(b), a.max(b));
-        let mut point: HashMap<Key, (Point2, f64)> = HashMap::new();
-        let mut links: HashMap<Key, Vec<Key>> = HashMap::new();
+        let mut point: FastMap<Key, (Point2, f64)> = FastMap::default();
+        let mut links: FastMap<Key, Vec<Key>> = FastMap::default();
         let at = |a: u32, b: u32| -> (Point2, f64) {
             let (fa, fb) = (f[a as usize], f[b as usize]);
             let t = if (fb - fa).abs() > 0.0 {
@@ -568,7 +593,7 @@ impl LayerMesh {
             links.entry(e1).or_default().push(e2);
             links.entry(e2).or_default().push(e1);
         }
-        let mut used: std::collections::HashSet<Key> = std::collections::HashSet::new();
+        let mut used: FastSet<Key> = FastSet::default();
         let mut keys: Vec<Key> = links.keys().copied().collect();
         keys.sort_unstable();
         // Chain from the open ends first, then the rings.

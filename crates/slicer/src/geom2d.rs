@@ -80,6 +80,76 @@ pub fn region_contains(region: &Region, q: Point2) -> bool {
     inside
 }
 
+/// [`region_contains`] for many points: the region's edges in horizontal bands, so a point is
+/// tested against the edges whose height range meets its band only. The same test on the
+/// same edges, so the same answers.
+#[derive(Debug, Clone)]
+pub(crate) struct RegionIndex {
+    lo: f64,
+    per_band: f64,
+    bands: Vec<Vec<(Point2, Point2)>>,
+}
+
+impl RegionIndex {
+    /// Indexes `region`'s rings.
+    pub(crate) fn new(region: &Region) -> RegionIndex {
+        let rings = || std::iter::once(&region.outer).chain(region.holes.iter());
+        let edges = rings().map(Vec::len).sum::<usize>();
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for q in rings().flatten() {
+            lo = lo.min(q[1]);
+            hi = hi.max(q[1]);
+        }
+        let n = (edges / 4).clamp(1, 4096);
+        let span = hi - lo;
+        let per_band = if span.is_finite() && span > 0.0 {
+            n as f64 / span
+        } else {
+            0.0
+        };
+        let mut index = RegionIndex {
+            lo,
+            per_band,
+            bands: vec![vec![]; n],
+        };
+        for ring in rings() {
+            let m = ring.len();
+            for i in 0..m {
+                let (a, b) = (ring[i], ring[(i + 1) % m]);
+                let (b0, b1) = (index.band(a[1].min(b[1])), index.band(a[1].max(b[1])));
+                for band in &mut index.bands[b0..=b1] {
+                    band.push((a, b));
+                }
+            }
+        }
+        index
+    }
+
+    /// The band of height `y` (monotone in `y`, clamped to the bands).
+    fn band(&self, y: f64) -> usize {
+        let k = ((y - self.lo) * self.per_band).floor();
+        if k.is_nan() || k < 0.0 {
+            0
+        } else {
+            (k as usize).min(self.bands.len() - 1)
+        }
+    }
+
+    /// Whether `q` lies inside the region (even-odd, as [`region_contains`]).
+    pub(crate) fn contains(&self, q: Point2) -> bool {
+        let mut inside = false;
+        for &(a, b) in &self.bands[self.band(q[1])] {
+            if (a[1] > q[1]) != (b[1] > q[1]) {
+                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > q[0] {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
 /// Distance from `p` to the segment `a`–`b`.
 pub(crate) fn seg_dist(p: Point2, a: Point2, b: Point2) -> f64 {
     dist(p, segment_foot(p, a, b).1)

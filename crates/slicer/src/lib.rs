@@ -27,6 +27,7 @@
 
 mod chart;
 pub mod error;
+mod fast_hash;
 mod feature_mesh;
 pub mod feature_plan;
 pub mod figures;
