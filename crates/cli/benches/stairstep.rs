@@ -48,6 +48,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
+#[path = "common/prusa.rs"]
+mod prusa;
+
 /// Bead width of both plans, mm.
 const W: f64 = 0.45;
 /// Layer height of both plans, mm.
@@ -600,55 +603,23 @@ fn stl_bbox(path: &Path) -> Result<Aabb, String> {
     Ok(bb)
 }
 
-fn prusa_exe() -> String {
-    std::env::var("PRUSA_SLICER").unwrap_or_else(|_| "prusa-slicer".into())
-}
-
 fn run_prusa(stl: &Path, gcode: &Path) -> PrusaRun {
-    let exe = prusa_exe();
     let bbox = match stl_bbox(stl) {
         Ok(b) => b,
         Err(e) => return PrusaRun::Failed(e),
     };
-    let w = format!("{W}");
-    let h = format!("{H}");
-    let mut cmd = Command::new(&exe);
-    cmd.args(["--export-gcode", "--loglevel", "1"])
-        .args(["--layer-height", &h, "--first-layer-height", &h])
-        .args(["--fill-density", "100%", "--fill-pattern", "rectilinear"])
-        .args(["--perimeters", "2", "--perimeter-generator", "classic"])
-        .args(["--extrusion-width", &w, "--first-layer-extrusion-width", &w])
-        .args(["--perimeter-extrusion-width", &w])
-        .args(["--external-perimeter-extrusion-width", &w])
-        .args(["--infill-extrusion-width", &w])
-        .args(["--solid-infill-extrusion-width", &w])
-        .args(["--top-infill-extrusion-width", &w])
-        .args(["--nozzle-diameter", "0.4", "--filament-diameter"])
-        .arg(format!("{FILAMENT}"))
-        .args(["--skirts", "0", "--brim-width", "0"])
-        .arg("--center")
-        .arg(format!("{},{}", CENTER.0, CENTER.1))
-        .arg("-o")
-        .arg(gcode)
-        .arg(stl);
-    let t = Instant::now();
-    let out = match cmd.output() {
-        Ok(o) => o,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return PrusaRun::Missing(format!("{exe} not found"))
-        }
-        Err(e) => return PrusaRun::Failed(format!("running {exe}: {e}")),
+    let settings = prusa::Settings {
+        layer: H,
+        width: W,
+        filament: FILAMENT,
+        center: CENTER,
+        supports: false,
     };
-    let seconds = t.elapsed().as_secs_f64();
-    if !out.status.success() || !gcode.exists() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        let tail: Vec<&str> = err.lines().rev().take(3).collect();
-        return PrusaRun::Failed(format!(
-            "{exe} exited with {}: {}",
-            out.status,
-            tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
-        ));
-    }
+    let seconds = match prusa::slice(stl, gcode, &settings, &[]) {
+        prusa::Run::Done(s) => s,
+        prusa::Run::Missing(why) => return PrusaRun::Missing(why),
+        prusa::Run::Failed(why) => return PrusaRun::Failed(why),
+    };
     let text = match std::fs::read_to_string(gcode) {
         Ok(t) => t,
         Err(e) => return PrusaRun::Failed(format!("{}: {e}", gcode.display())),
