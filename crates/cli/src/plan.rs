@@ -44,19 +44,22 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let dir = &args.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
-    let csv = plan.toolpath.to_csv();
-    let mut files = vec![
-        ("toolpath.csv", csv.as_bytes()),
-        ("plan.json", json.as_bytes()),
-    ];
-    files.extend(
+    let written = |name: &str, r: std::io::Result<()>| {
+        r.map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))
+    };
+    // The tool path is written point by point, not built as one text first.
+    let csv = "toolpath.csv";
+    written(
+        csv,
+        write_atomic(&dir.join(csv), |w| plan.toolpath.write_csv(w)),
+    )?;
+    let files = std::iter::once(("plan.json", json.as_bytes())).chain(
         plan.program
             .iter()
             .map(|f| (f.name.as_str(), f.bytes.as_slice())),
     );
     for (name, bytes) in files {
-        write_atomic(&dir.join(name), |w| w.write_all(bytes))
-            .map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))?;
+        written(name, write_atomic(&dir.join(name), |w| w.write_all(bytes)))?;
     }
     // The plan's warnings on stderr too, one line each, so a terminal shows them.
     for w in plan.warnings() {

@@ -77,8 +77,10 @@ impl FeaturePlan {
 /// The tool path of a part: the features' points one plan after the other, each point tagged
 /// with its feature's file-wide id (the `usize` beside its plan). The travel into each feature
 /// is already in its plan (planned from the previous plan's [`FeaturePlan::exit`]).
-pub fn sequence(plans: impl IntoIterator<Item = (usize, FeaturePlan)>) -> ToolPath {
-    let mut points = vec![];
+pub fn sequence(plans: Vec<(usize, FeaturePlan)>) -> ToolPath {
+    // Sized once: a path of millions of points is not grown by doubling.
+    let total = plans.iter().map(|(_, p)| p.points().count()).sum();
+    let mut points = Vec::with_capacity(total);
     for (id, plan) in plans {
         for layer in plan.layers {
             for path in layer.paths {
@@ -131,7 +133,7 @@ mod tests {
         let a = plan(&[0.0, 1.0, 2.0]);
         let b = plan(&[5.0, 6.0]);
         assert_eq!(a.exit(), Some([2.0, 0.0, 0.0]));
-        let path = sequence([(3, a), (7, b)]);
+        let path = sequence(vec![(3, a), (7, b)]);
         let xs: Vec<f64> = path.points.iter().map(|q| q.p[0]).collect();
         assert_eq!(xs, [0.0, 1.0, 2.0, 5.0, 6.0]);
         let ids: Vec<usize> = path.points.iter().map(|q| q.feature).collect();

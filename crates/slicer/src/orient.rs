@@ -404,6 +404,19 @@ fn smooth_run(points: &mut [PathPoint], params: &SmoothParams) {
     if points.len() < 3 {
         return;
     }
+    // A path along one coordinate axis throughout (every planar layer) smooths to itself
+    // exactly: each weighted sum is that axis times a positive weight, which `unit` divides
+    // back to ±1 exactly, and the zero components stay +0. Skipped, it costs nothing.
+    let first = points[0].axis;
+    let aligned = first.iter().filter(|x| x.abs() == 1.0).count() == 1
+        && first.iter().all(|x| x.abs() == 1.0 || x.to_bits() == 0);
+    if aligned
+        && points
+            .iter()
+            .all(|q| q.axis.map(f64::to_bits) == first.map(f64::to_bits))
+    {
+        return;
+    }
     let mut axes = Vec::with_capacity(points.len());
     for q in points.iter() {
         match unit(q.axis) {

@@ -15,4 +15,4 @@ mod path;
 pub mod vec3;
 
 pub use bead::Bead;
-pub use path::{fixed, MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};
+pub use path::{fixed, push_fixed, MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};

@@ -27,10 +27,20 @@ pub enum ToolPathError {
 
 /// `x` in fixed-point with `decimals` places: never exponent notation, never `-0`.
 pub fn fixed(x: f64, decimals: usize) -> String {
-    let s = format!("{x:.decimals$}");
-    match s.strip_prefix('-') {
-        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
-        _ => s,
+    let mut s = String::new();
+    push_fixed(&mut s, x, decimals);
+    s
+}
+
+/// Appends [`fixed`]`(x, decimals)` to `out` without a new allocation.
+pub fn push_fixed(out: &mut String, x: f64, decimals: usize) {
+    use std::fmt::Write as _;
+    let start = out.len();
+    // Writing to a String cannot fail.
+    let _ = write!(out, "{x:.decimals$}");
+    let written = &out.as_bytes()[start..];
+    if written.first() == Some(&b'-') && written[1..].iter().all(|&b| b == b'0' || b == b'.') {
+        out.remove(start);
     }
 }
 
@@ -107,28 +117,38 @@ impl ToolPath {
     /// is `print` or `travel`; coordinates, axis and `e` with 6 decimals, thickness and width
     /// with 4, fixed-point (never exponent notation, no `-0`). Lines end with `\n`.
     pub fn to_csv(&self) -> String {
-        let mut out = String::with_capacity(64 * (self.points.len() + 1));
-        out.push_str(CSV_HEADER);
-        out.push('\n');
+        let mut out = Vec::with_capacity(64 * (self.points.len() + 1));
+        // Writing to memory cannot fail, and the text is ASCII.
+        let _ = self.write_csv(&mut out);
+        String::from_utf8(out).unwrap_or_default()
+    }
+
+    /// Writes [`ToolPath::to_csv`]'s text to `w` line by line, without holding it in memory.
+    pub fn write_csv(&self, w: &mut impl std::io::Write) -> std::io::Result<()> {
+        use std::fmt::Write as _;
+        writeln!(w, "{CSV_HEADER}")?;
+        let mut line = String::with_capacity(128);
         for q in &self.points {
-            let fields = [
-                q.feature.to_string(),
-                q.layer.to_string(),
-                q.kind.as_str().to_string(),
-                fixed(q.p[0], 6),
-                fixed(q.p[1], 6),
-                fixed(q.p[2], 6),
-                fixed(q.axis[0], 6),
-                fixed(q.axis[1], 6),
-                fixed(q.axis[2], 6),
-                fixed(q.e, 6),
-                fixed(q.thickness, 4),
-                fixed(q.width, 4),
-            ];
-            out.push_str(&fields.join(","));
-            out.push('\n');
+            line.clear();
+            let _ = write!(line, "{},{},{}", q.feature, q.layer, q.kind.as_str());
+            for (x, decimals) in [
+                (q.p[0], 6),
+                (q.p[1], 6),
+                (q.p[2], 6),
+                (q.axis[0], 6),
+                (q.axis[1], 6),
+                (q.axis[2], 6),
+                (q.e, 6),
+                (q.thickness, 4),
+                (q.width, 4),
+            ] {
+                line.push(',');
+                push_fixed(&mut line, x, decimals);
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
         }
-        out
+        Ok(())
     }
 
     /// Reads CSV written by [`ToolPath::to_csv`]. The first line must be the header exactly;
