@@ -168,7 +168,8 @@ pub fn plan(
             // lies below that is not printed).
             if let Some(plate) = &plate {
                 let planned = plan
-                    .points()
+                    .points
+                    .iter()
                     .map(|q| -plate.height(&P3::from(q.p)))
                     .fold(0.0f64, f64::max);
                 let depth = planned.max(slicer::planar::depth_below(t, f, plate));

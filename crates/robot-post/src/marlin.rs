@@ -48,6 +48,8 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
     let offset = bed_offset(path, m)?;
 
     let mut w = Writer::new(m);
+    // About 45 bytes a point: the program is not grown by doubling (a copy of it at each step).
+    w.out.reserve(48 * path.points.len());
     w.header(m, source, offset);
     for q in &path.points {
         let t = [q.p[0] + offset[0], q.p[1] + offset[1], q.p[2] + offset[2]];

@@ -1,9 +1,11 @@
 //! What a planner returns for one feature: its [`Layer`]s of bead paths, the surface each lies
-//! on and the feature's figures (as libslic3r's `Layer` → `ExtrusionEntity`). [`sequence`] joins
-//! the features' plans into the one [`ToolPath`] the posts read.
+//! on and the feature's figures (as libslic3r's `Layer` → `ExtrusionEntity`). The points of a
+//! feature are one arena ([`FeaturePlan::points`]) that its layers' paths index, so [`sequence`]
+//! joins the features' plans into the one [`ToolPath`] the posts read without copying them.
 
 use crate::figures::{FeatureFigures, FreeformFigures};
 use crate::toolpath::{PathPoint, ToolPath};
+use std::ops::Range;
 
 /// The surface a layer's beads are laid on (their top, where the nozzle tip runs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,13 +25,14 @@ pub enum LayerSurface {
     },
 }
 
-/// One bead path of a layer: the travel that reaches its start, then the beads it lays.
+/// One bead path of a layer, as ranges of its feature's [`FeaturePlan::points`]: the travel
+/// that reaches its start, then the beads it lays.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LayerPath {
     /// Travel points, the last one the path's start.
-    pub travel: Vec<PathPoint>,
+    pub travel: Range<usize>,
     /// Print points: each lays a bead from the point before it.
-    pub print: Vec<PathPoint>,
+    pub print: Range<usize>,
 }
 
 /// One layer of a feature that prints.
@@ -46,11 +49,13 @@ pub struct Layer {
     pub paths: Vec<LayerPath>,
 }
 
-/// The plan of one feature: its layers in print order and its figures.
+/// The plan of one feature: its points, its layers in print order and its figures.
 #[derive(Debug, Clone)]
 pub struct FeaturePlan {
     /// The feature's index in its tree.
     pub feature: usize,
+    /// Every point of the plan in print order; the layers' paths are ranges of it.
+    pub points: Vec<PathPoint>,
     /// The layers that print, bottom up.
     pub layers: Vec<Layer>,
     /// Lengths, filament, layer thicknesses, warnings.
@@ -60,17 +65,17 @@ pub struct FeaturePlan {
 }
 
 impl FeaturePlan {
-    /// Every point of the plan in print order.
-    pub fn points(&self) -> impl Iterator<Item = &PathPoint> {
-        self.layers
-            .iter()
-            .flat_map(|l| &l.paths)
-            .flat_map(|p| p.travel.iter().chain(&p.print))
-    }
-
     /// Where the nozzle is when the feature is done: its last point, if it has any.
     pub fn exit(&self) -> Option<[f64; 3]> {
-        self.points().last().map(|q| q.p)
+        self.points.last().map(|q| q.p)
+    }
+
+    /// The travel and print points of one path of a layer.
+    pub fn path_points(&self, path: &LayerPath) -> (&[PathPoint], &[PathPoint]) {
+        (
+            &self.points[path.travel.clone()],
+            &self.points[path.print.clone()],
+        )
     }
 }
 
@@ -78,16 +83,17 @@ impl FeaturePlan {
 /// with its feature's file-wide id (the `usize` beside its plan). The travel into each feature
 /// is already in its plan (planned from the previous plan's [`FeaturePlan::exit`]).
 pub fn sequence(plans: Vec<(usize, FeaturePlan)>) -> ToolPath {
-    // Sized once: a path of millions of points is not grown by doubling.
-    let total = plans.iter().map(|(_, p)| p.points().count()).sum();
-    let mut points = Vec::with_capacity(total);
+    let mut points: Vec<PathPoint> = vec![];
     for (id, plan) in plans {
-        for layer in plan.layers {
-            for path in layer.paths {
-                for q in path.travel.into_iter().chain(path.print) {
-                    points.push(PathPoint { feature: id, ..q });
-                }
-            }
+        let mut own = plan.points;
+        for q in &mut own {
+            q.feature = id;
+        }
+        // The first plan's points become the path's (no copy); the others are appended.
+        if points.is_empty() {
+            points = own;
+        } else {
+            points.append(&mut own);
         }
     }
     ToolPath { points }
@@ -112,6 +118,8 @@ mod tests {
     }
 
     fn plan(xs: &[f64]) -> FeaturePlan {
+        let mut points = vec![point(MoveKind::Travel, xs[0])];
+        points.extend(xs[1..].iter().map(|&x| point(MoveKind::Print, x)));
         FeaturePlan {
             feature: 0,
             layers: vec![Layer {
@@ -119,10 +127,11 @@ mod tests {
                 thickness: 0.2,
                 surface: LayerSurface::Offset { offset: 0.2 },
                 paths: vec![LayerPath {
-                    travel: vec![point(MoveKind::Travel, xs[0])],
-                    print: xs[1..].iter().map(|&x| point(MoveKind::Print, x)).collect(),
+                    travel: 0..1,
+                    print: 1..xs.len(),
                 }],
             }],
+            points,
             figures: FeatureFigures::default(),
             freeform: None,
         }
@@ -133,6 +142,8 @@ mod tests {
         let a = plan(&[0.0, 1.0, 2.0]);
         let b = plan(&[5.0, 6.0]);
         assert_eq!(a.exit(), Some([2.0, 0.0, 0.0]));
+        let (travel, print) = a.path_points(&a.layers[0].paths[0]);
+        assert_eq!((travel.len(), print.len()), (1, 2));
         let path = sequence(vec![(3, a), (7, b)]);
         let xs: Vec<f64> = path.points.iter().map(|q| q.p[0]).collect();
         assert_eq!(xs, [0.0, 1.0, 2.0, 5.0, 6.0]);

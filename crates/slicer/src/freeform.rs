@@ -145,6 +145,7 @@ pub fn plan_freeform(
     let mut prev_regions: Vec<Region> = vec![];
     let mut printed_layers = vec![];
     let mut layers = vec![];
+    let mut points: Vec<PathPoint> = vec![];
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -223,7 +224,7 @@ pub fn plan_freeform(
                     });
                 }
             }
-            let mut out = LayerPath::default();
+            let start = points.len();
             let axis = |n: V3| {
                 let a = fixed.unwrap_or(n);
                 [a.x, a.y, a.z]
@@ -255,7 +256,7 @@ pub fn plan_freeform(
                 if let Some(c) = *cursor {
                     fig.travel_length += (p - c).norm();
                 }
-                out.travel.push(PathPoint {
+                points.push(PathPoint {
                     feature: id,
                     layer,
                     kind: MoveKind::Travel,
@@ -267,13 +268,14 @@ pub fn plan_freeform(
                 });
                 *cursor = Some(p);
             }
+            let print_start = points.len();
             for w in pts.windows(2) {
                 let l = (w[1].p - w[0].p).norm();
                 let width = 0.5 * (w[0].w + w[1].w);
                 let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
-                out.print.push(PathPoint {
+                points.push(PathPoint {
                     feature: id,
                     layer,
                     kind: MoveKind::Print,
@@ -285,7 +287,10 @@ pub fn plan_freeform(
                 });
             }
             *cursor = pts.last().map(|x| x.p);
-            layer_paths.push(out);
+            layer_paths.push(LayerPath {
+                travel: start..print_start,
+                print: print_start..points.len(),
+            });
         }
         if !layer_paths.is_empty() {
             printed_layers.push(dl);
@@ -297,12 +302,7 @@ pub fn plan_freeform(
             });
         }
     }
-    let points = layers
-        .iter()
-        .flat_map(|l| &l.paths)
-        .map(|p| p.travel.len() + p.print.len())
-        .sum();
-    fig.finish(id, points, &printed_layers);
+    fig.finish(id, points.len(), &printed_layers);
     if let Some((a, b)) = ff.overhang_layers {
         fig.warnings.push(format!(
             "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
@@ -311,6 +311,7 @@ pub fn plan_freeform(
     }
     Ok(FeaturePlan {
         feature: f.id,
+        points,
         layers,
         figures: fig,
         freeform: Some(ff),

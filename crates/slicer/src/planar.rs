@@ -165,6 +165,7 @@ pub fn plan_two5d(
     let mut fig = FeatureFigures::default();
     let mut printed = vec![];
     let mut layers = vec![];
+    let mut points: Vec<PathPoint> = vec![];
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
     // ordered and joined by travel one layer after the other.
     let mut tops = Vec::with_capacity(heights.len());
@@ -201,8 +202,8 @@ pub fn plan_two5d(
             if let Some(c) = cursor {
                 fig.travel_length += (first - c).norm();
             }
-            let mut out = LayerPath::default();
-            out.travel.push(PathPoint {
+            let start = points.len();
+            points.push(PathPoint {
                 feature: f.id,
                 layer,
                 kind: MoveKind::Travel,
@@ -219,7 +220,7 @@ pub fn plan_two5d(
                 let e = bead.filament_length(width, dl, l);
                 fig.print_length += l;
                 fig.filament += e;
-                out.print.push(PathPoint {
+                points.push(PathPoint {
                     feature: f.id,
                     layer,
                     kind: MoveKind::Print,
@@ -231,7 +232,10 @@ pub fn plan_two5d(
                 });
             }
             cursor = pts.last().copied();
-            layer_paths.push(out);
+            layer_paths.push(LayerPath {
+                travel: start..start + 1,
+                print: start + 1..points.len(),
+            });
         }
         layers.push(Layer {
             index: layer,
@@ -243,13 +247,12 @@ pub fn plan_two5d(
             paths: layer_paths,
         });
     }
-    let mut plan = FeaturePlan {
+    fig.finish(f.id, points.len(), &printed);
+    Ok(FeaturePlan {
         feature: f.id,
+        points,
         layers,
         figures: fig,
         freeform: None,
-    };
-    let points = plan.points().count();
-    plan.figures.finish(f.id, points, &printed);
-    Ok(plan)
+    })
 }

@@ -124,7 +124,7 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
         }
         let plan = plan_freeform(&t, f, params, BEAD, None)
             .unwrap_or_else(|e| panic!("{name} feature {k}: {e}"));
-        let pts: Vec<PathPoint> = plan.points().copied().collect();
+        let pts: Vec<PathPoint> = plan.points.clone();
         let (fig, ff) = (&plan.figures, plan.freeform.expect("freeform figures"));
         assert_eq!(fig.points, pts.len(), "{name} feature {k}");
         assert_eq!(fig.layers, plan.layers.len(), "{name} feature {k}");
@@ -134,8 +134,9 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
                 "{name} feature {k}: layer {} without paths",
                 l.index
             );
-            assert!(l.paths.iter().all(|p| p
-                .print
+            assert!(l.paths.iter().all(|p| plan
+                .path_points(p)
+                .1
                 .iter()
                 .all(|q| q.layer == l.index && q.thickness == l.thickness)));
         }
@@ -364,8 +365,8 @@ fn a_fixed_tool_axis_holds_on_every_point_of_the_curved_layers() {
         ..LayerParams::default()
     };
     let plan = plan_freeform(&t, &t.features[2], &params, BEAD, None).expect("plans");
-    assert!(plan.points().count() > 100);
-    for p in plan.points() {
+    assert!(plan.points.len() > 100);
+    for p in &plan.points {
         assert_eq!(p.axis, [0.0, 0.0, 1.0]);
     }
 }

@@ -155,6 +155,8 @@ pub fn delta5(
     let safe_z = wanted_safe.min(m.bed_size[2]);
 
     let mut w = Writer::new(m, g, offset, safe_z);
+    // About 45 bytes a point: the program is not grown by doubling (a copy of it at each step).
+    w.out.reserve(48 * path.points.len());
     let mut previous: Option<usize> = None;
     for (i, q) in path.points.iter().enumerate() {
         w.comments(q);
