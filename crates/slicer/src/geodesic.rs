@@ -20,7 +20,7 @@ use crate::geom2d::{dist2, Point2, Region};
 use crate::fast_hash::{FastMap, FastSet};
 pub use crate::geom2d::region_contains;
 use crate::geom2d::RegionIndex;
-use brep::math::P3;
+use brep::math::{P3, V3};
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -66,6 +66,35 @@ pub(crate) fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
         0.0
     };
     (p - (a + d * t)).norm()
+}
+
+/// A boundary segment of a layer mesh on the layer surface: start, direction (end − start) and
+/// squared length.
+type Segment = (P3, V3, f64);
+
+/// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
+/// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
+/// the root, without taking it.
+fn sqrt_at_most(r: f64) -> f64 {
+    if !(r.is_finite() && r >= 0.0) {
+        return if r == f64::INFINITY {
+            f64::INFINITY
+        } else {
+            -1.0
+        };
+    }
+    let step = |x: f64, up: bool| {
+        let b = x.to_bits();
+        f64::from_bits(if up { b + 1 } else { b - 1 })
+    };
+    let mut x = r * r;
+    while x > 0.0 && x.sqrt() > r {
+        x = step(x, false);
+    }
+    while x < f64::MAX && step(x, true).sqrt() <= r {
+        x = step(x, true);
+    }
+    x
 }
 
 /// Resamples a closed ring so no segment is longer than `step`, or `fine` where `near` holds
@@ -411,7 +440,9 @@ impl LayerMesh {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
             ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
         };
-        let mut grid: FastMap<(i64, i64), Vec<(u32, u32)>> = FastMap::default();
+        // Each segment as its start and direction (what `segment_distance` computes from its
+        // ends), so a vertex's pass over its cells reads them in a row.
+        let mut grid: FastMap<(i64, i64), Vec<Segment>> = FastMap::default();
         for ring in &self.rings {
             let n = ring.len();
             for i in 0..n {
@@ -419,22 +450,33 @@ impl LayerMesh {
                 let qa = self.q[a as usize];
                 let qb = self.q[b as usize];
                 let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
-                grid.entry(key(mid)).or_default().push((a, b));
+                let (pa, pb) = (self.p[a as usize], self.p[b as usize]);
+                let d = pb - pa;
+                grid.entry(key(mid))
+                    .or_default()
+                    .push((pa, d, d.norm_squared()));
             }
         }
         let mut out = vec![];
         for (v, q) in self.q.iter().enumerate() {
             let (i, j) = key(*q);
             let p = self.p[v];
-            let mut best = f64::INFINITY;
+            // `segment_distance` squared; the square root of the least square is the least
+            // distance (the root is monotone and rounded correctly).
+            let mut best2 = f64::INFINITY;
             for a in i - 2..=i + 2 {
                 for b in j - 2..=j + 2 {
-                    for &(s, e) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
-                        let (ps, pe) = (self.p[s as usize], self.p[e as usize]);
-                        best = best.min(segment_distance(&p, &ps, &pe));
+                    for &(pa, d, l2) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
+                        let t = if l2 > 0.0 {
+                            ((p - pa).dot(&d) / l2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        best2 = best2.min((p - (pa + d * t)).norm_squared());
                     }
                 }
             }
+            let mut best = best2.sqrt();
             if self.boundary[v] {
                 best = 0.0;
             }
@@ -454,6 +496,7 @@ impl LayerMesh {
             return out;
         }
         let (first, next) = self.neighbours();
+        let within = sqrt_at_most(radius);
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
         // between vertices; each vertex's distance is taken once per flood).
         let mut seen = vec![0u32; self.q.len()];
@@ -476,7 +519,7 @@ impl LayerMesh {
                 for &x in &next[first[u] as usize..first[u + 1] as usize] {
                     if seen[x as usize] != stamp {
                         seen[x as usize] = stamp;
-                        if (self.p[x as usize] - pv).norm() <= radius {
+                        if (self.p[x as usize] - pv).norm_squared() <= within {
                             stack.push(x);
                         }
                     }
@@ -809,6 +852,19 @@ mod tests {
         Region {
             outer: vec![[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]],
             holes: vec![],
+        }
+    }
+
+    #[test]
+    fn the_square_limit_answers_as_the_root_does() {
+        for r in [0.0, 1e-300, 0.3, 0.675, 1.0, 2.0f64.sqrt(), 1e10] {
+            let lim = sqrt_at_most(r);
+            assert!(lim.sqrt() <= r, "{r}");
+            assert!(f64::from_bits(lim.to_bits() + 1).sqrt() > r, "{r}");
+            for k in -50i64..50 {
+                let x = f64::from_bits((lim.to_bits() as i64 + k).max(0) as u64);
+                assert_eq!(x.sqrt() <= r, x <= lim, "r {r}, x {x}");
+            }
         }
     }
 
