@@ -209,20 +209,7 @@ fn bench_part(
     let stl = dir.join(format!("{name}.stl"));
     let gcode = dir.join(format!("{name}.gcode"));
     if *prusa_on {
-        let m = Command::new(&exe)
-            .arg("mesh")
-            .arg(step)
-            .arg("-o")
-            .arg(&stl)
-            .args(["--tolerance", "0.01"])
-            .output()
-            .map_err(|e| format!("running {}: {e}", exe.display()))?;
-        if !m.status.success() {
-            return Err(format!(
-                "features mesh failed: {}",
-                String::from_utf8_lossy(&m.stderr).trim()
-            ));
-        }
+        prusa::mesh_stl(&exe, step, &stl)?;
     }
     let mut res = PartResult {
         name: name.clone(),

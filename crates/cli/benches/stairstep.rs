@@ -45,7 +45,6 @@ use brep::mesh::{mesh_faces, MeshOptions};
 use features::{extract, ExtractOptions, FeatureKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 #[path = "common/prusa.rs"]
@@ -898,20 +897,7 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
     }
 
     let stl = dir.join(format!("{name}.stl"));
-    let m = Command::new(&exe)
-        .arg("mesh")
-        .arg(step)
-        .arg("-o")
-        .arg(&stl)
-        .args(["--tolerance", "0.01"])
-        .output()
-        .map_err(|e| format!("running {}: {e}", exe.display()))?;
-    if !m.status.success() {
-        return Err(format!(
-            "features mesh failed: {}",
-            String::from_utf8_lossy(&m.stderr).trim()
-        ));
-    }
+    prusa::mesh_stl(&exe, step, &stl)?;
     let prusa = match run_prusa(&stl, &dir.join(format!("{name}.gcode"))) {
         PrusaRun::Done(p) => Some(p),
         PrusaRun::Missing(why) => {

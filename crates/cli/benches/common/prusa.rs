@@ -31,6 +31,26 @@ pub enum Run {
 }
 
 /// The PrusaSlicer executable: `$PRUSA_SLICER`, or `prusa-slicer` on the PATH.
+/// Meshes `step` into the binary STL `stl` with our `features mesh` (`exe`) at 0.01 mm, the
+/// part PrusaSlicer is given.
+pub fn mesh_stl(exe: &Path, step: &Path, stl: &Path) -> Result<(), String> {
+    let m = Command::new(exe)
+        .arg("mesh")
+        .arg(step)
+        .arg("-o")
+        .arg(stl)
+        .args(["--tolerance", "0.01"])
+        .output()
+        .map_err(|e| format!("running {}: {e}", exe.display()))?;
+    if !m.status.success() {
+        return Err(format!(
+            "features mesh failed: {}",
+            String::from_utf8_lossy(&m.stderr).trim()
+        ));
+    }
+    Ok(())
+}
+
 pub fn exe() -> String {
     std::env::var("PRUSA_SLICER").unwrap_or_else(|_| "prusa-slicer".into())
 }
