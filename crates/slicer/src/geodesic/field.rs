@@ -1,0 +1,271 @@
+//! Distance fields on a layer mesh: exact seeds near the boundary, fast marching, and the
+//! local maximum of a field (a strip's ridge).
+
+use super::mesh::LayerMesh;
+use crate::fast_hash::FastMap;
+use crate::geom2d::Point2;
+use brep::math::{P3, V3};
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Distance from `p` to the segment `a`–`b` in 3-D.
+pub(crate) fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * t)).norm()
+}
+
+/// A boundary segment of a layer mesh on the layer surface: start, direction (end − start) and
+/// squared length.
+type Segment = (P3, V3, f64);
+
+/// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
+/// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
+/// the root, without taking it.
+pub(super) fn sqrt_at_most(r: f64) -> f64 {
+    if !(r.is_finite() && r >= 0.0) {
+        return if r == f64::INFINITY {
+            f64::INFINITY
+        } else {
+            -1.0
+        };
+    }
+    let step = |x: f64, up: bool| {
+        let b = x.to_bits();
+        f64::from_bits(if up { b + 1 } else { b - 1 })
+    };
+    let mut x = r * r;
+    while x > 0.0 && x.sqrt() > r {
+        x = step(x, false);
+    }
+    while x < f64::MAX && step(x, true).sqrt() <= r {
+        x = step(x, true);
+    }
+    x
+}
+
+/// Min-heap entry for marching.
+#[derive(PartialEq)]
+struct Entry(f64, u32);
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
+    }
+}
+
+/// The planar-wavefront update of vertex `c` from the known vertices `a`, `b` of a triangle
+/// (Kimmel & Sethian 1998): unfold the triangle into the plane, take the distance as linear
+/// over it with a unit gradient matching `da`, `db` along `ab`, and use it when the
+/// characteristic through `c` comes from within `ab` (upwind); otherwise the shorter path along
+/// an edge.
+fn triangle_update(pa: &P3, pb: &P3, pc: &P3, da: f64, db: f64) -> f64 {
+    let along_edges = (da + (pc - pa).norm()).min(db + (pc - pb).norm());
+    let ab = pb - pa;
+    let c = ab.norm();
+    if c < 1e-12 {
+        return along_edges;
+    }
+    let ex = ab / c;
+    let ac = pc - pa;
+    let cx = ac.dot(&ex);
+    let cy = (ac - ex * cx).norm();
+    let gx = (db - da) / c;
+    if cy < 1e-12 || gx.abs() >= 1.0 {
+        return along_edges;
+    }
+    let gy = (1.0 - gx * gx).sqrt();
+    // Where the characteristic through c crosses the line through a and b.
+    let x = cx - gx * cy / gy;
+    let through = da + gx * cx + gy * cy;
+    if (0.0..=c).contains(&x) && through >= da.max(db) {
+        through.min(along_edges)
+    } else {
+        along_edges
+    }
+}
+
+impl LayerMesh {
+    /// Exact 3-D distances to the boundary (the lifted ring polylines) of every vertex within
+    /// `reach` (chart units) of it, as seeds for [`LayerMesh::march`]: a front started from
+    /// exact values a few triangles deep is far more accurate than one started at the ring.
+    pub fn boundary_seeds(&self, reach: f64) -> Vec<(u32, f64)> {
+        // A grid of half-reach cells in the surface-isotropic frame (about mm): the boundary
+        // segments within `reach` of a vertex lie in the 5 × 5 cells around it.
+        let cell = (0.5 * reach).max(1e-9);
+        let frame = self.frame.unwrap_or([1.0, 0.0, 1.0]);
+        let key = |q: Point2| {
+            let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
+            ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
+        };
+        // Each segment as its start and direction (what `segment_distance` computes from its
+        // ends), so a vertex's pass over its cells reads them in a row.
+        let mut grid: FastMap<(i64, i64), Vec<Segment>> = FastMap::default();
+        for ring in &self.rings {
+            let n = ring.len();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let qa = self.q[a as usize];
+                let qb = self.q[b as usize];
+                let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
+                let (pa, pb) = (self.p[a as usize], self.p[b as usize]);
+                let d = pb - pa;
+                grid.entry(key(mid))
+                    .or_default()
+                    .push((pa, d, d.norm_squared()));
+            }
+        }
+        let mut out = vec![];
+        for (v, q) in self.q.iter().enumerate() {
+            let (i, j) = key(*q);
+            let p = self.p[v];
+            // `segment_distance` squared; the square root of the least square is the least
+            // distance (the root is monotone and rounded correctly).
+            let mut best2 = f64::INFINITY;
+            for a in i - 2..=i + 2 {
+                for b in j - 2..=j + 2 {
+                    for &(pa, d, l2) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
+                        let t = if l2 > 0.0 {
+                            ((p - pa).dot(&d) / l2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        best2 = best2.min((p - (pa + d * t)).norm_squared());
+                    }
+                }
+            }
+            let mut best = best2.sqrt();
+            if self.boundary[v] {
+                best = 0.0;
+            }
+            if best.is_finite() && (best <= reach || self.boundary[v]) {
+                out.push((v as u32, best));
+            }
+        }
+        out
+    }
+
+    /// For each vertex where `mask` holds, the largest `f` over the vertices joined to it
+    /// through the mesh within 3-D distance `radius` (others get `f` itself): the local height
+    /// of a ridge of `f` seen from its flanks.
+    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
+        let mut out = f.to_vec();
+        if !mask.iter().any(|&m| m) {
+            return out;
+        }
+        let (first, next) = self.neighbours();
+        let within = sqrt_at_most(radius);
+        // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
+        // between vertices; each vertex's distance is taken once per flood).
+        let mut seen = vec![0u32; self.q.len()];
+        let mut stack = vec![];
+        for v in 0..self.q.len() {
+            if !mask[v] {
+                continue;
+            }
+            let stamp = v as u32 + 1;
+            stack.clear();
+            stack.push(v as u32);
+            seen[v] = stamp;
+            let mut best = f[v];
+            let pv = self.p[v];
+            while let Some(u) = stack.pop() {
+                let u = u as usize;
+                if f[u].is_finite() {
+                    best = best.max(f[u]);
+                }
+                for &x in &next[first[u] as usize..first[u + 1] as usize] {
+                    if seen[x as usize] != stamp {
+                        seen[x as usize] = stamp;
+                        if (self.p[x as usize] - pv).norm_squared() <= within {
+                            stack.push(x);
+                        }
+                    }
+                }
+            }
+            out[v] = best;
+        }
+        out
+    }
+
+    /// The vertices joined to each vertex by an edge of a triangle, as offsets (`first[v]` ..
+    /// `first[v + 1]`) into one list.
+    fn neighbours(&self) -> (Vec<u32>, Vec<u32>) {
+        let n = self.q.len();
+        let mut first = Vec::with_capacity(n + 1);
+        let mut next = Vec::with_capacity(6 * n);
+        first.push(0u32);
+        for v in 0..n {
+            let start = next.len();
+            for &t in &self.around[v] {
+                for &x in &self.tris[t as usize] {
+                    if x as usize != v && !next[start..].contains(&x) {
+                        next.push(x);
+                    }
+                }
+            }
+            first.push(next.len() as u32);
+        }
+        (first, next)
+    }
+
+    /// Distances over the mesh's 3-D points from `seeds` (vertex, starting distance), by fast
+    /// marching. Vertices the front never reaches keep `f64::INFINITY`.
+    pub fn march(&self, seeds: &[(u32, f64)]) -> Vec<f64> {
+        let n = self.p.len();
+        let mut d = vec![f64::INFINITY; n];
+        let mut known = vec![false; n];
+        let mut heap = BinaryHeap::new();
+        // Seeds are exact: the front may not lower them. A triangle with a seed on each side
+        // of a convex corner of the boundary would otherwise give the distance to the chord
+        // across the corner, and the iso-lines would cut the corner off.
+        let mut seeded = vec![false; n];
+        for &(v, s) in seeds {
+            if (v as usize) < n && s < d[v as usize] {
+                d[v as usize] = s;
+                seeded[v as usize] = true;
+                heap.push(Entry(s, v));
+            }
+        }
+        while let Some(Entry(dv, v)) = heap.pop() {
+            let vi = v as usize;
+            if known[vi] || dv > d[vi] {
+                continue;
+            }
+            known[vi] = true;
+            for &t in &self.around[vi] {
+                let tri = self.tris[t as usize];
+                for k in 0..3 {
+                    let c = tri[k] as usize;
+                    if known[c] || seeded[c] {
+                        continue;
+                    }
+                    let (a, b) = (tri[(k + 1) % 3] as usize, tri[(k + 2) % 3] as usize);
+                    let cand = match (known[a], known[b]) {
+                        (true, true) => {
+                            triangle_update(&self.p[a], &self.p[b], &self.p[c], d[a], d[b])
+                        }
+                        (true, false) => d[a] + (self.p[c] - self.p[a]).norm(),
+                        (false, true) => d[b] + (self.p[c] - self.p[b]).norm(),
+                        _ => continue,
+                    };
+                    if cand < d[c] {
+                        d[c] = cand;
+                        heap.push(Entry(cand, c as u32));
+                    }
+                }
+            }
+        }
+        d
+    }
+}
