@@ -3,6 +3,7 @@
 use crate::mesh::{solid_mesh, write_atomic, write_stl};
 use crate::{emit, ExtractArgs, Failure};
 use features::{extract_all, solid_name, ExtractOptions, FeatureTree};
+use plan::report::round;
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -41,10 +42,6 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
         to_text(&source, &solids, &assembly.warnings)
     };
     emit(&text)
-}
-
-fn round(x: f64, scale: f64) -> f64 {
-    (x * scale).round() / scale + 0.0
 }
 
 fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {

@@ -3,6 +3,7 @@
 use crate::{emit, Failure, InspectArgs};
 use brep::solid::{report_solid, SolidReport};
 use brep::StepPart;
+use plan::report::round;
 use serde_json::{json, Map, Value};
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -65,11 +66,6 @@ pub fn run(args: &InspectArgs) -> Result<(), Failure> {
         to_text(&ins)
     };
     emit(&text)
-}
-
-/// `x` rounded to `1 / scale` (scale a power of ten), without `-0`.
-fn round(x: f64, scale: f64) -> f64 {
-    (x * scale).round() / scale + 0.0
 }
 
 fn counts(m: &BTreeMap<String, usize>) -> Value {

@@ -11,7 +11,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let path = &args.part;
     // Settings first: a bad process or machine file fails before any work.
     let (process, machine) = settings(args)?;
-    let settings = args.process.as_deref().unwrap_or(path);
+    // A feature's bad parameters are reported against the process file (or the part without one).
+    let process_file = args.process.as_deref().unwrap_or(path);
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg}");
     let progress = |p: Progress| match p {
@@ -29,7 +30,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         progress: Some(&progress),
     };
     let plan = plan::plan(&part, &process, &machine, &options).map_err(|e| match e {
-        PlanError::Process(e) => Failure::new(settings, e),
+        PlanError::Process(e) => Failure::new(process_file, e),
         PlanError::SelfCheck(problems) => {
             for p in &problems {
                 eprintln!("features: {}: {p}", path.display());

@@ -47,9 +47,6 @@ pub enum PlanError {
     /// layer, or its extruded volume is off its volume × fill.
     #[error("the plan fails its self-check for {} feature(s)", .0.len())]
     SelfCheck(Vec<PlanProblem>),
-    /// The report could not be written as JSON.
-    #[error("cannot write the report: {0}")]
-    Report(#[from] serde_json::Error),
 }
 
 /// Where a plan is: reported to [`Options::progress`].

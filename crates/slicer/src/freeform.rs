@@ -143,7 +143,6 @@ pub fn plan_freeform(
         overhang_layers: None,
     };
     let mut prev_regions: Vec<Region> = vec![];
-    let mut printed_layers = vec![];
     let mut layers = vec![];
     let mut points: Vec<PathPoint> = vec![];
     let mut z = 0.0;
@@ -293,7 +292,6 @@ pub fn plan_freeform(
             });
         }
         if !layer_paths.is_empty() {
-            printed_layers.push(dl);
             layers.push(Layer {
                 index: layer,
                 thickness: dl,
@@ -302,7 +300,8 @@ pub fn plan_freeform(
             });
         }
     }
-    fig.finish(id, points.len(), &printed_layers);
+    let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
+    fig.finish(id, points.len(), &printed);
     if let Some((a, b)) = ff.overhang_layers {
         fig.warnings.push(format!(
             "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",

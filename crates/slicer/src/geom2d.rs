@@ -68,16 +68,16 @@ pub fn region_contains(region: &Region, q: Point2) -> bool {
     for ring in std::iter::once(&region.outer).chain(region.holes.iter()) {
         let n = ring.len();
         for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if (a[1] > q[1]) != (b[1] > q[1]) {
-                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-                if x > q[0] {
-                    inside = !inside;
-                }
-            }
+            inside ^= crosses_right(ring[i], ring[(i + 1) % n], q);
         }
     }
     inside
+}
+
+/// Whether the edge `a`–`b` crosses the ray from `q` in +x (the even-odd step of
+/// [`region_contains`]).
+fn crosses_right(a: Point2, b: Point2, q: Point2) -> bool {
+    (a[1] > q[1]) != (b[1] > q[1]) && a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) > q[0]
 }
 
 /// [`region_contains`] for many points: the region's edges in horizontal bands, so a point is
@@ -139,12 +139,7 @@ impl RegionIndex {
     pub(crate) fn contains(&self, q: Point2) -> bool {
         let mut inside = false;
         for &(a, b) in &self.bands[self.band(q[1])] {
-            if (a[1] > q[1]) != (b[1] > q[1]) {
-                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-                if x > q[0] {
-                    inside = !inside;
-                }
-            }
+            inside ^= crosses_right(a, b, q);
         }
         inside
     }

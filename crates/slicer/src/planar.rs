@@ -163,7 +163,6 @@ pub fn plan_two5d(
     let spacing = params.spacing(bead.width);
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
     let mut fig = FeatureFigures::default();
-    let mut printed = vec![];
     let mut layers = vec![];
     let mut points: Vec<PathPoint> = vec![];
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
@@ -193,7 +192,6 @@ pub fn plan_two5d(
         if paths.is_empty() {
             continue;
         }
-        printed.push(dl);
         let mut layer_paths = Vec::with_capacity(paths.len());
         for path in paths {
             let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
@@ -247,6 +245,7 @@ pub fn plan_two5d(
             paths: layer_paths,
         });
     }
+    let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
     fig.finish(f.id, points.len(), &printed);
     Ok(FeaturePlan {
         feature: f.id,

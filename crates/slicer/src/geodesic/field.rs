@@ -10,19 +10,37 @@ use std::collections::BinaryHeap;
 
 /// Distance from `p` to the segment `a`–`b` in 3-D.
 pub(crate) fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
-    let d = b - a;
-    let l2 = d.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + d * t)).norm()
+    Segment::new(*a, *b).distance2(p).sqrt()
 }
 
-/// A boundary segment of a layer mesh on the layer surface: start, direction (end − start) and
-/// squared length.
-type Segment = (P3, V3, f64);
+/// A segment in 3-D as its start, direction (end − start) and squared length.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    a: P3,
+    d: V3,
+    l2: f64,
+}
+
+impl Segment {
+    fn new(a: P3, b: P3) -> Segment {
+        let d = b - a;
+        Segment {
+            a,
+            d,
+            l2: d.norm_squared(),
+        }
+    }
+
+    /// The squared distance from `p` to the segment.
+    fn distance2(&self, p: &P3) -> f64 {
+        let t = if self.l2 > 0.0 {
+            ((p - self.a).dot(&self.d) / self.l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (self.a + self.d * t)).norm_squared()
+    }
+}
 
 /// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
 /// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
@@ -108,8 +126,8 @@ impl LayerMesh {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
             ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
         };
-        // Each segment as its start and direction (what `segment_distance` computes from its
-        // ends), so a vertex's pass over its cells reads them in a row.
+        // Each segment with its direction and length computed once, so a vertex's pass over
+        // its cells reads them in a row.
         let mut grid: FastMap<(i64, i64), Vec<Segment>> = FastMap::default();
         for ring in &self.rings {
             let n = ring.len();
@@ -118,11 +136,9 @@ impl LayerMesh {
                 let qa = self.q[a as usize];
                 let qb = self.q[b as usize];
                 let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
-                let (pa, pb) = (self.p[a as usize], self.p[b as usize]);
-                let d = pb - pa;
                 grid.entry(key(mid))
                     .or_default()
-                    .push((pa, d, d.norm_squared()));
+                    .push(Segment::new(self.p[a as usize], self.p[b as usize]));
             }
         }
         let mut out = vec![];
@@ -134,13 +150,8 @@ impl LayerMesh {
             let mut best2 = f64::INFINITY;
             for a in i - 2..=i + 2 {
                 for b in j - 2..=j + 2 {
-                    for &(pa, d, l2) in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
-                        let t = if l2 > 0.0 {
-                            ((p - pa).dot(&d) / l2).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        best2 = best2.min((p - (pa + d * t)).norm_squared());
+                    for s in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
+                        best2 = best2.min(s.distance2(&p));
                     }
                 }
             }
