@@ -11,8 +11,10 @@
 #![warn(missing_docs)]
 
 mod bead;
+mod fixed;
 mod path;
 pub mod vec3;
 
 pub use bead::Bead;
-pub use path::{fixed, push_fixed, MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};
+pub use fixed::{fixed, push_fixed};
+pub use path::{MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};

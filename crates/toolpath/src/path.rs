@@ -1,5 +1,7 @@
 //! The planned tool path the posts consume (the planner fills it), and its `toolpath.csv` form.
 
+use crate::fixed::push_fixed;
+
 /// Why a tool path could not be read or used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ToolPathError {
@@ -23,42 +25,6 @@ pub enum ToolPathError {
         /// The field that is not finite.
         field: &'static str,
     },
-}
-
-/// `x` in fixed-point with `decimals` places: never exponent notation, never `-0`.
-pub fn fixed(x: f64, decimals: usize) -> String {
-    let mut s = String::new();
-    push_fixed(&mut s, x, decimals);
-    s
-}
-
-/// Appends [`fixed`]`(x, decimals)` to `out` without a new allocation.
-pub fn push_fixed(out: &mut String, x: f64, decimals: usize) {
-    use std::fmt::Write as _;
-    let start = out.len();
-    // Writing to a String cannot fail.
-    let _ = write!(out, "{x:.decimals$}");
-    let written = &out.as_bytes()[start..];
-    if written.first() == Some(&b'-') && written[1..].iter().all(|&b| b == b'0' || b == b'.') {
-        out.remove(start);
-    }
-}
-
-#[cfg(test)]
-mod fixed_tests {
-    use super::fixed;
-
-    #[test]
-    fn fixed_point_without_negative_zero_or_exponent() {
-        assert_eq!(fixed(-0.0, 3), "0.000");
-        assert_eq!(fixed(-0.0004, 3), "0.000");
-        assert_eq!(fixed(-0.0005001, 3), "-0.001");
-        assert_eq!(fixed(1e-12, 5), "0.00000");
-        assert_eq!(fixed(1.5e21, 1), "1500000000000000000000.0");
-        assert_eq!(fixed(2100.4, 0), "2100");
-        assert_eq!(fixed(-0.4, 0), "0");
-        assert_eq!(fixed(12.3456789, 6), "12.345679");
-    }
 }
 
 /// Whether the nozzle deposits on the segment ending at a point.

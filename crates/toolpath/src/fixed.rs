@@ -1,0 +1,181 @@
+//! Fixed-point text of a number, as every program and `toolpath.csv` write it.
+//!
+//! The text is exactly Rust's `format!("{x:.d$}")` (the exact binary value rounded to `d`
+//! decimals, a tie to the even last digit) with `-0` written `0`. For the decimals the programs
+//! use (at most 9) and magnitudes under 2^63 / 10^9 it is computed in integers: `x = m·2^e`
+//! exactly, so `x·10^d = m·10^d·2^e` with `m·10^d < 2^83`, shifted and rounded in `u128`.
+//! That is the same number `format!` prints, at a fraction of its cost (the standard
+//! formatter falls back to big-number arithmetic for many values); other inputs take
+//! `format!` itself.
+
+/// `x` in fixed-point with `decimals` places: never exponent notation, never `-0`.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    let mut s = String::new();
+    push_fixed(&mut s, x, decimals);
+    s
+}
+
+/// Appends [`fixed`]`(x, decimals)` to `out` without a new allocation.
+pub fn push_fixed(out: &mut String, x: f64, decimals: usize) {
+    match scaled(x, decimals) {
+        Some((negative, n)) => push_scaled(out, negative, n, decimals),
+        None => push_formatted(out, x, decimals),
+    }
+}
+
+/// The largest decimals and magnitude taken in integers.
+const MAX_DECIMALS: usize = 9;
+const MAX_MAGNITUDE: f64 = 9.0e9;
+
+/// `(sign, round(|x|·10^decimals))`, rounded half to even, where the integer path applies.
+fn scaled(x: f64, decimals: usize) -> Option<(bool, u128)> {
+    if decimals > MAX_DECIMALS || !x.is_finite() || x.abs() >= MAX_MAGNITUDE {
+        return None;
+    }
+    let bits = x.to_bits();
+    let negative = bits >> 63 == 1;
+    let biased = ((bits >> 52) & 0x7ff) as i32;
+    let fraction = bits & ((1u64 << 52) - 1);
+    // x = m · 2^e exactly.
+    let (m, e) = if biased == 0 {
+        (fraction, -1074)
+    } else {
+        (fraction | (1u64 << 52), biased - 1075)
+    };
+    let n = m as u128 * 10u128.pow(decimals as u32);
+    let q = if e >= 0 {
+        // |x| < 9e9 < 2^34 and m ≥ 2^52 for a normal number, so e ≤ 0 except for
+        // integers, whose shift stays far inside u128.
+        n << e
+    } else {
+        let s = (-e) as u32;
+        if s >= 127 {
+            // Below 2^-74 · 10^9: rounds to zero (far from a half).
+            0
+        } else {
+            let q = n >> s;
+            let r = n & ((1u128 << s) - 1);
+            let half = 1u128 << (s - 1);
+            if r > half || (r == half && q & 1 == 1) {
+                q + 1
+            } else {
+                q
+            }
+        }
+    };
+    Some((negative, q))
+}
+
+/// Writes the integer `n` as a fixed-point number with `decimals` places.
+fn push_scaled(out: &mut String, negative: bool, n: u128, decimals: usize) {
+    let mut digits = [0u8; 40];
+    let mut len = 0;
+    let mut v = n;
+    while v > 0 || len <= decimals {
+        digits[len] = b'0' + (v % 10) as u8;
+        v /= 10;
+        len += 1;
+    }
+    if negative && n != 0 {
+        out.push('-');
+    }
+    for i in (0..len).rev() {
+        out.push(digits[i] as char);
+        if i == decimals && decimals > 0 {
+            out.push('.');
+        }
+    }
+}
+
+/// The standard formatter, with `-0` written `0`.
+fn push_formatted(out: &mut String, x: f64, decimals: usize) {
+    use std::fmt::Write as _;
+    let start = out.len();
+    // Writing to a String cannot fail.
+    let _ = write!(out, "{x:.decimals$}");
+    let written = &out.as_bytes()[start..];
+    if written.first() == Some(&b'-') && written[1..].iter().all(|&b| b == b'0' || b == b'.') {
+        out.remove(start);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{fixed, push_formatted};
+
+    fn reference(x: f64, d: usize) -> String {
+        let mut s = String::new();
+        push_formatted(&mut s, x, d);
+        s
+    }
+
+    #[test]
+    fn fixed_point_without_negative_zero_or_exponent() {
+        assert_eq!(fixed(-0.0, 3), "0.000");
+        assert_eq!(fixed(-0.0004, 3), "0.000");
+        assert_eq!(fixed(-0.0005001, 3), "-0.001");
+        assert_eq!(fixed(1e-12, 5), "0.00000");
+        assert_eq!(fixed(1.5e21, 1), "1500000000000000000000.0");
+        assert_eq!(fixed(2100.4, 0), "2100");
+        assert_eq!(fixed(-0.4, 0), "0");
+        assert_eq!(fixed(12.3456789, 6), "12.345679");
+    }
+
+    #[test]
+    fn ties_go_to_the_even_digit_as_the_standard_formatter_does() {
+        for (x, d) in [
+            (0.5, 0),
+            (1.5, 0),
+            (2.5, 0),
+            (-2.5, 0),
+            (0.125, 2),
+            (0.375, 2),
+            (0.0625, 3),
+            (-0.0625, 3),
+            (1.0 / 1024.0, 9),
+            (4.0e9 + 0.5, 0),
+        ] {
+            assert_eq!(fixed(x, d), reference(x, d), "{x} with {d} decimals");
+        }
+    }
+
+    /// The integer path prints exactly what `format!` prints, over numbers of every scale
+    /// (a fixed xorshift sequence of bit patterns and of decimal-looking values).
+    #[test]
+    fn same_text_as_the_standard_formatter() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for i in 0..100_000 {
+            let r = next();
+            let x = match i % 4 {
+                // Any finite double.
+                0 => f64::from_bits(r),
+                // Magnitudes from 1e-12 to 1e10.
+                1 => {
+                    let m = (r >> 11) as f64 / (1u64 << 53) as f64;
+                    let s = 10f64.powi((r % 23) as i32 - 12);
+                    if r & 1 == 0 {
+                        m * s
+                    } else {
+                        -m * s
+                    }
+                }
+                // Values near a printed grid (what positions and extrusions look like).
+                2 => ((r % 2_000_000_000) as f64 - 1e9) / 10f64.powi((r % 10) as i32),
+                // Halves of the last printed digit, the hard cases.
+                _ => ((r % 20_000_001) as f64 - 1e7 + 0.5) / 10f64.powi((r % 7) as i32),
+            };
+            if !x.is_finite() {
+                continue;
+            }
+            for d in [0, 1, 2, 3, 4, 5, 6, 9, 12] {
+                assert_eq!(fixed(x, d), reference(x, d), "{x:e} with {d} decimals");
+            }
+        }
+    }
+}
