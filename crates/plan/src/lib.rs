@@ -169,7 +169,7 @@ pub fn plan(
                     .iter()
                     .map(|q| -plate.height(&P3::from(q.p)))
                     .fold(0.0f64, f64::max);
-                let depth = planned.max(slicer::planar::depth_below(t, f, plate));
+                let depth = planned.max(plan.figures.below_plate);
                 if depth > 1e-3 {
                     let w = format!("feature {id} reaches {depth:.3} mm below the build plate");
                     fw.push(w.clone());

@@ -15,6 +15,11 @@ pub struct FeatureFigures {
     pub filament: f64,
     /// Thinnest, mean and thickest layer, mm.
     pub thickness: (f64, f64, f64),
+    /// How far (mm) the feature's surface reaches below its tree's build plate (the base
+    /// feature's reference plane): 0 when it does not. Measured on the mesh the feature is
+    /// sliced from (its vertices lie on the exact faces, within the slicing tolerance of the
+    /// lowest point of a curved face), so the feature is not meshed a second time for it.
+    pub below_plate: f64,
     /// Things to know.
     pub warnings: Vec<String>,
 }

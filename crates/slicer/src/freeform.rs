@@ -100,6 +100,7 @@ pub fn plan_freeform(
     if mesh.positions.is_empty() {
         return Err(err("its mesh is empty".into()));
     }
+    let below = crate::planar::below_plate(tree, &mesh.positions);
     let mesh = refined(&mesh, MAX_MAPPED_EDGE);
     // Offset deterioration first: a concave reference under the feature folds its offsets
     // before they reach the feature's top, and the feature may not even have a chart then
@@ -132,7 +133,10 @@ pub fn plan_freeform(
         f64::INFINITY
     };
     let spacing = params.spacing(bead.width);
-    let mut fig = FeatureFigures::default();
+    let mut fig = FeatureFigures {
+        below_plate: below,
+        ..FeatureFigures::default()
+    };
     let mut ff = FreeformFigures {
         chart: match chart.kind {
             ChartKind::Native { .. } => "native",

@@ -69,13 +69,15 @@ fn surface_points(tree: &FeatureTree, f: &Feature) -> Vec<P3> {
     .unwrap_or_default()
 }
 
-/// How far (mm) feature `f` reaches below `plane` (the build plate): 0 when it does not.
-/// Measured on its faces' surfaces, not its vertices, so a curved face dipping below the
-/// plate between its vertices counts; within `EXTREME_TOL` (0.01 mm).
-pub fn depth_below(tree: &FeatureTree, f: &Feature, plane: &Plane) -> f64 {
-    surface_points(tree, f)
+/// How far (mm) `points` (a feature's mesh) reach below the build plate of `tree` (its base
+/// feature's reference plane): 0 when they do not, or when the tree has no plate.
+pub(crate) fn below_plate(tree: &FeatureTree, points: &[P3]) -> f64 {
+    let Some(plate) = tree.features.first().and_then(|b| reference_plane(tree, b)) else {
+        return 0.0;
+    };
+    points
         .iter()
-        .map(|p| -plane.height(p))
+        .map(|p| -plate.height(p))
         .fold(0.0f64, f64::max)
 }
 
@@ -162,7 +164,10 @@ pub fn plan_two5d(
     let heights = params.layer_heights(top);
     let spacing = params.spacing(bead.width);
     let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
-    let mut fig = FeatureFigures::default();
+    let mut fig = FeatureFigures {
+        below_plate: below_plate(tree, &mesh.positions),
+        ..FeatureFigures::default()
+    };
     let mut layers = vec![];
     let mut points: Vec<PathPoint> = vec![];
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
