@@ -17,16 +17,15 @@ pub use process::{Process, ProcessError};
 pub use report::{FeatureEntry, FeatureReport, PlanReport};
 
 use brep::math::P3;
-use features::{extract_all, ExtractOptions, FeatureKind};
+use features::{extract_all, ExtractOptions};
+use rayon::prelude::*;
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
 use robot_post::{Job, PostFigures, ProgramFile};
-use slicer::freeform::plan_freeform;
 use slicer::orient::{smooth, OrientationFigures};
-use slicer::planar::plan_two5d;
-use slicer::sequence;
 use slicer::toolpath::ToolPath;
 use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
+use slicer::{fill_feature, sequence};
 
 /// Why a part could not be planned. Each message is one line.
 #[derive(Debug, thiserror::Error)]
@@ -124,30 +123,55 @@ pub fn plan(
 
     let assembly = extract_all(&part.brep, &ExtractOptions::default())?;
     let trees = &assembly.trees;
+    // Each tree's build plate: its base feature's reference plane.
+    let plates: Vec<_> = trees
+        .iter()
+        .map(|t| {
+            t.features
+                .first()
+                .and_then(|b| slicer::planar::reference_plane(t, b))
+        })
+        .collect();
     tell(Progress::Start {
         features: trees.iter().map(|t| t.features.len() as u64).sum(),
     });
 
+    // Every feature in build order: its tree, its index there and its file-wide id.
+    let mut order = vec![];
+    let mut offset = 0usize;
+    for (ti, t) in trees.iter().enumerate() {
+        for &k in &t.build_order {
+            order.push((ti, k, offset));
+        }
+        offset += t.features.len();
+    }
+    // Features are filled (sectioned and filled layer by layer: the bulk of the work) a few
+    // at a time in parallel, as many as there are threads, so memory holds no more than that
+    // many fills; then laid one after the other, each from where the one before ended.
+    let window = rayon::current_num_threads().max(1);
     let mut plans = vec![];
     let mut cursor: Option<P3> = None;
     let mut reports = vec![];
     let mut warnings: Vec<String> = vec![];
-    let mut offset = 0usize;
     let mut planned = vec![];
-    for t in trees {
-        let plate = t
-            .features
-            .first()
-            .and_then(|b| slicer::planar::reference_plane(t, b));
-        for &k in &t.build_order {
+    for chunk in order.chunks(window) {
+        let fills: Vec<Result<_, PlanError>> = chunk
+            .par_iter()
+            .map(|&(ti, k, offset)| {
+                let t = &trees[ti];
+                let f = &t.features[k];
+                let params = process.params_for(&base, offset + f.id)?;
+                let fill = fill_feature(t, f, &params, bead)?;
+                Ok((params, fill))
+            })
+            .collect();
+        for (&(ti, k, offset), fill) in chunk.iter().zip(fills) {
+            let t = &trees[ti];
             let f = &t.features[k];
             let id = offset + f.id;
             tell(Progress::Feature { id });
-            let params = process.params_for(&base, id)?;
-            let plan = match f.kind {
-                FeatureKind::Two5d => plan_two5d(t, f, &params, bead, cursor)?,
-                FeatureKind::Freeform => plan_freeform(t, f, &params, bead, cursor)?,
-            };
+            let (params, fill) = fill?;
+            let plan = fill.lay(cursor);
             cursor = plan.exit().map(P3::from).or(cursor);
             let fig = &plan.figures;
             let extruded = fig.filament * filament_area;
@@ -163,7 +187,7 @@ pub fn plan(
             // Below the build plate (the base feature's reference plane): any point of the
             // feature, planned or not (a planar layer starts at its reference plane, so what
             // lies below that is not printed).
-            if let Some(plate) = &plate {
+            if let Some(plate) = &plates[ti] {
                 let planned = plan
                     .points
                     .iter()
@@ -201,7 +225,6 @@ pub fn plan(
             plans.push((id, plan));
             tell(Progress::FeatureDone);
         }
-        offset += t.features.len();
     }
     warnings.extend(assembly.all_warnings());
     tell(Progress::Planned);

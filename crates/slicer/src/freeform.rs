@@ -38,7 +38,7 @@ pub use crate::figures::FreeformFigures;
 use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
-use crate::lift::lift;
+use crate::lift::{lift, Lifted};
 use crate::params::{LayerParams, PathMode};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
@@ -69,7 +69,7 @@ fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
 }
 
 /// Plans one freeform feature on offsets of its reference surface; its first travel starts at
-/// `entry` (where the nozzle is, if anywhere).
+/// `entry` (where the nozzle is, if anywhere): [`fill_freeform`], then [`FreeformFill::lay`].
 pub fn plan_freeform(
     tree: &FeatureTree,
     f: &Feature,
@@ -77,8 +77,36 @@ pub fn plan_freeform(
     bead: Bead,
     entry: Option<P3>,
 ) -> Result<FeaturePlan, PlanError> {
-    let mut cursor = entry;
-    let cursor = &mut cursor;
+    Ok(fill_freeform(tree, f, params, bead)?.lay(entry))
+}
+
+/// A freeform feature's layers filled in its chart, before they are ordered from where the
+/// nozzle is, lifted onto their offset surfaces and joined by travel: all of a feature's
+/// planning that does not depend on where the feature before it ended, so features can be
+/// filled in parallel and laid one after the other.
+pub struct FreeformFill<'a> {
+    id: usize,
+    chart: Chart<'a>,
+    params: LayerParams,
+    bead: Bead,
+    fixed: Option<V3>,
+    heights: Vec<f64>,
+    /// Each layer's middle and top offset.
+    tops: Vec<(f64, f64)>,
+    /// Each layer's regions and fill paths in the chart.
+    filled: Vec<(Vec<Region>, Vec<FillPath>)>,
+    fig: FeatureFigures,
+    ff: FreeformFigures,
+}
+
+/// Fills every layer of a freeform feature in its chart (the offsets of its reference
+/// surface, sectioned and filled in parallel): see the module documentation.
+pub fn fill_freeform<'a>(
+    tree: &'a FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+) -> Result<FreeformFill<'a>, PlanError> {
     let id = f.id;
     let err = |msg: String| PlanError::Freeform { id, msg };
     if f.kind != FeatureKind::Freeform {
@@ -133,11 +161,11 @@ pub fn plan_freeform(
         f64::INFINITY
     };
     let spacing = params.spacing(bead.width);
-    let mut fig = FeatureFigures {
+    let fig = FeatureFigures {
         below_plate: below,
         ..FeatureFigures::default()
     };
-    let mut ff = FreeformFigures {
+    let ff = FreeformFigures {
         chart: match chart.kind {
             ChartKind::Native { .. } => "native",
             ChartKind::Ortho { .. } => "projection",
@@ -146,9 +174,6 @@ pub fn plan_freeform(
         overhang_points: 0,
         overhang_layers: None,
     };
-    let mut prev_regions: Vec<Region> = vec![];
-    let mut layers = vec![];
-    let mut points: Vec<PathPoint> = vec![];
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -193,130 +218,178 @@ pub fn plan_freeform(
             (regions, paths)
         })
         .collect();
-    for (layer, ((&dl, &(_, z)), (regions, paths))) in
-        heights.iter().zip(&tops).zip(filled).enumerate()
-    {
-        let below = std::mem::replace(&mut prev_regions, regions);
-        let start = cursor
-            .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
-            .unwrap_or([0.0, 0.0]);
-        let paths = if params.path_mode == PathMode::Raster {
-            paths
-        } else {
-            order_fill_paths(paths, start)
-        };
-        let mut layer_paths: Vec<LayerPath> = vec![];
-        for path in paths {
-            let pts = lift(&chart, &path, z, params.tolerance);
-            if pts.len() < 2 {
-                continue;
-            }
-            // Support: the layer below (or, under the first layer, the reference face).
-            for x in &pts {
-                let held = if layer == 0 {
-                    chart.on_face(x.q)
-                } else {
-                    near_regions(&below, x.q, 0.5 * bead.width / chart.stretch(x.q, z))
-                };
-                if !held {
-                    ff.overhang_points += 1;
+    Ok(FreeformFill {
+        id,
+        chart,
+        params: params.clone(),
+        bead,
+        fixed,
+        heights,
+        tops,
+        filled,
+        fig,
+        ff,
+    })
+}
+
+impl FreeformFill<'_> {
+    /// Orders each layer's paths from where the nozzle is (starting at `entry`), lifts them
+    /// onto the layer's offset surface (the paths of a layer in parallel) and joins them by
+    /// travel over the layer above.
+    pub fn lay(self, entry: Option<P3>) -> FeaturePlan {
+        let FreeformFill {
+            id,
+            chart,
+            params,
+            bead,
+            fixed,
+            heights,
+            tops,
+            filled,
+            mut fig,
+            mut ff,
+        } = self;
+        let params = &params;
+        let mut cursor = entry;
+        let cursor = &mut cursor;
+        let mut prev_regions: Vec<Region> = vec![];
+        let mut layers = vec![];
+        let mut points: Vec<PathPoint> = vec![];
+        for (layer, ((&dl, &(_, z)), (regions, paths))) in
+            heights.iter().zip(&tops).zip(filled).enumerate()
+        {
+            let below = std::mem::replace(&mut prev_regions, regions);
+            let start = cursor
+                .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
+                .unwrap_or([0.0, 0.0]);
+            let paths = if params.path_mode == PathMode::Raster {
+                paths
+            } else {
+                order_fill_paths(paths, start)
+            };
+            // Each path lifted onto the layer and its unsupported points counted, in parallel.
+            let lifted: Vec<(Vec<Lifted>, usize)> = paths
+                .par_iter()
+                .map(|path| {
+                    let pts = lift(&chart, path, z, params.tolerance);
+                    // Support: the layer below (or, under the first layer, the reference face).
+                    let unheld = pts
+                        .iter()
+                        .filter(|x| {
+                            !if layer == 0 {
+                                chart.on_face(x.q)
+                            } else {
+                                near_regions(&below, x.q, 0.5 * bead.width / chart.stretch(x.q, z))
+                            }
+                        })
+                        .count();
+                    (pts, unheld)
+                })
+                .collect();
+            let mut layer_paths: Vec<LayerPath> = vec![];
+            for (pts, unheld) in lifted {
+                if pts.len() < 2 {
+                    continue;
+                }
+                if unheld > 0 {
+                    ff.overhang_points += unheld;
                     let l = layer + 1;
                     ff.overhang_layers = Some(match ff.overhang_layers {
                         Some((a, b)) => (a.min(l), b.max(l)),
                         None => (l, l),
                     });
                 }
-            }
-            let start = points.len();
-            let axis = |n: V3| {
-                let a = fixed.unwrap_or(n);
-                [a.x, a.y, a.z]
-            };
-            // Travel: up one layer over the start of the path, along the layer above
-            // (clear of this layer's beads on a curved surface), then down.
-            let first = pts[0];
-            let lift_to = z + dl;
-            let mut travel: Vec<(P3, V3)> = vec![];
-            if let Some(c) = *cursor {
-                if let Some((qc, dc)) = chart.inverse(&c) {
-                    let hz = lift_to.max(dc + dl);
-                    let span = dist2(first.q, qc).sqrt();
-                    let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
-                    for i in 0..=n {
-                        let t = i as f64 / n as f64;
-                        let q = [
-                            qc[0] + (first.q[0] - qc[0]) * t,
-                            qc[1] + (first.q[1] - qc[1]) * t,
-                        ];
-                        if let Some(x) = chart.at(q, hz) {
-                            travel.push(x);
+                let start = points.len();
+                let axis = |n: V3| {
+                    let a = fixed.unwrap_or(n);
+                    [a.x, a.y, a.z]
+                };
+                // Travel: up one layer over the start of the path, along the layer above
+                // (clear of this layer's beads on a curved surface), then down.
+                let first = pts[0];
+                let lift_to = z + dl;
+                let mut travel: Vec<(P3, V3)> = vec![];
+                if let Some(c) = *cursor {
+                    if let Some((qc, dc)) = chart.inverse(&c) {
+                        let hz = lift_to.max(dc + dl);
+                        let span = dist2(first.q, qc).sqrt();
+                        let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
+                        for i in 0..=n {
+                            let t = i as f64 / n as f64;
+                            let q = [
+                                qc[0] + (first.q[0] - qc[0]) * t,
+                                qc[1] + (first.q[1] - qc[1]) * t,
+                            ];
+                            if let Some(x) = chart.at(q, hz) {
+                                travel.push(x);
+                            }
                         }
                     }
                 }
-            }
-            travel.push((first.p, first.n));
-            for (p, n) in travel {
-                if let Some(c) = *cursor {
-                    fig.travel_length += (p - c).norm();
+                travel.push((first.p, first.n));
+                for (p, n) in travel {
+                    if let Some(c) = *cursor {
+                        fig.travel_length += (p - c).norm();
+                    }
+                    points.push(PathPoint {
+                        feature: id,
+                        layer,
+                        kind: MoveKind::Travel,
+                        p: [p.x, p.y, p.z],
+                        axis: axis(n),
+                        e: 0.0,
+                        thickness: dl,
+                        width: bead.width,
+                    });
+                    *cursor = Some(p);
                 }
-                points.push(PathPoint {
-                    feature: id,
-                    layer,
-                    kind: MoveKind::Travel,
-                    p: [p.x, p.y, p.z],
-                    axis: axis(n),
-                    e: 0.0,
-                    thickness: dl,
-                    width: bead.width,
-                });
-                *cursor = Some(p);
-            }
-            let print_start = points.len();
-            for w in pts.windows(2) {
-                let l = (w[1].p - w[0].p).norm();
-                let width = 0.5 * (w[0].w + w[1].w);
-                let e = bead.filament_length(width, dl, l);
-                fig.print_length += l;
-                fig.filament += e;
-                points.push(PathPoint {
-                    feature: id,
-                    layer,
-                    kind: MoveKind::Print,
-                    p: [w[1].p.x, w[1].p.y, w[1].p.z],
-                    axis: axis(w[1].n),
-                    e,
-                    thickness: dl,
-                    width,
+                let print_start = points.len();
+                for w in pts.windows(2) {
+                    let l = (w[1].p - w[0].p).norm();
+                    let width = 0.5 * (w[0].w + w[1].w);
+                    let e = bead.filament_length(width, dl, l);
+                    fig.print_length += l;
+                    fig.filament += e;
+                    points.push(PathPoint {
+                        feature: id,
+                        layer,
+                        kind: MoveKind::Print,
+                        p: [w[1].p.x, w[1].p.y, w[1].p.z],
+                        axis: axis(w[1].n),
+                        e,
+                        thickness: dl,
+                        width,
+                    });
+                }
+                *cursor = pts.last().map(|x| x.p);
+                layer_paths.push(LayerPath {
+                    travel: start..print_start,
+                    print: print_start..points.len(),
                 });
             }
-            *cursor = pts.last().map(|x| x.p);
-            layer_paths.push(LayerPath {
-                travel: start..print_start,
-                print: print_start..points.len(),
-            });
+            if !layer_paths.is_empty() {
+                layers.push(Layer {
+                    index: layer,
+                    thickness: dl,
+                    surface: LayerSurface::Offset { offset: z },
+                    paths: layer_paths,
+                });
+            }
         }
-        if !layer_paths.is_empty() {
-            layers.push(Layer {
-                index: layer,
-                thickness: dl,
-                surface: LayerSurface::Offset { offset: z },
-                paths: layer_paths,
-            });
+        let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
+        fig.finish(id, points.len(), &printed);
+        if let Some((a, b)) = ff.overhang_layers {
+            fig.warnings.push(format!(
+                "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
+                ff.overhang_points
+            ));
+        }
+        FeaturePlan {
+            feature: id,
+            points,
+            layers,
+            figures: fig,
+            freeform: Some(ff),
         }
     }
-    let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
-    fig.finish(id, points.len(), &printed);
-    if let Some((a, b)) = ff.overhang_layers {
-        fig.warnings.push(format!(
-            "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
-            ff.overhang_points
-        ));
-    }
-    Ok(FeaturePlan {
-        feature: f.id,
-        points,
-        layers,
-        figures: fig,
-        freeform: Some(ff),
-    })
 }

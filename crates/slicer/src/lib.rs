@@ -4,6 +4,8 @@
 //!   validation, per-feature patches and the layer thicknesses they give;
 //! - [`fill`]: filling one planar layer by path mode (raster, zig-zag, contour,
 //!   contour-zig-zag) and ordering the paths for print;
+//! - [`feature_fill`]: a feature's layers filled by its planner before they are laid from where
+//!   the nozzle is (the part of planning that features do in parallel);
 //! - [`feature_plan`]: what a planner returns ([`FeaturePlan`] of [`Layer`]s of paths) and
 //!   [`feature_plan::sequence`], which joins the features' plans into the tool path;
 //! - [`freeform`]: curved layers of `freeform` features: offsets of the reference surface,
@@ -28,6 +30,7 @@
 mod chart;
 pub mod error;
 mod fast_hash;
+pub mod feature_fill;
 mod feature_mesh;
 pub mod feature_plan;
 pub mod figures;
@@ -47,6 +50,7 @@ pub mod verify;
 pub use toolpath;
 pub use toolpath::vec3;
 
+pub use feature_fill::{fill_feature, FeatureFill};
 pub use feature_plan::{sequence, FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
 pub use params::{LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

@@ -138,8 +138,9 @@ pub fn fill_regions(
     paths
 }
 
-/// Plans one two5d feature in planar layers; its first travel starts at `entry` (where the
-/// nozzle is, if anywhere).
+/// Plans one two5d feature in planar layers parallel to its reference plane; its first travel
+/// starts at `entry` (where the nozzle is, if anywhere): [`fill_two5d`], then
+/// [`Two5dFill::lay`].
 pub fn plan_two5d(
     tree: &FeatureTree,
     f: &Feature,
@@ -147,7 +148,29 @@ pub fn plan_two5d(
     bead: Bead,
     entry: Option<P3>,
 ) -> Result<FeaturePlan, PlanError> {
-    let mut cursor = entry;
+    Ok(fill_two5d(tree, f, params, bead)?.lay(entry))
+}
+
+/// A two5d feature's layers sectioned and filled in their planes, before they are ordered
+/// from where the nozzle is and joined by travel (see [`crate::freeform::FreeformFill`]).
+pub struct Two5dFill {
+    id: usize,
+    plane: Plane,
+    bead: Bead,
+    /// Each layer's middle and top height and thickness.
+    tops: Vec<(f64, f64, f64)>,
+    /// Each layer's fill paths in its plane.
+    filled: Vec<Vec<FillPath>>,
+    fig: FeatureFigures,
+}
+
+/// Sections and fills every layer of a two5d feature (in parallel).
+pub fn fill_two5d(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+) -> Result<Two5dFill, PlanError> {
     if f.kind != FeatureKind::Two5d {
         return Err(PlanError::NotTwo5d(f.id));
     }
@@ -163,13 +186,10 @@ pub fn plan_two5d(
         .fold(0.0f64, f64::max);
     let heights = params.layer_heights(top);
     let spacing = params.spacing(bead.width);
-    let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
-    let mut fig = FeatureFigures {
+    let fig = FeatureFigures {
         below_plate: below_plate(tree, &mesh.positions),
         ..FeatureFigures::default()
     };
-    let mut layers = vec![];
-    let mut points: Vec<PathPoint> = vec![];
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
     // ordered and joined by travel one layer after the other.
     let mut tops = Vec::with_capacity(heights.len());
@@ -191,72 +211,99 @@ pub fn plan_two5d(
             fill_regions(regions, params, layer, bead.width, spacing)
         })
         .collect();
-    for (layer, (paths, &(_, z, dl))) in filled.into_iter().zip(&tops).enumerate() {
-        let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-        let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
-        if paths.is_empty() {
-            continue;
-        }
-        let mut layer_paths = Vec::with_capacity(paths.len());
-        for path in paths {
-            let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
-            let Some(first) = pts.first() else { continue };
-            // Travel to the start of the path.
-            if let Some(c) = cursor {
-                fig.travel_length += (first - c).norm();
+    Ok(Two5dFill {
+        id: f.id,
+        plane,
+        bead,
+        tops,
+        filled,
+        fig,
+    })
+}
+
+impl Two5dFill {
+    /// Orders each layer's paths from where the nozzle is (starting at `entry`) and joins them
+    /// by travel.
+    pub fn lay(self, entry: Option<P3>) -> FeaturePlan {
+        let Two5dFill {
+            id,
+            plane,
+            bead,
+            tops,
+            filled,
+            mut fig,
+        } = self;
+        let mut cursor = entry;
+        let axis = [plane.normal.x, plane.normal.y, plane.normal.z];
+        let mut layers = vec![];
+        let mut points: Vec<PathPoint> = vec![];
+        for (layer, (paths, &(_, z, dl))) in filled.into_iter().zip(&tops).enumerate() {
+            let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
+            let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
+            if paths.is_empty() {
+                continue;
             }
-            let start = points.len();
-            points.push(PathPoint {
-                feature: f.id,
-                layer,
-                kind: MoveKind::Travel,
-                p: [first.x, first.y, first.z],
-                axis,
-                e: 0.0,
-                thickness: dl,
-                width: path.widths[0],
-            });
-            for (i, w) in pts.windows(2).enumerate() {
-                let l = (w[1] - w[0]).norm();
-                // Eq. 1 with the bead's width along the segment.
-                let width = 0.5 * (path.widths[i] + path.widths[i + 1]);
-                let e = bead.filament_length(width, dl, l);
-                fig.print_length += l;
-                fig.filament += e;
+            let mut layer_paths = Vec::with_capacity(paths.len());
+            for path in paths {
+                let pts: Vec<P3> = path.points.iter().map(|q| plane.to_3d(*q, z)).collect();
+                let Some(first) = pts.first() else { continue };
+                // Travel to the start of the path.
+                if let Some(c) = cursor {
+                    fig.travel_length += (first - c).norm();
+                }
+                let start = points.len();
                 points.push(PathPoint {
-                    feature: f.id,
+                    feature: id,
                     layer,
-                    kind: MoveKind::Print,
-                    p: [w[1].x, w[1].y, w[1].z],
+                    kind: MoveKind::Travel,
+                    p: [first.x, first.y, first.z],
                     axis,
-                    e,
+                    e: 0.0,
                     thickness: dl,
-                    width: path.widths[i + 1],
+                    width: path.widths[0],
+                });
+                for (i, w) in pts.windows(2).enumerate() {
+                    let l = (w[1] - w[0]).norm();
+                    // Eq. 1 with the bead's width along the segment.
+                    let width = 0.5 * (path.widths[i] + path.widths[i + 1]);
+                    let e = bead.filament_length(width, dl, l);
+                    fig.print_length += l;
+                    fig.filament += e;
+                    points.push(PathPoint {
+                        feature: id,
+                        layer,
+                        kind: MoveKind::Print,
+                        p: [w[1].x, w[1].y, w[1].z],
+                        axis,
+                        e,
+                        thickness: dl,
+                        width: path.widths[i + 1],
+                    });
+                }
+                cursor = pts.last().copied();
+                layer_paths.push(LayerPath {
+                    travel: start..start + 1,
+                    print: start + 1..points.len(),
                 });
             }
-            cursor = pts.last().copied();
-            layer_paths.push(LayerPath {
-                travel: start..start + 1,
-                print: start + 1..points.len(),
+            layers.push(Layer {
+                index: layer,
+                thickness: dl,
+                surface: LayerSurface::Plane {
+                    normal: axis,
+                    height: z,
+                },
+                paths: layer_paths,
             });
         }
-        layers.push(Layer {
-            index: layer,
-            thickness: dl,
-            surface: LayerSurface::Plane {
-                normal: axis,
-                height: z,
-            },
-            paths: layer_paths,
-        });
+        let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
+        fig.finish(id, points.len(), &printed);
+        FeaturePlan {
+            feature: id,
+            points,
+            layers,
+            figures: fig,
+            freeform: None,
+        }
     }
-    let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
-    fig.finish(f.id, points.len(), &printed);
-    Ok(FeaturePlan {
-        feature: f.id,
-        points,
-        layers,
-        figures: fig,
-        freeform: None,
-    })
 }

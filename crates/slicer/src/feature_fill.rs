@@ -1,0 +1,44 @@
+//! A feature's layers filled, before they are laid from where the nozzle is: the part of
+//! planning a feature that does not depend on the feature printed before it, so a part's
+//! features are filled in parallel and laid one after the other.
+
+use crate::error::PlanError;
+use crate::feature_plan::FeaturePlan;
+use crate::freeform::{fill_freeform, FreeformFill};
+use crate::params::LayerParams;
+use crate::planar::{fill_two5d, Two5dFill};
+use crate::toolpath::Bead;
+use brep::math::P3;
+use features::{Feature, FeatureKind, FeatureTree};
+
+/// A feature's layers filled by its planner: planar for `two5d`, offsets of the reference
+/// surface for `freeform`.
+pub enum FeatureFill<'a> {
+    /// Planar layers ([`crate::planar`]).
+    Two5d(Two5dFill),
+    /// Offset layers ([`crate::freeform`]).
+    Freeform(FreeformFill<'a>),
+}
+
+/// Fills every layer of feature `f` of `tree` by its kind's planner.
+pub fn fill_feature<'a>(
+    tree: &'a FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+) -> Result<FeatureFill<'a>, PlanError> {
+    Ok(match f.kind {
+        FeatureKind::Two5d => FeatureFill::Two5d(fill_two5d(tree, f, params, bead)?),
+        FeatureKind::Freeform => FeatureFill::Freeform(fill_freeform(tree, f, params, bead)?),
+    })
+}
+
+impl FeatureFill<'_> {
+    /// The feature's plan, its first travel starting at `entry` (where the nozzle is).
+    pub fn lay(self, entry: Option<P3>) -> FeaturePlan {
+        match self {
+            FeatureFill::Two5d(f) => f.lay(entry),
+            FeatureFill::Freeform(f) => f.lay(entry),
+        }
+    }
+}
