@@ -12,7 +12,9 @@ use brep::math::P3;
 use features::{Feature, FeatureKind, FeatureTree};
 
 /// A feature's layers filled by its planner: planar for `two5d`, offsets of the reference
-/// surface for `freeform`.
+/// surface for `freeform`. Only a few live at once (one per thread), so the variants are not
+/// boxed.
+#[allow(clippy::large_enum_variant)]
 pub enum FeatureFill<'a> {
     /// Planar layers ([`crate::planar`]).
     Two5d(Two5dFill),
