@@ -6,6 +6,7 @@
 mod extract;
 mod inspect;
 mod mesh;
+mod outputs;
 mod plan;
 mod settings;
 
@@ -58,9 +59,25 @@ pub struct PlanArgs {
     /// Machine profile (TOML) instead of a built-in one (see profiles/*.toml)
     #[arg(long, value_name = "FILE")]
     pub machine_profile: Option<PathBuf>,
-    /// Output directory for toolpath.csv, plan.json and the machine program [required]
-    #[arg(short, long, value_name = "DIR")]
+    /// Output folder, or the program file [required]
+    ///
+    /// A folder (created if missing) gets toolpath.csv, plan.json and the machine program
+    /// (program.gcode, or the KRL modules named by the part). A path ending in .gcode (Marlin,
+    /// delta5) or .src (KUKA) is the program file itself, and the other outputs go beside it
+    /// under its stem: `-o box.gcode` writes box.gcode, box.toolpath.csv and box.plan.json. A
+    /// place that holds an earlier plan is refused unless --force.
+    #[arg(short, long, value_name = "DIR|FILE.gcode|FILE.src")]
     pub output: PathBuf,
+    /// Replace an earlier plan at the output: its files (those its plan.json lists) are removed
+    /// first, so none is left beside the new ones
+    #[arg(long)]
+    pub force: bool,
+    /// Treat every warning as an error: exit 2 and write nothing when the plan has one
+    #[arg(long)]
+    pub strict: bool,
+    /// Write a KUKA program even when points are out of the arm's reach (an error otherwise)
+    #[arg(long)]
+    pub allow_unreachable: bool,
     /// Write the plan even when its self-check fails (a feature with no layer, or extruded
     /// volume more than 3 % from volume x fill): the failures become warnings and plan.json
     /// says `"complete": false`

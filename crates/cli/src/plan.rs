@@ -1,6 +1,7 @@
 //! `features plan`: reads the settings and the part, runs [`plan::plan`] and writes its files.
 
 use crate::mesh::write_atomic;
+use crate::outputs::Outputs;
 use crate::settings::settings;
 use crate::{emit, Failure, PlanArgs};
 use plan::{Options, PlanError, Progress};
@@ -11,25 +12,41 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let path = &args.part;
     // Settings first: a bad process or machine file fails before any work.
     let (process, machine) = settings(args)?;
+    // Then where the outputs go: a place holding an earlier plan fails before any work too.
+    let outputs = Outputs::from_arg(&args.output, machine.kind)?;
+    let earlier = outputs.earlier();
+    if !earlier.is_empty() && !args.force {
+        return Err(Failure::new(
+            &args.output,
+            format!(
+                "holds an earlier plan ({} file(s), e.g. {}): --force replaces it, or choose another output",
+                earlier.len(),
+                earlier[0].display()
+            ),
+        ));
+    }
     // A feature's bad parameters are reported against the process file (or the part without one).
     let process_file = args.process.as_deref().unwrap_or(path);
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
-    let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg}");
+    let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg} [{elapsed}]");
     let progress = |p: Progress| match p {
         Progress::Start { features } => bar.set_length(features),
         Progress::Feature { id } => bar.set_message(format!("feature {id}")),
         Progress::FeatureDone => bar.inc(1),
-        Progress::Planned => bar.finish_and_clear(),
+        Progress::Planned => bar.set_message("posting"),
     };
+    let part_stem = path
+        .file_stem()
+        .map_or("part".into(), |s| s.to_string_lossy().into_owned());
     let options = Options {
         source: path.display().to_string(),
-        stem: path
-            .file_stem()
-            .map_or("part".into(), |s| s.to_string_lossy().into()),
+        stem: outputs.stem(&part_stem),
         keep_going: args.keep_going,
         progress: Some(&progress),
     };
-    let plan = plan::plan(&part, &process, &machine, &options).map_err(|e| match e {
+    let result = plan::plan(&part, &process, &machine, &options);
+    bar.finish_and_clear();
+    let mut plan = result.map_err(|e| match e {
         PlanError::Process(e) => Failure::new(process_file, e),
         PlanError::SelfCheck(problems) => {
             for p in &problems {
@@ -40,39 +57,74 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         }
         e => Failure::new(path, e),
     })?;
-    let json = plan.report.to_json().map_err(|e| Failure::new(path, e))?;
+    // Every warning on stderr, one line each, as plan.json holds them; before anything is
+    // written, since --strict and unreachable points stop the plan here.
+    let warnings: Vec<String> = plan.warnings().iter().map(|w| w.to_string()).collect();
+    for w in &warnings {
+        eprintln!("features: {}: warning: {w}", path.display());
+    }
+    if args.strict && !warnings.is_empty() {
+        return Err(Failure::new(
+            path,
+            format!(
+                "{} warning(s) (listed above) and --strict: nothing written",
+                warnings.len()
+            ),
+        ));
+    }
+    let unreachable = plan.report.unreachable_points();
+    if unreachable > 0 && !args.allow_unreachable {
+        return Err(Failure::new(
+            path,
+            format!("{unreachable} point(s) out of the arm's reach or joint limits (listed above): nothing written (--allow-unreachable writes the program anyway)"),
+        ));
+    }
     // Everything is ready: write the files.
-    let dir = &args.output;
+    let dir = &outputs.dir;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
+    if args.force {
+        outputs.clear_earlier()?;
+    }
+    let csv = outputs.name("toolpath.csv");
+    let program: Vec<(String, &[u8])> = plan
+        .program
+        .iter()
+        .map(|f| (outputs.name(&f.name), f.bytes.as_slice()))
+        .collect();
+    plan.report.outputs = std::iter::once(csv.clone())
+        .chain(program.iter().map(|(n, _)| n.clone()))
+        .collect();
+    let json = plan.report.to_json().map_err(|e| Failure::new(path, e))?;
     let written = |name: &str, r: std::io::Result<()>| {
         r.map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))
     };
     // The tool path is written point by point, not built as one text first.
-    let csv = "toolpath.csv";
     written(
-        csv,
-        write_atomic(&dir.join(csv), |w| plan.toolpath.write_csv(w)),
+        &csv,
+        write_atomic(&dir.join(&csv), |w| plan.toolpath.write_csv(w)),
     )?;
-    let files = std::iter::once(("plan.json", json.as_bytes())).chain(
-        plan.program
-            .iter()
-            .map(|f| (f.name.as_str(), f.bytes.as_slice())),
-    );
-    for (name, bytes) in files {
+    for (name, bytes) in &program {
         written(name, write_atomic(&dir.join(name), |w| w.write_all(bytes)))?;
     }
-    // The plan's warnings on stderr too, one line each, so a terminal shows them.
-    for w in plan.warnings() {
-        eprintln!("features: {}: warning: {w}", path.display());
-    }
+    // The report last: a folder with plan.json holds a whole plan.
+    let report = outputs.name("plan.json");
+    written(
+        &report,
+        write_atomic(&dir.join(&report), |w| w.write_all(json.as_bytes())),
+    )?;
     let print: f64 = plan.features().iter().map(|f| f.print_length_mm).sum();
     let vol: f64 = plan.features().iter().map(|f| f.extruded_volume_mm3).sum();
+    // Where it went: the folder, or the program file `-o` named.
+    let to = match &args.output {
+        o if o.is_dir() => dir.display().to_string(),
+        o => o.display().to_string(),
+    };
     emit(&format!(
-        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded -> {}\n",
+        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded, {} warning(s) -> {to}\n",
         path.display(),
         plan.features().len(),
         plan.toolpath.points.len(),
-        dir.display()
+        warnings.len(),
     ))
 }

@@ -98,9 +98,9 @@ impl Plan {
         &self.report.features
     }
 
-    /// Things to know about the plan.
-    pub fn warnings(&self) -> &[String] {
-        &self.report.warnings
+    /// Things to know about the plan: the part's warnings and every feature's, each once.
+    pub fn warnings(&self) -> Vec<&str> {
+        self.report.every_warning()
     }
 }
 
@@ -117,12 +117,14 @@ pub fn plan(
             f(p)
         }
     };
+    process.validate_for_nozzle(machine.nozzle_diameter)?;
     let base = process.base();
     let bead = machine.bead();
     let filament_area = bead.filament_area();
 
     let assembly = extract_all(&part.brep, &ExtractOptions::default())?;
     let trees = &assembly.trees;
+    process.validate_feature_ids(trees.iter().map(|t| t.features.len()).sum())?;
     // Each tree's build plate: its base feature's reference plane.
     let plates: Vec<_> = trees
         .iter()
@@ -267,6 +269,7 @@ pub fn plan(
         complete: problems.is_empty(),
         features: reports,
         warnings,
+        outputs: vec![],
     };
     Ok(Plan {
         report,

@@ -23,18 +23,159 @@ pub struct Process {
     /// Tool-axis smoothing (Chalvin et al. 2022, Eq. 3–7).
     #[serde(default)]
     pub orientation: SmoothParams,
+    /// Where each key was written: `(table, key)` → line, for errors that name the line.
+    #[serde(skip)]
+    lines: HashMap<(String, String), usize>,
+}
+
+/// Layer heights a machine can lay: at least this, mm.
+pub const MIN_LAYER_HEIGHT: f64 = 0.05;
+/// ... and at most this share of the nozzle's diameter.
+pub const MAX_LAYER_HEIGHT_SHARE: f64 = 0.8;
+/// Path spacing: within these shares of the nozzle's diameter.
+pub const SPACING_SHARES: (f64, f64) = (0.5, 2.0);
+/// Tolerance: at most this, mm.
+pub const MAX_TOLERANCE: f64 = 1.0;
+
+/// `(table, key)` → line of every `key = value` in a TOML text, by its lines (enough for
+/// the flat tables of a process file).
+fn key_lines(text: &str) -> HashMap<(String, String), usize> {
+    let mut out = HashMap::new();
+    let mut table = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if let Some(h) = l.strip_prefix('[') {
+            table = h.split(']').next().unwrap_or("").trim().to_string();
+            out.entry((table.clone(), String::new())).or_insert(i + 1);
+        } else if let Some((k, _)) = l.split_once('=') {
+            if !l.starts_with('#') {
+                out.entry((table.clone(), k.trim().to_string()))
+                    .or_insert(i + 1);
+            }
+        }
+    }
+    out
 }
 
 impl Process {
     /// Reads a process file's text; the error names the line where the TOML is wrong.
+    /// A `[features.<id>]` table must name a feature by its whole-number id.
     pub fn from_toml(text: &str) -> Result<Process, ProcessError> {
-        toml::from_str(text).map_err(|e| {
+        let mut process: Process = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
                 .map(|r| text[..r.start.min(text.len())].matches('\n').count() + 1);
             let at = line.map(|l| format!(" line {l}")).unwrap_or_default();
             ProcessError(format!("process file{at}: {}", e.message().trim()))
-        })
+        })?;
+        process.lines = key_lines(text);
+        let mut ids: Vec<&String> = process.features.keys().collect();
+        ids.sort();
+        for id in ids {
+            if id.parse::<usize>().is_err() {
+                return Err(ProcessError(format!(
+                    "process file{}: [features.{id}]: a feature is named by its id, a whole number from 0 (`features extract` lists them)",
+                    process.at("features", id, "")
+                )));
+            }
+        }
+        Ok(process)
+    }
+
+    /// ` line N` where `key` of table `[table.sub]` (or the table itself) was written.
+    fn at(&self, table: &str, sub: &str, key: &str) -> String {
+        let t = if sub.is_empty() {
+            table.to_string()
+        } else {
+            format!("{table}.{sub}")
+        };
+        self.lines
+            .get(&(t.clone(), key.to_string()))
+            .or_else(|| self.lines.get(&(t, String::new())))
+            .map(|l| format!(" line {l}"))
+            .unwrap_or_default()
+    }
+
+    /// Checks that every `[features.<id>]` names one of the part's `count` features.
+    pub fn validate_feature_ids(&self, count: usize) -> Result<(), ProcessError> {
+        let mut ids: Vec<(usize, &String)> = self
+            .features
+            .keys()
+            .filter_map(|k| k.parse().ok().map(|n| (n, k)))
+            .collect();
+        ids.sort();
+        for (n, key) in ids {
+            if n >= count {
+                let have = match count {
+                    0 => "no feature".to_string(),
+                    1 => "one feature, id 0".to_string(),
+                    c => format!("{c} features, ids 0 to {}", c - 1),
+                };
+                return Err(ProcessError(format!(
+                    "process file{}: [features.{key}]: the part has {have}",
+                    self.at("features", key, "")
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the layer heights, path spacing and tolerance of `[defaults]` and of every
+    /// `[features.<id>]` against a nozzle `nozzle` mm wide: heights within
+    /// [[`MIN_LAYER_HEIGHT`], [`MAX_LAYER_HEIGHT_SHARE`] × nozzle], spacing within
+    /// [`SPACING_SHARES`] × nozzle, tolerance at most [`MAX_TOLERANCE`]. The error names the
+    /// table, key, value, line and range.
+    pub fn validate_for_nozzle(&self, nozzle: f64) -> Result<(), ProcessError> {
+        let base = self.base();
+        let mut tables: Vec<(String, LayerParams)> = vec![("defaults".into(), base.clone())];
+        let mut ids: Vec<&String> = self.features.keys().collect();
+        ids.sort();
+        for id in ids {
+            tables.push((format!("features.{id}"), base.patched(&self.features[id])));
+        }
+        let h = (MIN_LAYER_HEIGHT, MAX_LAYER_HEIGHT_SHARE * nozzle);
+        let w = (SPACING_SHARES.0 * nozzle, SPACING_SHARES.1 * nozzle);
+        for (table, p) in &tables {
+            let mut checks: Vec<(String, f64, (f64, f64), String)> = vec![];
+            let why_h = format!(
+                "{MIN_LAYER_HEIGHT} mm to {MAX_LAYER_HEIGHT_SHARE} x the {nozzle} mm nozzle"
+            );
+            let why_w = format!(
+                "{} to {} x the {nozzle} mm nozzle",
+                SPACING_SHARES.0, SPACING_SHARES.1
+            );
+            checks.push((
+                "uniform_layer_height".into(),
+                p.uniform_layer_height,
+                h,
+                why_h.clone(),
+            ));
+            for &a in &p.adaptive_layer_height {
+                checks.push(("adaptive_layer_height".into(), a, h, why_h.clone()));
+            }
+            if let Some(o) = p.uniform_offset {
+                checks.push(("uniform_offset".into(), o, w, why_w.clone()));
+            }
+            for &o in &p.adaptive_offset {
+                checks.push(("adaptive_offset".into(), o, w, why_w.clone()));
+            }
+            checks.push((
+                "tolerance".into(),
+                p.tolerance,
+                (0.0, MAX_TOLERANCE),
+                format!("at most {MAX_TOLERANCE} mm"),
+            ));
+            for (key, v, (lo, hi), why) in checks {
+                if !(v >= lo && v <= hi) {
+                    let (t, sub) = table.split_once('.').unwrap_or((table.as_str(), ""));
+                    return Err(ProcessError(format!(
+                        "process file{}: [{table}] {key} = {v} is outside [{lo}, {hi:.3}] mm ({why})",
+                        self.at(t, sub, &key)
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The layer parameters of every feature before its own overrides.

@@ -179,9 +179,42 @@ pub struct PlanReport {
     pub features: Vec<FeatureReport>,
     /// Things to know about the plan.
     pub warnings: Vec<String>,
+    /// The files the plan was written to, beside `plan.json` (set by whoever writes them; the
+    /// command line lists them so that `--force` can clear them before the next plan).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<String>,
 }
 
 impl PlanReport {
+    /// Every warning of the plan once, in order: the part's, then each feature's that the
+    /// part's list does not already hold.
+    pub fn every_warning(&self) -> Vec<&str> {
+        let mut out: Vec<&str> = vec![];
+        let all = self
+            .warnings
+            .iter()
+            .chain(self.features.iter().flat_map(|f| f.warnings.iter()));
+        for w in all {
+            if !out.contains(&w.as_str()) {
+                out.push(w);
+            }
+        }
+        out
+    }
+
+    /// Points the robot cannot reach, over every feature (KUKA plans; 0 otherwise).
+    pub fn unreachable_points(&self) -> usize {
+        self.features
+            .iter()
+            .map(|f| match f.post {
+                Some(PostEntry::Kuka {
+                    unreachable_points, ..
+                }) => unreachable_points,
+                _ => 0,
+            })
+            .sum()
+    }
+
     /// The report as pretty JSON with a final newline.
     pub fn to_json(&self) -> Result<String, serde_json::Error> {
         let mut text = serde_json::to_string_pretty(self)?;

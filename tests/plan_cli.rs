@@ -1,0 +1,325 @@
+//! `features plan` tells the truth (issue 21), end to end through the binary: every warning on
+//! stderr, `--strict`, unreachable robot points, process-file mistakes, output files and
+//! earlier plans, and the wording of settings errors.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_features");
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures")
+        .join(name)
+}
+
+/// A scratch folder of one test, removed when dropped.
+struct Scratch(PathBuf);
+impl Scratch {
+    fn new(test: &str) -> Scratch {
+        let d =
+            std::env::temp_dir().join(format!("features-plancli-{}-{test}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("scratch");
+        Scratch(d)
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+    fn write(&self, name: &str, text: &str) -> String {
+        let p = self.path(name);
+        std::fs::write(&p, text).expect("write");
+        p.display().to_string()
+    }
+    /// File names in `sub` (the scratch folder itself for ""), sorted.
+    fn names(&self, sub: &str) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(self.0.join(sub))
+            .map(|r| {
+                r.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    }
+}
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn plan(part: &str, args: &[&str]) -> Output {
+    Command::new(BIN)
+        .arg("plan")
+        .arg(fixture(part))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Exit 2 with one line on stderr that contains every one of `words`.
+fn assert_refused(o: &Output, words: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or("");
+    for w in words {
+        assert!(last.contains(w), "`{w}` missing from: {last}");
+    }
+}
+
+#[test]
+fn every_warning_of_the_plan_is_one_line_on_stderr() {
+    // The impeller's blades each warn of overhanging points: feature warnings, not the part's.
+    let s = Scratch::new("warnings");
+    let out = s.path("imp");
+    let o = plan(
+        "impeller.step",
+        &["--machine", "delta5", "-o", out.to_str().unwrap()],
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    let mut all: Vec<String> = vec![];
+    let part = report["warnings"].as_array().unwrap().iter();
+    let features = report["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|f| f["warnings"].as_array().unwrap().iter());
+    for w in part.chain(features) {
+        let w = w.as_str().unwrap().to_string();
+        if !all.contains(&w) {
+            all.push(w);
+        }
+    }
+    assert!(!all.is_empty(), "the impeller plan has warnings");
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains(": warning: ")).collect();
+    assert_eq!(lines.len(), all.len(), "{err}");
+    for w in &all {
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.ends_with(&format!(": warning: {w}"))),
+            "not on stderr: {w}"
+        );
+    }
+    // The summary counts them.
+    let summary = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        summary.contains(&format!("{} warning(s)", all.len())),
+        "{summary}"
+    );
+}
+
+#[test]
+fn strict_turns_warnings_into_an_error_and_writes_nothing() {
+    // Two solids overlap and one starts in the air: part warnings.
+    let s = Scratch::new("strict");
+    let out = s.path("stack");
+    let o = plan(
+        "stacked_solids.step",
+        &["--strict", "-o", out.to_str().unwrap()],
+    );
+    assert_refused(&o, &["--strict", "nothing written"]);
+    let err = stderr(&o);
+    assert!(err.contains("in the air"), "{err}");
+    assert!(!out.exists(), "nothing is written under --strict");
+    // Without --strict the same plan is written, with the same warnings.
+    let o = plan("stacked_solids.step", &["-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("in the air"));
+}
+
+#[test]
+fn unreachable_robot_points_stop_the_plan_unless_allowed() {
+    let s = Scratch::new("reach");
+    let out = s.path("cap");
+    let o = plan(
+        "capsule.step",
+        &["--machine", "kuka", "-o", out.to_str().unwrap()],
+    );
+    assert_refused(&o, &["out of the arm's reach", "--allow-unreachable"]);
+    assert!(!out.exists(), "no KRL written for an arm that cannot reach");
+    let o = plan(
+        "capsule.step",
+        &[
+            "--machine",
+            "kuka",
+            "--allow-unreachable",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    let unreachable: u64 = report["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f["unreachable_points"].as_u64())
+        .sum();
+    assert!(unreachable > 0, "the report keeps the count");
+    assert!(stderr(&o).contains("out of the arm's reach"));
+}
+
+#[test]
+fn process_file_mistakes_are_refused_naming_key_line_and_range() {
+    let s = Scratch::new("process");
+    let out = s.path("never");
+    let o_arg = out.to_str().unwrap();
+    let cases: Vec<(&str, Vec<&str>)> = vec![
+        (
+            "[defaults]\nuniform_layer_height = 2.0\n",
+            vec!["line 2", "uniform_layer_height", "0.05", "0.320", "nozzle"],
+        ),
+        (
+            "# thin\n[defaults]\nuniform_layer_height = 0.001\n",
+            vec!["line 3", "uniform_layer_height = 0.001", "outside"],
+        ),
+        (
+            "[features.7]\nperimeters = 3\n",
+            vec!["line 1", "[features.7]", "3 features, ids 0 to 2"],
+        ),
+        (
+            "[features.one]\nperimeters = 3\n",
+            vec!["[features.one]", "whole number"],
+        ),
+        (
+            "[features.-1]\nperimeters = 3\n",
+            vec!["[features.-1]", "whole number"],
+        ),
+        (
+            "[defaults]\nuniform_layer_heigth = 0.1\n",
+            vec!["line 2", "did you mean `uniform_layer_height`?"],
+        ),
+        (
+            "[features.1]\nuniform_offset = 5.0\n",
+            vec!["line 2", "[features.1] uniform_offset = 5", "nozzle"],
+        ),
+    ];
+    for (i, (text, words)) in cases.iter().enumerate() {
+        let p = s.write(&format!("p{i}.toml"), text);
+        let o = plan("plate_boss_boss.step", &["--process", &p, "-o", o_arg]);
+        assert_refused(&o, words);
+        assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).starts_with(&format!("features: {p}: ")));
+        assert!(!out.exists(), "case {i}: nothing written");
+    }
+    // A machine profile given as the process file is recognised as one.
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../profiles/delta5.toml");
+    let o = plan(
+        "box.step",
+        &["--process", profile.to_str().unwrap(), "-o", o_arg],
+    );
+    assert_refused(&o, &["machine profile", "--machine-profile"]);
+}
+
+#[test]
+fn machine_names_are_checked_against_the_flag_not_the_part() {
+    let s = Scratch::new("machine");
+    let out = s.path("never");
+    let o = plan(
+        "box.step",
+        &["--machine", "prusa", "-o", out.to_str().unwrap()],
+    );
+    assert_refused(&o, &["unknown machine `prusa`", "marlin, delta5 and kuka"]);
+    assert!(
+        stderr(&o).starts_with("features: --machine: "),
+        "{}",
+        stderr(&o)
+    );
+    let o = plan(
+        "box.step",
+        &["--machine", "marlin.toml", "-o", out.to_str().unwrap()],
+    );
+    assert_refused(&o, &["--machine-profile"]);
+    // A misspelt machine key gets the nearest one.
+    let p = s.write(
+        "m.toml",
+        "name = \"m\"\nkind = \"marlin\"\nnozle_diameter = 0.4\n",
+    );
+    let o = plan(
+        "box.step",
+        &["--machine-profile", &p, "-o", out.to_str().unwrap()],
+    );
+    assert_refused(&o, &["line 3", "did you mean `nozzle_diameter`?"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_program_file_as_output_gets_its_outputs_beside_it() {
+    let s = Scratch::new("file");
+    let gcode = s.path("box.gcode");
+    let o = plan("box.step", &["-o", gcode.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        s.names(""),
+        ["box.gcode", "box.plan.json", "box.toolpath.csv"],
+        "no folder named box.gcode"
+    );
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    assert!(text.lines().any(|l| l.starts_with("G1 X")), "a program");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(s.path("box.plan.json")).unwrap()).unwrap();
+    assert_eq!(
+        report["outputs"],
+        serde_json::json!(["box.toolpath.csv", "box.gcode"])
+    );
+    // The wrong program kind for the machine is refused.
+    let o = plan(
+        "box.step",
+        &["--machine", "kuka", "-o", gcode.to_str().unwrap()],
+    );
+    assert_refused(&o, &["kuka plan writes a .src program"]);
+    // A KUKA program file names the modules.
+    let src = s.path("cell.src");
+    let o = plan(
+        "box.step",
+        &["--machine", "kuka", "-o", src.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names = s.names("");
+    assert!(names.contains(&"cell.src".to_string()), "{names:?}");
+    assert!(names.contains(&"cell.plan.json".to_string()), "{names:?}");
+    assert!(names.iter().all(|n| !n.starts_with("box.src")), "{names:?}");
+}
+
+#[test]
+fn an_earlier_plan_is_refused_unless_forced_and_then_cleared() {
+    let s = Scratch::new("earlier");
+    let out = s.path("out");
+    let o_arg = out.to_str().unwrap();
+    // An earlier KUKA plan of two solids leaves its modules.
+    let o = plan("two_solids.step", &["--machine", "kuka", "-o", o_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let first = s.names("out");
+    assert!(first
+        .iter()
+        .any(|n| n.starts_with("two_solids") && n.ends_with(".src")));
+    let before = std::fs::read(out.join("plan.json")).unwrap();
+    // Planning into it again is refused, and leaves it as it was.
+    let o = plan("box.step", &["--machine", "kuka", "-o", o_arg]);
+    assert_refused(&o, &["earlier plan", "--force"]);
+    assert_eq!(s.names("out"), first);
+    assert_eq!(std::fs::read(out.join("plan.json")).unwrap(), before);
+    // --force removes what the earlier plan wrote, and nothing else.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let o = plan("box.step", &["--machine", "kuka", "--force", "-o", o_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let after = s.names("out");
+    assert!(
+        after.iter().all(|n| !n.starts_with("two_solids")),
+        "{after:?}"
+    );
+    assert!(after.contains(&"notes.txt".to_string()));
+    assert!(after.contains(&"box.src".to_string()), "{after:?}");
+}
