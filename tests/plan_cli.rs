@@ -323,3 +323,71 @@ fn an_earlier_plan_is_refused_unless_forced_and_then_cleared() {
     assert!(after.contains(&"notes.txt".to_string()));
     assert!(after.contains(&"box.src".to_string()), "{after:?}");
 }
+
+#[test]
+fn an_stl_is_named_as_a_mesh_and_export_into_a_file_is_explained() {
+    let s = Scratch::new("wording");
+    let stl = s.path("part.stl");
+    let o = Command::new(BIN)
+        .args(["mesh"])
+        .arg(fixture("box.step"))
+        .arg("-o")
+        .arg(&stl)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    for verb in ["plan", "inspect", "extract"] {
+        let mut c = Command::new(BIN);
+        c.arg(verb).arg(&stl);
+        if verb == "plan" {
+            c.arg("-o").arg(s.path("never"));
+        }
+        let o = c.output().unwrap();
+        assert_refused(&o, &["an STL mesh, not a STEP file", "export STEP"]);
+    }
+    let file = s.path("taken");
+    std::fs::write(&file, "x").unwrap();
+    let o = Command::new(BIN)
+        .arg("extract")
+        .arg(fixture("box.step"))
+        .arg("--export")
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert_refused(&o, &["is a file", "into a folder"]);
+    assert!(!stderr(&o).contains("os error"), "{}", stderr(&o));
+}
+
+#[test]
+fn the_extract_tree_tells_siblings_from_the_last_child() {
+    let o = Command::new(BIN)
+        .arg("extract")
+        .arg(fixture("impeller.step"))
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    let children: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("├─ ") || l.starts_with("└─ "))
+        .collect();
+    // Six blades on the hub: five with a sibling after them, one last.
+    assert_eq!(children.len(), 6, "{text}");
+    assert_eq!(children.iter().filter(|l| l.starts_with("└─ ")).count(), 1);
+    assert!(children[5].starts_with("└─ "), "{text}");
+}
+
+#[test]
+fn help_gives_examples_of_every_verb() {
+    let o = Command::new(BIN).arg("--help").output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    for verb in ["plan", "extract", "inspect", "mesh"] {
+        assert!(
+            text.contains(&format!("  features {verb} ")),
+            "{verb}: {text}"
+        );
+        let o = Command::new(BIN).args([verb, "--help"]).output().unwrap();
+        let sub = String::from_utf8_lossy(&o.stdout);
+        assert!(sub.contains("Examples:"), "{verb}: {sub}");
+    }
+}

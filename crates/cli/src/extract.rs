@@ -30,6 +30,12 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
         offset += n;
     }
     if let Some(dir) = &args.export {
+        if dir.exists() && !dir.is_dir() {
+            return Err(Failure::new(
+                dir,
+                "is a file: --export writes one STEP and one STL file per feature into a folder",
+            ));
+        }
         export(dir, &solids).map_err(|e| Failure::new(dir, e))?;
     }
     let source = path.display().to_string();
@@ -105,8 +111,16 @@ fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
             t.depth,
             t.part_volume
         );
-        // Children under their parents, in build order.
-        fn walk(out: &mut String, t: &FeatureTree, offset: usize, k: usize, indent: usize) {
+        // Children under their parents, in build order: `├─` before a sibling that follows,
+        // `└─` before the last, and `│` down the side of a parent with more to come.
+        fn walk(
+            out: &mut String,
+            t: &FeatureTree,
+            offset: usize,
+            k: usize,
+            lead: &str,
+            branch: &str,
+        ) {
             let f = &t.features[k];
             let r = &f.reference;
             let on = match (r.surface.as_str(), r.step_face) {
@@ -117,9 +131,7 @@ fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
             };
             let _ = writeln!(
                 out,
-                "{}{}feature {}  {} {}  {}  {:.3} mm^3{}",
-                "   ".repeat(indent.saturating_sub(1)),
-                if indent > 0 { "└─ " } else { "" },
+                "{lead}{branch}feature {}  {} {}  {}  {:.3} mm^3{}",
                 offset + f.id,
                 f.kind.as_str(),
                 f.subtype,
@@ -131,12 +143,24 @@ fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
                     String::new()
                 }
             );
-            for c in t
+            let children: Vec<usize> = t
                 .build_order
                 .iter()
-                .filter(|&&c| t.features[c].parents.first() == Some(&k))
-            {
-                walk(out, t, offset, *c, indent + 1);
+                .copied()
+                .filter(|&c| t.features[c].parents.first() == Some(&k))
+                .collect();
+            let below = match branch {
+                "" => lead.to_string(),
+                "├─ " => format!("{lead}│  "),
+                _ => format!("{lead}   "),
+            };
+            for (i, &c) in children.iter().enumerate() {
+                let b = if i + 1 == children.len() {
+                    "└─ "
+                } else {
+                    "├─ "
+                };
+                walk(out, t, offset, c, &below, b);
             }
         }
         for &k in t
@@ -144,7 +168,7 @@ fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
             .iter()
             .filter(|&&k| t.features[k].parents.is_empty())
         {
-            walk(&mut out, t, s.offset, k, 0);
+            walk(&mut out, t, s.offset, k, "", "");
         }
         for w in &t.warnings {
             let _ = writeln!(out, "warning: {w}");

@@ -21,10 +21,14 @@ use std::process::ExitCode;
 #[command(
     name = "features",
     version,
-    after_help = "Examples:\n  features inspect part.step\n  features inspect part.step --json\n  \
-                  features mesh part.step -o part.stl --tolerance 0.02\n  \
-                  features extract part.step --json --export features/\n\n\
-                  Errors are one line on stderr, `features: <file>: <cause>`, exit code 2."
+    after_help = "Examples:\n  features plan part.step --machine delta5 -o out/\n  \
+                  features plan part.step --process my_process.toml -o part.gcode\n  \
+                  features extract part.step\n  \
+                  features extract part.step --json --export features/\n  \
+                  features inspect part.step --json\n  \
+                  features mesh part.step -o part.stl --tolerance 0.02\n\n\
+                  Errors are one line on stderr, `features: <file>: <cause>`, exit code 2; \
+                  warnings are lines `features: <file>: warning: ...`."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -34,12 +38,29 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Read a STEP file and report each solid: volume, area, topology, surface kinds, checks.
+    #[command(
+        after_help = "Examples:\n  features inspect part.step\n  features inspect part.step --json"
+    )]
     Inspect(InspectArgs),
     /// Triangulate every solid of a STEP file into one STL or OBJ file.
+    #[command(
+        after_help = "Examples:\n  features mesh part.step -o part.stl\n  features mesh part.step -o part.obj --tolerance 0.01"
+    )]
     Mesh(MeshArgs),
     /// Recognise the AM features a part is built from: concave loops, splitting, dependency order.
+    #[command(
+        after_help = "Examples:\n  features extract part.step                 the feature tree\n  \
+                            features extract part.step --json          features.extract/1 JSON\n  \
+                            features extract part.step --export out/   each feature as its own STEP and STL"
+    )]
     Extract(ExtractArgs),
     /// Plan layers and paths for every feature and write the machine program.
+    #[command(
+        after_help = "Examples:\n  features plan part.step -o out/                      Marlin G-code, toolpath.csv, plan.json in out/\n  \
+                            features plan part.step --machine delta5 -o part.gcode   5-axis program part.gcode, beside it part.toolpath.csv, part.plan.json\n  \
+                            features plan part.step --machine kuka -o cell/          KRL modules for a KUKA cell\n  \
+                            features plan part.step --process profiles/process.toml --strict -o out/ --force"
+    )]
     Plan(PlanArgs),
 }
 

@@ -160,6 +160,9 @@ pub enum P21Error {
     /// The file does not start (after whitespace and comments) with `ISO-10303-21;`.
     #[error("not a step part 21 file: it does not start with iso-10303-21")]
     NotPart21,
+    /// The file is an STL mesh.
+    #[error("an STL mesh, not a STEP file: features plans from the exact B-rep of a STEP file (AP203, AP214 or AP242), which triangles no longer hold; export STEP from the CAD system")]
+    Stl,
     /// Malformed content at `line`; `msg` is one line and names the entity.
     #[error("syntax error at line {line}: {msg}")]
     Syntax {

@@ -25,7 +25,25 @@ pub fn parse(bytes: &[u8]) -> Result<P21File, P21Error> {
     if bytes.starts_with(b"\xEF\xBB\xBF") {
         p.pos = 3;
     }
-    p.file()
+    p.file().map_err(|e| match e {
+        P21Error::NotPart21 if is_stl(bytes) => P21Error::Stl,
+        e => e,
+    })
+}
+
+/// Whether `bytes` are an STL mesh: ASCII (`solid` then a `facet` within the first lines) or
+/// binary (an 80-byte header and a triangle count that gives the file's length exactly).
+fn is_stl(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(1024)];
+    let text = String::from_utf8_lossy(head).to_ascii_lowercase();
+    if text.trim_start().starts_with("solid") && text.contains("facet") {
+        return true;
+    }
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        return 84 + 50 * n == bytes.len() as u64;
+    }
+    false
 }
 
 impl<'a> Parser<'a> {

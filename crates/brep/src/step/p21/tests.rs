@@ -598,3 +598,16 @@ fn p21_corpus_files_parse() {
         paths.len()
     );
 }
+
+#[test]
+fn an_stl_mesh_is_named_as_one() {
+    let ascii = b"solid part\n  facet normal 0 0 1\n    outer loop\n";
+    assert_eq!(parse(ascii).unwrap_err(), P21Error::Stl);
+    let mut binary = vec![0u8; 80];
+    binary.extend_from_slice(&2u32.to_le_bytes());
+    binary.extend(std::iter::repeat_n(0u8, 100));
+    assert_eq!(parse(&binary).unwrap_err(), P21Error::Stl);
+    // One byte short is not an STL: just not Part 21.
+    binary.pop();
+    assert_eq!(parse(&binary).unwrap_err(), P21Error::NotPart21);
+}
