@@ -111,6 +111,34 @@ fn every_warning_of_the_plan_is_one_line_on_stderr() {
             "not on stderr: {w}"
         );
     }
+    // Narrow beads (the blades' thin edges): each blade's warning gives the share of its print
+    // points under min_bead_width (0.24 mm built in), counted again here from toolpath.csv.
+    let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
+    let mut narrow = std::collections::BTreeMap::<usize, (usize, usize)>::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f[2] != "print" {
+            continue;
+        }
+        let e = narrow.entry(f[0].parse().unwrap()).or_default();
+        e.1 += 1;
+        if f[11].parse::<f64>().unwrap() < 0.24 {
+            e.0 += 1;
+        }
+    }
+    for (id, (n, total)) in &narrow {
+        let said = all.iter().any(|w| {
+            w.starts_with(&format!("feature {id}: "))
+                && w.contains(&format!(
+                    "({n} of {total}) lay beads narrower than min_bead_width 0.24 mm"
+                ))
+        });
+        assert_eq!(said, *n > 0, "feature {id}: {n} of {total} narrow");
+    }
+    assert!(
+        narrow.values().any(|(n, _)| *n > 0),
+        "the blades have narrow beads"
+    );
     // The summary counts them.
     let summary = String::from_utf8_lossy(&o.stdout);
     assert!(
@@ -389,5 +417,123 @@ fn help_gives_examples_of_every_verb() {
         let o = Command::new(BIN).args([verb, "--help"]).output().unwrap();
         let sub = String::from_utf8_lossy(&o.stdout);
         assert!(sub.contains("Examples:"), "{verb}: {sub}");
+    }
+}
+
+#[test]
+fn a_built_in_profile_shown_edited_and_given_back_plans() {
+    let s = Scratch::new("profiles");
+    let o = Command::new(BIN).arg("profiles").output().unwrap();
+    let list = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    for name in ["marlin", "delta5", "kuka", "process"] {
+        assert!(
+            list.lines().any(|l| l.trim_start().starts_with(name)),
+            "{list}"
+        );
+    }
+    let o = Command::new(BIN)
+        .args(["profiles", "show", "delta5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout)
+        .replace("nozzle_temperature = 210.0", "nozzle_temperature = 237.0");
+    assert!(
+        text.contains("nozzle_temperature = 237.0"),
+        "the key is in the shown profile"
+    );
+    let mine = s.write("my.toml", &text);
+    let gcode = s.path("part.gcode");
+    let o = plan(
+        "sphere_boss.step",
+        &["--machine-profile", &mine, "-o", gcode.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let program = std::fs::read_to_string(&gcode).unwrap();
+    assert!(
+        program.lines().any(|l| l.starts_with("M104 S237")),
+        "the edit is used"
+    );
+    // The process profile shown is a process file the planner takes as it is.
+    let o = Command::new(BIN)
+        .args(["profiles", "show", "process"])
+        .output()
+        .unwrap();
+    let p = s.write("process.toml", &String::from_utf8_lossy(&o.stdout));
+    let o = plan(
+        "box.step",
+        &["--process", &p, "-o", s.path("b").to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = Command::new(BIN)
+        .args(["profiles", "show", "prusa"])
+        .output()
+        .unwrap();
+    assert_refused(&o, &["no such profile"]);
+}
+
+#[test]
+fn set_overrides_any_setting_and_the_settings_used_are_recorded() {
+    let s = Scratch::new("set");
+    let out = s.path("o");
+    let o = plan(
+        "box.step",
+        &[
+            "--set",
+            "uniform_layer_height=0.1",
+            "--set",
+            "features.0.perimeters=3",
+            "--set",
+            "machine.nozzle_temperature=215",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    let f = &report["features"][0];
+    // The box is 10 mm tall: 0.1 mm layers are 100 layers, each as thick.
+    assert_eq!(f["thickness_mean_mm"].as_f64(), Some(0.1));
+    let settings = &report["settings"];
+    assert_eq!(settings["process"]["defaults"]["uniform_layer_height"], 0.1);
+    assert_eq!(settings["process"]["features"]["0"]["perimeters"], 3);
+    assert_eq!(
+        settings["process"]["features"]["0"]["uniform_layer_height"],
+        0.1
+    );
+    assert_eq!(settings["machine"]["nozzle_temperature"], 215.0);
+    assert!(settings["version"].as_str().is_some_and(|v| !v.is_empty()));
+    // The program's header says the same, with the version.
+    let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
+    let head: Vec<&str> = program.lines().take(120).collect();
+    assert!(head[1].starts_with("; features "), "{}", head[1]);
+    for line in [
+        "; process.defaults.uniform_layer_height = 0.1",
+        "; process.features.0.perimeters = 3",
+        "; machine.nozzle_temperature = 215.0",
+    ] {
+        assert!(head.contains(&line), "{line} missing");
+    }
+    assert!(program.lines().any(|l| l == "M104 S215 ; nozzle"));
+    // Mistakes name the --set and the key.
+    for (set, words) in [
+        (
+            "uniform_layer_heigth=0.1",
+            vec!["--set uniform_layer_heigth=0.1", "did you mean"],
+        ),
+        (
+            "machine.nozzle_temperature=hot",
+            vec!["--set machine.nozzle_temperature=hot", "expected f64"],
+        ),
+        ("layer", vec!["KEY=VALUE"]),
+        ("uniform_layer_height=3", vec!["outside"]),
+    ] {
+        let o = plan(
+            "box.step",
+            &["--set", set, "-o", s.path("x").to_str().unwrap()],
+        );
+        assert_refused(&o, &words);
     }
 }

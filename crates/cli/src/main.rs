@@ -8,6 +8,7 @@ mod inspect;
 mod mesh;
 mod outputs;
 mod plan;
+mod profiles;
 mod settings;
 
 use clap::{Args, Parser, Subcommand};
@@ -26,7 +27,8 @@ use std::process::ExitCode;
                   features extract part.step\n  \
                   features extract part.step --json --export features/\n  \
                   features inspect part.step --json\n  \
-                  features mesh part.step -o part.stl --tolerance 0.02\n\n\
+                  features mesh part.step -o part.stl --tolerance 0.02\n  \
+                  features profiles show delta5 > my.toml\n\n\
                   Errors are one line on stderr, `features: <file>: <cause>`, exit code 2; \
                   warnings are lines `features: <file>: warning: ...`."
 )]
@@ -62,6 +64,29 @@ enum Command {
                             features plan part.step --process profiles/process.toml --strict -o out/ --force"
     )]
     Plan(PlanArgs),
+    /// List the built-in machine and process profiles, or print one as TOML to copy and edit.
+    #[command(
+        after_help = "Examples:\n  features profiles\n  features profiles show delta5 > my.toml\n  \
+                            features plan part.step --machine-profile my.toml -o out/"
+    )]
+    Profiles(ProfilesArgs),
+}
+
+/// Arguments of `features profiles`.
+#[derive(Debug, Args)]
+pub struct ProfilesArgs {
+    #[command(subcommand)]
+    pub action: Option<ProfilesAction>,
+}
+
+/// What `features profiles` does beyond listing.
+#[derive(Debug, Subcommand)]
+pub enum ProfilesAction {
+    /// Print a built-in profile (marlin, delta5, kuka or process) as TOML, with its comments.
+    Show {
+        /// The profile's name.
+        name: String,
+    },
 }
 
 /// Arguments of `features plan`.
@@ -99,6 +124,11 @@ pub struct PlanArgs {
     /// Write a KUKA program even when points are out of the arm's reach (an error otherwise)
     #[arg(long)]
     pub allow_unreachable: bool,
+    /// Override one setting, KEY=VALUE (repeatable): a process key (`uniform_layer_height=0.1`
+    /// for [defaults], `features.2.perimeters=3`, `orientation.cone_angle_deg=20`) or a machine
+    /// key after `machine.` (`machine.nozzle_temperature=215`)
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Write the plan even when its self-check fails (a feature with no layer, or extruded
     /// volume more than 3 % from volume x fill): the failures become warnings and plan.json
     /// says `"complete": false`
@@ -235,6 +265,7 @@ fn run(cmd: &Command) -> Result<(), Failure> {
         Command::Mesh(a) => mesh::run(a),
         Command::Extract(a) => extract::run(a),
         Command::Plan(a) => plan::run(a),
+        Command::Profiles(a) => profiles::run(a),
     }
 }
 
@@ -255,6 +286,7 @@ fn main() -> ExitCode {
         Command::Mesh(a) => a.part.display().to_string(),
         Command::Extract(a) => a.part.display().to_string(),
         Command::Plan(a) => a.part.display().to_string(),
+        Command::Profiles(_) => "profiles".to_string(),
     };
     // The panic is reported below, on one line; the default hook would add a second.
     panic::set_hook(Box::new(|_| {}));

@@ -5,39 +5,55 @@ use crate::{Failure, PlanArgs};
 use plan::Process;
 use robot_post::machine::{MachineKind, MachineProfile};
 
-/// The process file and the machine profile of a plan, checked, in the order a user fixes them.
+/// The process file and the machine profile of a plan, with the `--set` overrides, checked,
+/// in the order a user fixes them.
 pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
     let path = &args.part;
     let settings = args.process.as_deref().unwrap_or(path);
-    let process = match &args.process {
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| Failure::new(p, format!("cannot read process file: {e}")))?;
-            Process::from_toml(&text).map_err(|e| {
-                if looks_like_machine_profile(&text) {
-                    Failure::new(
-                        p,
-                        "this is a machine profile (it has `kind` and `bed_size`), not a process file: give it with --machine-profile",
-                    )
-                } else {
-                    Failure::new(p, with_suggestion(&e.to_string()))
-                }
-            })?
-        }
-        None => Process::default(),
+    let sets = args
+        .set
+        .iter()
+        .map(|s| Set::parse(s))
+        .collect::<Result<Vec<Set>, Failure>>()?;
+    let process_text = match &args.process {
+        Some(p) => std::fs::read_to_string(p)
+            .map_err(|e| Failure::new(p, format!("cannot read process file: {e}")))?,
+        None => String::new(),
     };
+    // The file alone first, so that its own mistakes are reported against its lines.
+    let mut process = Process::from_toml(&process_text).map_err(|e| {
+        if looks_like_machine_profile(&process_text) {
+            Failure::new(
+                settings,
+                "this is a machine profile (it has `kind` and `bed_size`), not a process file: give it with --machine-profile",
+            )
+        } else {
+            Failure::new(settings, with_suggestion(&e.to_string()))
+        }
+    })?;
+    let process_sets: Vec<&Set> = sets.iter().filter(|s| !s.machine).collect();
+    if !process_sets.is_empty() {
+        let mut table = process_text
+            .parse::<toml::Table>()
+            .map_err(|e| Failure::new(settings, e.message().trim()))?;
+        for set in process_sets {
+            set.apply(&mut table)?;
+            let text = toml::to_string(&table).map_err(|e| set.failure(e))?;
+            process = Process::from_toml(&text)
+                .map_err(|e| set.failure(with_suggestion(&e.to_string())))?;
+        }
+    }
     process
         .validate_defaults()
         .map_err(|e| Failure::new(settings, e))?;
-    let machine = match (&args.machine_profile, args.machine.as_deref()) {
-        (Some(p), _) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| Failure::new(p, format!("cannot read machine profile: {e}")))?;
-            MachineProfile::from_toml(&text)
-                .map_err(|e| Failure::new(p, with_suggestion(&e.to_string())))?
-        }
-        (None, Some(name)) => MachineProfile::builtin(MachineKind::from_name(name).ok_or_else(
-            || {
+    let (machine_text, machine_source) = match (&args.machine_profile, args.machine.as_deref()) {
+        (Some(p), _) => (
+            std::fs::read_to_string(p)
+                .map_err(|e| Failure::new(p, format!("cannot read machine profile: {e}")))?,
+            p.display().to_string(),
+        ),
+        (None, Some(name)) => {
+            let kind = MachineKind::from_name(name).ok_or_else(|| {
                 let hint = if name.ends_with(".toml") || std::path::Path::new(name).is_file() {
                     format!("`{name}` is a file: a machine profile goes to --machine-profile")
                 } else {
@@ -47,10 +63,31 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
                     path: "--machine".into(),
                     cause: hint,
                 }
-            },
-        )?),
-        (None, None) => MachineProfile::builtin(MachineKind::Marlin),
+            })?;
+            (builtin_text(kind).to_string(), format!("built-in {name}"))
+        }
+        (None, None) => (
+            builtin_text(MachineKind::Marlin).to_string(),
+            "built-in marlin".into(),
+        ),
     };
+    let mut machine = MachineProfile::from_toml(&machine_text).map_err(|e| Failure {
+        path: machine_source.clone(),
+        cause: with_suggestion(&e.to_string()),
+    })?;
+    let machine_sets: Vec<&Set> = sets.iter().filter(|s| s.machine).collect();
+    if !machine_sets.is_empty() {
+        let mut table = machine_text.parse::<toml::Table>().map_err(|e| Failure {
+            path: machine_source.clone(),
+            cause: e.message().trim().to_string(),
+        })?;
+        for set in machine_sets {
+            set.apply(&mut table)?;
+            let text = toml::to_string(&table).map_err(|e| set.failure(e))?;
+            machine = MachineProfile::from_toml(&text)
+                .map_err(|e| set.failure(with_suggestion(&e.to_string())))?;
+        }
+    }
     process
         .validate_orientation()
         .map_err(|e| Failure::new(settings, e))?;
@@ -58,6 +95,109 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
         .validate_for_nozzle(machine.nozzle_diameter)
         .map_err(|e| Failure::new(settings, e))?;
     Ok((process, machine))
+}
+
+/// The bundled TOML text of a built-in machine profile (comments kept).
+pub fn builtin_text(kind: MachineKind) -> &'static str {
+    match kind {
+        MachineKind::Marlin => robot_post::machine::MARLIN_TOML,
+        MachineKind::Delta5 => robot_post::machine::DELTA5_TOML,
+        MachineKind::Kuka => robot_post::machine::KUKA_TOML,
+    }
+}
+
+/// One `--set KEY=VALUE`: a process key (`uniform_layer_height` is `[defaults]`'s;
+/// `features.2.perimeters`, `orientation.cone_angle_deg` name their table) or, after
+/// `machine.`, a machine-profile key (`machine.nozzle_temperature`, `machine.delta5.z_min`).
+/// The value is read as TOML (`0.1`, `true`, `[0, 0, 1]`, `"text"`), else taken as text
+/// (`path_mode=contour`).
+#[derive(Debug)]
+struct Set {
+    /// As given, for errors.
+    given: String,
+    machine: bool,
+    /// The key's path of tables, the last one the key itself.
+    path: Vec<String>,
+    value: toml::Value,
+}
+
+impl Set {
+    fn parse(given: &str) -> Result<Set, Failure> {
+        let fail = |cause: &str| Failure {
+            path: format!("--set {given}"),
+            cause: cause.to_string(),
+        };
+        let (key, value) = given
+            .split_once('=')
+            .ok_or_else(|| fail("expected KEY=VALUE, e.g. uniform_layer_height=0.1"))?;
+        let mut path: Vec<String> = key
+            .trim()
+            .split('.')
+            .map(|k| k.trim().to_string())
+            .collect();
+        if path.iter().any(|k| k.is_empty()) {
+            return Err(fail("the key is empty or has an empty part"));
+        }
+        let machine = path[0] == "machine";
+        if machine {
+            path.remove(0);
+            if path.is_empty() {
+                return Err(fail(
+                    "a machine key follows `machine.`, e.g. machine.nozzle_temperature=215",
+                ));
+            }
+        } else if !matches!(path[0].as_str(), "defaults" | "features" | "orientation") {
+            path.insert(0, "defaults".to_string());
+        }
+        let value = value.trim();
+        let value = format!("v = {value}")
+            .parse::<toml::Table>()
+            .ok()
+            .and_then(|mut t| t.remove("v"))
+            .unwrap_or_else(|| toml::Value::String(value.to_string()));
+        Ok(Set {
+            given: given.to_string(),
+            machine,
+            path,
+            value,
+        })
+    }
+
+    /// A failure of this override; a line number of the text it was merged into means nothing
+    /// to the user, so it is left out.
+    fn failure(&self, cause: impl std::fmt::Display) -> Failure {
+        let mut cause = cause.to_string();
+        for head in ["process file line ", "machine profile: line "] {
+            if let Some(rest) = cause.strip_prefix(head) {
+                if let Some((_, after)) = rest.split_once(": ") {
+                    cause = after.to_string();
+                }
+            }
+        }
+        Failure {
+            path: format!("--set {}", self.given),
+            cause,
+        }
+    }
+
+    /// Puts the value into `table`, making the tables on its path.
+    fn apply(&self, table: &mut toml::Table) -> Result<(), Failure> {
+        let (last, tables) = self
+            .path
+            .split_last()
+            .ok_or_else(|| self.failure("no key"))?;
+        let mut t = table;
+        for name in tables {
+            let next = t
+                .entry(name.clone())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            t = next
+                .as_table_mut()
+                .ok_or_else(|| self.failure(format!("`{name}` is a value, not a table of keys")))?;
+        }
+        t.insert(last.clone(), self.value.clone());
+        Ok(())
+    }
 }
 
 /// Whether a TOML text is a machine profile (its top-level `kind` and `bed_size`).

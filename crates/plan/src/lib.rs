@@ -14,7 +14,7 @@ pub mod process;
 pub mod report;
 
 pub use process::{Process, ProcessError};
-pub use report::{FeatureEntry, FeatureReport, PlanReport};
+pub use report::{FeatureEntry, FeatureReport, PlanReport, SettingsEntry};
 
 use brep::math::P3;
 use features::{extract_all, ExtractOptions};
@@ -23,7 +23,8 @@ use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
 use robot_post::{Job, PostFigures, ProgramFile};
 use slicer::orient::{smooth, OrientationFigures};
-use slicer::toolpath::ToolPath;
+use slicer::params::LayerParams;
+use slicer::toolpath::{MoveKind, ToolPath};
 use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
 use slicer::{fill_feature, sequence};
 
@@ -121,6 +122,7 @@ pub fn plan(
     let base = process.base();
     let bead = machine.bead();
     let filament_area = bead.filament_area();
+    let min_bead = machine.min_bead_width();
 
     let assembly = extract_all(&part.brep, &ExtractOptions::default())?;
     let trees = &assembly.trees;
@@ -186,6 +188,25 @@ pub fn plan(
                 extruded,
             });
             let mut fw = fig.warnings.clone();
+            // Printability: beads narrower than the nozzle lays well (thin walls, blade tips).
+            let (narrow, prints, thinnest) = plan
+                .points
+                .iter()
+                .filter(|q| q.kind == MoveKind::Print)
+                .fold((0usize, 0usize, f64::INFINITY), |(n, all, lo), q| {
+                    let thin = q.width < min_bead;
+                    (
+                        n + thin as usize,
+                        all + 1,
+                        if thin { lo.min(q.width) } else { lo },
+                    )
+                });
+            if narrow > 0 {
+                fw.push(format!(
+                    "feature {id}: {:.1} % of its print points ({narrow} of {prints}) lay beads narrower than min_bead_width {min_bead} mm, down to {thinnest:.3} mm: the nozzle lays them poorly",
+                    100.0 * narrow as f64 / prints.max(1) as f64
+                ));
+            }
             // Below the build plate (the base feature's reference plane): any point of the
             // feature, planned or not (a planar layer starts at its reference plane, so what
             // lies below that is not printed).
@@ -242,9 +263,12 @@ pub fn plan(
             rate_max_deg_per_mm_after: round(o.rate_max_deg_per_mm_after, 1e6),
         });
     }
+    let settings = settings_entry(process, machine, &base);
+    let notes = settings.lines();
     let job = Job {
         source: &options.source,
         stem: &options.stem,
+        notes: &notes,
     };
     let program = machine.post().post(&toolpath, &job)?;
     for r in &mut reports {
@@ -269,6 +293,7 @@ pub fn plan(
         complete: problems.is_empty(),
         features: reports,
         warnings,
+        settings,
         outputs: vec![],
     };
     Ok(Plan {
@@ -276,4 +301,34 @@ pub fn plan(
         toolpath,
         program: program.files,
     })
+}
+
+/// The settings of a plan, every key: the process's defaults with `base`'s values, each
+/// overridden feature's full parameters, the smoothing, and the machine profile.
+fn settings_entry(
+    process: &Process,
+    machine: &MachineProfile,
+    base: &LayerParams,
+) -> SettingsEntry {
+    let json = |v: Result<serde_json::Value, serde_json::Error>| v.unwrap_or_default();
+    let mut features = serde_json::Map::new();
+    let mut ids: Vec<(usize, &String)> = process
+        .features
+        .keys()
+        .filter_map(|k| k.parse().ok().map(|n| (n, k)))
+        .collect();
+    ids.sort();
+    for (_, key) in ids {
+        let p = base.patched(&process.features[key]);
+        features.insert(key.clone(), json(serde_json::to_value(p)));
+    }
+    SettingsEntry {
+        version: env!("CARGO_PKG_VERSION"),
+        process: serde_json::json!({
+            "defaults": json(serde_json::to_value(base)),
+            "features": features,
+            "orientation": json(serde_json::to_value(&process.orientation)),
+        }),
+        machine: json(serde_json::to_value(machine)),
+    }
 }

@@ -164,6 +164,41 @@ pub struct FeatureReport {
     pub post: Option<PostEntry>,
 }
 
+/// The settings a plan was made with: the planner's version and the full process and machine
+/// tables (every key, defaults included), so that a plan can be made again.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SettingsEntry {
+    /// The version of the planner (the `features` workspace).
+    pub version: &'static str,
+    /// `defaults` (every layer parameter), `features` (each overridden feature's full
+    /// parameters, by id) and `orientation` (smoothing).
+    pub process: serde_json::Value,
+    /// The machine profile, every key.
+    pub machine: serde_json::Value,
+}
+
+impl SettingsEntry {
+    /// The settings as `key = value` lines (`process.defaults.tolerance = 0.05`,
+    /// `machine.nozzle_diameter = 0.4`) for programs' headers, after the version line.
+    pub fn lines(&self) -> Vec<String> {
+        fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<String>) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    for (k, x) in m {
+                        flatten(&format!("{prefix}.{k}"), x, out);
+                    }
+                }
+                serde_json::Value::Null => {}
+                x => out.push(format!("{prefix} = {x}")),
+            }
+        }
+        let mut out = vec![format!("features {}", self.version)];
+        flatten("process", &self.process, &mut out);
+        flatten("machine", &self.machine, &mut out);
+        out
+    }
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -179,6 +214,8 @@ pub struct PlanReport {
     pub features: Vec<FeatureReport>,
     /// Things to know about the plan.
     pub warnings: Vec<String>,
+    /// The settings the plan was made with.
+    pub settings: SettingsEntry,
     /// The files the plan was written to, beside `plan.json` (set by whoever writes them; the
     /// command line lists them so that `--force` can clear them before the next plan).
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -32,6 +32,10 @@ pub struct MachineProfile {
     pub filament_diameter: f64,
     /// Bead width w (mm).
     pub bead_width: f64,
+    /// Narrowest bead the nozzle lays well (mm); narrower beads of a plan are a warning.
+    /// Optional: 0.6 × `nozzle_diameter` when left out ([`MachineProfile::min_bead_width`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_bead_width: Option<f64>,
     /// Printing speed (mm/s).
     pub print_speed: f64,
     /// Printing speed of beads resting on the build plate (mm/s).
@@ -61,6 +65,10 @@ pub struct MachineProfile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kuka: Option<crate::kuka::cell::KukaCell>,
 }
+
+/// The narrowest bead a nozzle lays well, as a share of its diameter, when a profile does
+/// not say (`min_bead_width`).
+pub const MIN_BEAD_SHARE: f64 = 0.6;
 
 impl MachineProfile {
     /// The built-in profile of `kind`, parsed from the bundled `profiles/<kind>.toml`.
@@ -123,6 +131,17 @@ impl MachineProfile {
         for (field, v) in positive {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(field, format!("must be a positive number, got {v}")));
+            }
+        }
+        if let Some(w) = self.min_bead_width {
+            if !(w.is_finite() && w > 0.0 && w <= self.bead_width) {
+                return Err(bad(
+                    "min_bead_width",
+                    format!(
+                        "must be positive and at most bead_width {}, got {w}",
+                        self.bead_width
+                    ),
+                ));
             }
         }
         let non_negative = [
@@ -223,6 +242,12 @@ impl MachineProfile {
         self.bead().filament_length(w, dl, len)
     }
 
+    /// The narrowest bead the nozzle lays well: `min_bead_width`, or 0.6 × the nozzle.
+    pub fn min_bead_width(&self) -> f64 {
+        self.min_bead_width
+            .unwrap_or(MIN_BEAD_SHARE * self.nozzle_diameter)
+    }
+
     /// The profile's bead: its `bead_width` and `filament_diameter`.
     pub fn bead(&self) -> Bead {
         Bead {
@@ -277,7 +302,9 @@ mod tests {
         let negative = MARLIN_TOML.replace("print_speed = 40.0", "print_speed = -40.0");
         let nan = MARLIN_TOML.replace("bead_width = 0.45", "bead_width = nan");
         let hot = MARLIN_TOML.replace("nozzle_temperature = 210.0", "nozzle_temperature = 2100.0");
+        let wide = MARLIN_TOML.replace("min_bead_width = 0.24", "min_bead_width = 0.5");
         for (text, needle) in [
+            (wide.as_str(), "min_bead_width"),
             (unknown.as_str(), "zhop"),
             (missing.as_str(), "z_hop"),
             (bad_kind.as_str(), "prusa"),
@@ -293,6 +320,11 @@ mod tests {
         }
         let e = MachineProfile::from_toml(&unknown).unwrap_err().to_string();
         assert!(e.contains("line "), "{e}");
+        // Left out, the narrowest bead is 0.6 x the nozzle.
+        let old =
+            MachineProfile::from_toml(&MARLIN_TOML.replace("min_bead_width = 0.24", "")).unwrap();
+        assert_eq!(old.min_bead_width, None);
+        assert!((old.min_bead_width() - 0.6 * old.nozzle_diameter).abs() < 1e-12);
     }
 
     #[test]
