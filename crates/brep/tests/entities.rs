@@ -292,3 +292,50 @@ fn a_misspelt_entity_is_warned_naming_its_id() {
         clean.brep.warnings
     );
 }
+
+/// An assembly placing box.step's part twice: once through a
+/// REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION (the box turned 90° about Z, its origin at
+/// x = 100), once through a MAPPED_ITEM (its axes onto +Y, +Z, +X, its origin at z = 50). Two
+/// solids, each where its placement puts it.
+#[test]
+fn a_part_placed_twice_is_two_solids_where_the_assembly_puts_them() {
+    let box_step = fixture("box.step");
+    let asm = rewrite(
+        &box_step,
+        &[],
+        "#900000 = SHAPE_REPRESENTATION('asm',(#900001,#900020),#345);
+#900001 = AXIS2_PLACEMENT_3D('',#900002,#13,#900003);
+#900002 = CARTESIAN_POINT('',(100.,0.,0.));
+#900003 = DIRECTION('',(0.,1.,0.));
+#900010 = ITEM_DEFINED_TRANSFORMATION('','',#11,#900001);
+#900011 = (REPRESENTATION_RELATIONSHIP('','',#10,#900000) REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#900010) SHAPE_REPRESENTATION_RELATIONSHIP());
+#900020 = MAPPED_ITEM('',#900021,#900022);
+#900021 = REPRESENTATION_MAP(#11,#10);
+#900022 = AXIS2_PLACEMENT_3D('',#900023,#900024,#900003);
+#900023 = CARTESIAN_POINT('',(0.,0.,50.));
+#900024 = DIRECTION('',(1.,0.,0.));
+",
+    );
+    let part = brep::read_step_bytes(asm.as_bytes()).expect("reads");
+    let b = &part.brep;
+    assert_eq!(b.solids.len(), 2, "{:?}", b.warnings);
+    let mut boxes = vec![];
+    for s in b.solid_ids() {
+        let r = report_solid(b, s).expect("meshes");
+        assert!(r.closed && r.watertight && (r.volume - 6000.0).abs() < 1e-6);
+        boxes.push((r.bbox.min, r.bbox.max));
+    }
+    let want = [
+        ([70.0, 0.0, 0.0], [100.0, 20.0, 10.0]),
+        ([0.0, 0.0, 50.0], [10.0, 20.0, 80.0]),
+    ];
+    for (lo, hi) in want {
+        assert!(
+            boxes
+                .iter()
+                .any(|(a, b)| (0..3)
+                    .all(|k| (a[k] - lo[k]).abs() < 1e-6 && (b[k] - hi[k]).abs() < 1e-6)),
+            "no solid spans {lo:?}..{hi:?}: {boxes:?}"
+        );
+    }
+}

@@ -4,8 +4,10 @@
 //! Handles, beyond what truck-stepio 0.3 does: the file's length and plane-angle units, closed
 //! edges and seam edges (any edge shape goes into our arena unchanged), `BREP_WITH_VOIDS`,
 //! `OFFSET_SURFACE`, `RECTANGULAR_TRIMMED_SURFACE`, `TRIMMED_CURVE`, and `SURFACE_CURVE`s taken by
-//! their 3-D curve (so a seam that ends at a sphere's pole reads like any other edge).
+//! their 3-D curve (so a seam that ends at a sphere's pole reads like any other edge). Each solid
+//! stands where its assembly places it (`assembly`): a component placed twice is two solids.
 
+mod assembly;
 mod curves;
 mod geometry;
 mod schema_names;
@@ -36,7 +38,7 @@ pub fn translate(file: &P21File) -> R<Brep> {
     }
     let default_units = t.default_units();
     let mut unit_names: Vec<LengthUnit> = vec![];
-    for (id, kind) in bodies {
+    for (id, kind, place) in t.placed_bodies(&bodies)? {
         let units = contexts
             .get(&id)
             .and_then(|c| t.context_units(*c).ok())
@@ -46,6 +48,8 @@ pub fn translate(file: &P21File) -> R<Brep> {
         if !unit_names.contains(&units.0) {
             unit_names.push(units.0.clone());
         }
+        t.place = place;
+        t.forget_read();
         t.read_body(id, kind)?;
     }
     if t.off_curve.0 > 0 {
