@@ -68,6 +68,10 @@ impl Placement {
 /// How many placements deep an assembly may nest before the walk stops (a cycle).
 const MAX_DEPTH: usize = 32;
 
+/// How many placed representations the walk visits at most (a file nesting a few components
+/// many times over would otherwise take exponential time).
+const MAX_VISITS: usize = 100_000;
+
 impl<'a> Translator<'a> {
     /// Every placed instance of the bodies, in file order of the bodies: `(body, kind,
     /// placement)`, `None` where the body stands as written.
@@ -151,6 +155,9 @@ impl<'a> Translator<'a> {
         let mut placed: HashSet<u64> = HashSet::new();
         for (p, c, pl) in links {
             let (gp, gc) = (find(&mut group, p), find(&mut group, c));
+            if gp == gc {
+                continue; // placed into its own frame: no placement at all
+            }
             children.entry(gp).or_default().push((gc, pl));
             placed.insert(gc);
         }
@@ -173,7 +180,15 @@ impl<'a> Translator<'a> {
             .into_iter()
             .map(|g| (g, Placement::identity(), 0))
             .collect();
+        let mut visits = 0usize;
         while let Some((g, pl, depth)) = stack.pop() {
+            visits += 1;
+            if visits > MAX_VISITS {
+                self.brep.warnings.push(format!(
+                    "assembly of more than {MAX_VISITS} placed representations: the rest not placed"
+                ));
+                break;
+            }
             for r in members.get(&g).into_iter().flatten() {
                 for it in &reps[r].0 {
                     if kinds.contains_key(it) {
