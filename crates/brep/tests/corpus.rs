@@ -10,14 +10,10 @@ use serde_json::Value;
 use std::path::PathBuf;
 
 /// Files still off, with why (measured 2026-11-25).
-const KNOWN_OFF: [(&str, &str); 3] = [
+const KNOWN_OFF: [(&str, &str); 2] = [
     (
         "fusion_atf65_example.step",
         "+0.22 %: a tiny part (9.6 mm^3) whose B-spline faces' trims the analysis mesh follows coarsely",
-    ),
-    (
-        "ascon_kompas_push_switch.step",
-        "two mirrored solids (#61, #81) mesh with faces against their loops: 0.187 vs 0.405 mm^3, not watertight (warned)",
     ),
     (
         "onshape_abc_0_13.step",

@@ -339,3 +339,34 @@ fn a_part_placed_twice_is_two_solids_where_the_assembly_puts_them() {
         );
     }
 }
+
+/// A face whose `same_sense` runs against the rest of its shell (ASCON KOMPAS writes mirrored
+/// parts so) is turned round on reading, with a warning naming it: box.step with one face's
+/// sense flipped reads as the box.
+#[test]
+fn a_face_facing_against_its_shell_is_turned_round_and_named() {
+    let box_step = fixture("box.step");
+    let flipped = rewrite(
+        &box_step,
+        &[(
+            "#17 = ADVANCED_FACE('',(#18),#32,.F.);",
+            "#17 = ADVANCED_FACE('',(#18),#32,.T.);",
+        )],
+        "",
+    );
+    let part = brep::read_step_bytes(flipped.as_bytes()).expect("reads");
+    assert!(
+        part.brep
+            .warnings
+            .iter()
+            .any(|w| w.contains("#17") && w.contains("turned round")),
+        "{:?}",
+        part.brep.warnings
+    );
+    let r = report_solid(&part.brep, SolidId(0)).expect("meshes");
+    assert!(r.closed && r.watertight, "{:?}", r.findings);
+    assert!((r.volume - 6000.0).abs() < 1e-6, "volume {}", r.volume);
+    // The file as written warns of nothing.
+    let part = brep::read_step_bytes(box_step.as_bytes()).expect("reads");
+    assert!(part.brep.warnings.is_empty(), "{:?}", part.brep.warnings);
+}

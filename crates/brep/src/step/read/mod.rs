@@ -52,6 +52,26 @@ pub fn translate(file: &P21File) -> R<Brep> {
         t.forget_read();
         t.read_body(id, kind)?;
     }
+    // Faces whose normal runs against their neighbours' are turned round, as OpenCASCADE heals
+    // them on reading.
+    for k in 0..t.brep.shells.len() {
+        let sh = crate::topology::ShellId(k as u32);
+        if !t.shell_is_closed(sh) {
+            continue;
+        }
+        let turned = crate::orient::orient_shell(&mut t.brep, sh);
+        if !turned.is_empty() {
+            let ids: Vec<String> = turned
+                .iter()
+                .map(|f| format!("#{}", t.brep.faces[f.idx()].step_id))
+                .collect();
+            let sid = t.brep.shells[k].step_id;
+            t.brep.warnings.push(format!(
+                "shell #{sid}: face(s) {} faced against the rest of the shell; turned round",
+                ids.join(", ")
+            ));
+        }
+    }
     if t.off_curve.0 > 0 {
         t.brep.warnings.push(format!(
             "{} edge ends lie off their curves by up to {:.3} mm (worst at #{})",
