@@ -10,6 +10,7 @@
 mod assembly;
 mod curves;
 mod geometry;
+mod placement;
 mod schema_names;
 mod surfaces;
 mod topology;

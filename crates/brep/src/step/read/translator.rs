@@ -23,7 +23,7 @@ pub(super) struct Translator<'a> {
     /// (count, worst distance, worst edge id) of edge ends off their curve.
     pub(super) off_curve: (usize, f64, u64),
     /// Where the body being read is placed (an assembly's component), if anywhere.
-    pub(super) place: Option<super::assembly::Placement>,
+    pub(super) place: Option<super::placement::Placement>,
 }
 
 pub(super) fn names_of(e: &Entity) -> String {
