@@ -383,3 +383,30 @@ fn a_face_facing_against_its_shell_is_turned_round_and_named() {
     let part = brep::read_step_bytes(box_step.as_bytes()).expect("reads");
     assert!(part.brep.warnings.is_empty(), "{:?}", part.brep.warnings);
 }
+
+/// A placement that is not one (its item a DIRECTION, not an AXIS2_PLACEMENT_3D) leaves the
+/// component where it stands, with a warning naming the entity; the file still reads.
+#[test]
+fn a_broken_placement_is_warned_and_the_part_read_where_it_stands() {
+    let box_step = fixture("box.step");
+    let asm = rewrite(
+        &box_step,
+        &[],
+        "#900000 = SHAPE_REPRESENTATION('asm',(#11),#345);
+#900010 = ITEM_DEFINED_TRANSFORMATION('','',#11,#13);
+#900011 = (REPRESENTATION_RELATIONSHIP('','',#10,#900000) REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#900010) SHAPE_REPRESENTATION_RELATIONSHIP());
+",
+    );
+    let part = brep::read_step_bytes(asm.as_bytes()).expect("reads");
+    assert_eq!(part.brep.solids.len(), 1);
+    assert!(
+        part.brep
+            .warnings
+            .iter()
+            .any(|w| w.contains("#13") && w.contains("stands as written")),
+        "{:?}",
+        part.brep.warnings
+    );
+    let r = report_solid(&part.brep, SolidId(0)).expect("meshes");
+    assert!((r.volume - 6000.0).abs() < 1e-6 && r.bbox.min.coords.norm() < 1e-9);
+}

@@ -67,13 +67,20 @@ impl<'a> Translator<'a> {
                     group.insert(a, b);
                 }
                 Some(rt) => {
-                    let tr = self.reference(e.id, rt, 0)?;
                     // The parent is the assembly's representation where the occurrence names
                     // it; otherwise rep_2, as most writers have it.
                     let one_is_parent = parents.contains(&r1) && !parents.contains(&r2);
                     let (parent, child) = if one_is_parent { (r1, r2) } else { (r2, r1) };
-                    let p = self.transformation(tr, e.id, &reps, one_is_parent)?;
-                    links.push((parent, child, p));
+                    let p = self
+                        .reference(e.id, rt, 0)
+                        .and_then(|tr| self.transformation(tr, e.id, &reps, one_is_parent));
+                    match p {
+                        Ok(p) => links.push((parent, child, p)),
+                        Err(err) => self
+                            .brep
+                            .warnings
+                            .push(format!("{err}; the component stands as written")),
+                    }
                 }
             }
         }
@@ -86,17 +93,14 @@ impl<'a> Translator<'a> {
                 let Some(mi) = ent.instance.record("MAPPED_ITEM") else {
                     continue;
                 };
-                let source = self.reference(it, mi, 1)?;
-                let target = self.reference(it, mi, 2)?;
-                let (_, rm) = self.record(source, it, &["REPRESENTATION_MAP"])?;
-                let origin = self.reference(source, rm, 0)?;
-                let mapped = self.reference(source, rm, 1)?;
-                if !reps.contains_key(&mapped) {
-                    continue;
+                match self.mapped_item(it, mi, rep, &reps) {
+                    Ok(Some((mapped, p))) => links.push((rep, mapped, p)),
+                    Ok(None) => {}
+                    Err(err) => self
+                        .brep
+                        .warnings
+                        .push(format!("{err}; the mapped representation is not placed")),
                 }
-                let from = self.frame_in(origin, source, reps.get(&mapped).map(|r| r.1))?;
-                let to = self.frame_in(target, it, Some(reps[&rep].1))?;
-                links.push((rep, mapped, Placement::between(&from, &to)));
             }
         }
         // Walk from the groups nothing places.
@@ -167,6 +171,28 @@ impl<'a> Translator<'a> {
             }
         }
         Ok(out)
+    }
+
+    /// The representation a MAPPED_ITEM `it` (record `mi`, listed by `rep`) maps and its
+    /// placement into `rep`; `None` when it maps no representation of a known kind.
+    fn mapped_item(
+        &mut self,
+        it: u64,
+        mi: &crate::step::p21::Record,
+        rep: u64,
+        reps: &HashMap<u64, (Vec<u64>, u64)>,
+    ) -> R<Option<(u64, Placement)>> {
+        let source = self.reference(it, mi, 1)?;
+        let target = self.reference(it, mi, 2)?;
+        let (_, rm) = self.record(source, it, &["REPRESENTATION_MAP"])?;
+        let origin = self.reference(source, rm, 0)?;
+        let mapped = self.reference(source, rm, 1)?;
+        let (Some(m), Some(r)) = (reps.get(&mapped), reps.get(&rep)) else {
+            return Ok(None);
+        };
+        let from = self.frame_in(origin, source, Some(m.1))?;
+        let to = self.frame_in(target, it, Some(r.1))?;
+        Ok(Some((mapped, Placement::between(&from, &to))))
     }
 
     /// Each representation's items and context.
