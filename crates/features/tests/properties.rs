@@ -163,11 +163,7 @@ fn every_fixture_extracts_into_closed_features_that_add_up() {
 
 /// Files of `../shared/corpus-more` whose extraction still fails a property, with what fails
 /// (measured 2026-11-25). A listed file that comes right fails the test until it is taken off.
-const KNOWN_FAILING: [(&str, &str); 4] = [
-    (
-        "freecad_occ71_esp32_voids.step",
-        "feature 0 exported with the solid's void shells re-reads as 2 solids: a void is not inside the feature's outer shell",
-    ),
+const KNOWN_FAILING: [(&str, &str); 3] = [
     (
         "onshape_abc_0_13.step",
         "the part's mesh is not watertight (18 open edges where B-spline trims cross in (u, v); brep tests/corpus.rs)",
