@@ -1,5 +1,6 @@
-//! Read + mesh + analysis time per STEP file: every `fixtures/*.step` of the repository and every
-//! `*.step` of the shared corpus (`../../../shared/corpus` from this crate, skipped if absent).
+//! Read + mesh + analysis time per STEP file: every `fixtures/*.step` and `fixtures/reader/*.step`
+//! of the repository and every `*.step` of both shared corpora (`../../../shared/corpus` and
+//! `corpus-more` from this crate, each skipped if absent).
 //!
 //! ```text
 //! cargo bench -p brep --bench read_mesh            # every file
@@ -132,16 +133,18 @@ fn main() {
         .map(String::as_str);
 
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let fixtures = root.join("../../fixtures");
     let mut files: Vec<(String, PathBuf)> = vec![];
-    match step_files(&fixtures) {
-        Some(ps) => files.extend(ps.into_iter().map(|p| {
-            (
-                format!("fixtures/{}", p.file_name().unwrap().to_string_lossy()),
-                p,
-            )
-        })),
-        None => println!("note: {} not found, fixtures skipped", fixtures.display()),
+    for sub in ["fixtures", "fixtures/reader"] {
+        let fixtures = root.join("../..").join(sub);
+        match step_files(&fixtures) {
+            Some(ps) => files.extend(ps.into_iter().map(|p| {
+                (
+                    format!("{sub}/{}", p.file_name().unwrap().to_string_lossy()),
+                    p,
+                )
+            })),
+            None => println!("note: {} not found, fixtures skipped", fixtures.display()),
+        }
     }
     for set in ["corpus", "corpus-more"] {
         let dir = root.join("../../../shared").join(set);

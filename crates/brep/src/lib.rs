@@ -20,6 +20,7 @@ pub mod mass;
 pub mod math;
 pub mod mesh;
 pub mod nurbs;
+pub mod orient;
 pub mod section;
 pub mod solid;
 pub mod step;

@@ -1,6 +1,7 @@
 //! Real files from other CAD writers (`../shared/corpus/` and `../shared/corpus-more/`): every
 //! reference solid's volume within 0.1 % of OpenCASCADE's (adaptive integration), or a clear
-//! one-line refusal; never a panic. A solid that is not watertight, or whose volume is not
+//! one-line refusal; never a panic. Where OpenCASCADE's bounding boxes are given
+//! (`occ_details.json`), its box holds all our solids (components stand inside the assembly). A solid that is not watertight, or whose volume is not
 //! positive, always carries a warning. The files this reader cannot yet bring within 0.1 % are
 //! listed in [`KNOWN_OFF`] with the measured reason; one that comes right fails the test until
 //! it is taken off the list.
@@ -9,22 +10,14 @@ use serde_json::Value;
 use std::path::PathBuf;
 
 /// Files still off, with why (measured 2026-11-25).
-const KNOWN_OFF: [(&str, &str); 4] = [
+const KNOWN_OFF: [(&str, &str); 2] = [
     (
         "fusion_atf65_example.step",
-        "+0.22 %: a tiny part (9.6 mm^3) whose B-spline faces' trims the analysis mesh follows coarsely",
-    ),
-    (
-        "ascon_kompas_push_switch.step",
-        "two mirrored solids (#61, #81) mesh with faces against their loops: 0.187 vs 0.405 mm^3, not watertight (warned)",
+        "-0.22 % (9.558 vs 9.579 mm^3), OpenCASCADE's figure off, not ours: its pcurves, made by projecting the 3-D B-spline edges onto the thread's r = 0.7 cylinders, stray from the edges (edge tolerances 0.005-0.01 mm after reading); Green's theorem over the exact edges (sampled through OCC itself) gives face 1 0.727697 mm^2 as we do (OCC 0.741944 over its pcurves), face 2 0.846017 (we 0.846021, OCC 0.865914)",
     ),
     (
         "onshape_abc_0_13.step",
-        "+10.8 %: SURFACE_OF_REVOLUTION / rational B-spline faces mesh with 308 non-manifold edges (warned, faces named)",
-    ),
-    (
-        "solidedge_push_switch.step",
-        "7 solids read, 8 placed: a component placed twice through MAPPED_ITEM / NAUO is read once",
+        "volume -0.006 % (13130.6 vs 13131.3 mm^3; -0.0004 % at finer edges) but not watertight (warned, faces named): the trims of four rational B-spline faces (#161, #145, #149, #281) lie up to 0.0018 mm off them, and where two trims run side by side into a cusp their projections cross in (u, v) (#2562 and #2500 on #161: 3 crossings at 200 samples an edge), so the face's domain folds there; finer meshes leave the mesh as open",
     ),
 ];
 
@@ -38,6 +31,19 @@ fn dirs() -> Vec<PathBuf> {
         })
         .filter(|d| d.join("reference.json").exists())
         .collect()
+}
+
+/// Where OpenCASCADE places the file's solids, all together (`occ_details.json` beside
+/// `reference.json`, where there is one): `[xmin, ymin, zmin, xmax, ymax, zmax]`, mm.
+fn occ_bbox(dir: &std::path::Path, file: &str) -> Option<Vec<f64>> {
+    let text = std::fs::read_to_string(dir.join("occ_details.json")).ok()?;
+    let v: Value = serde_json::from_str(&text).ok()?;
+    let b: Vec<f64> = v[file]["bbox_mm"]
+        .as_array()?
+        .iter()
+        .filter_map(|x| x.as_f64())
+        .collect();
+    (b.len() == 6).then_some(b)
 }
 
 /// What is wrong with one file's reading, if anything.
@@ -69,9 +75,12 @@ fn check_file(dir: &std::path::Path, file: &str, r: &Value) -> Vec<String> {
         return failures;
     }
     let mut got = vec![];
+    let mut bbox = brep::math::Aabb::empty();
     for s in b.solid_ids() {
         match brep::solid::report_solid(b, s) {
             Ok(rep) => {
+                bbox.add(&rep.bbox.min);
+                bbox.add(&rep.bbox.max);
                 if !rep.closed || !rep.watertight {
                     failures.push(format!(
                         "{file}: solid #{} closed={} watertight={}",
@@ -98,6 +107,23 @@ fn check_file(dir: &std::path::Path, file: &str, r: &Value) -> Vec<String> {
                 got.push(rep.volume);
             }
             Err(e) => failures.push(format!("{file}: {e}")),
+        }
+    }
+    // Components stand where the assembly places them: OpenCASCADE's box holds ours (its box
+    // is widened by tolerances and, on B-spline faces, reaches to their control points).
+    if let Some(occ) = occ_bbox(dir, file) {
+        // (It is rounded to 1e-4 mm.)
+        let slack = 1e-4 + 1e-6 * bbox.diagonal();
+        for k in 0..3 {
+            if bbox.min[k] < occ[k] - slack || bbox.max[k] > occ[k + 3] + slack {
+                failures.push(format!(
+                    "{file}: solids span [{:.4}, {:.4}] on axis {k}, OpenCASCADE's [{}, {}]",
+                    bbox.min[k],
+                    bbox.max[k],
+                    occ[k],
+                    occ[k + 3]
+                ));
+            }
         }
     }
     got.sort_by(f64::total_cmp);

@@ -1,6 +1,7 @@
 //! Every fixture read back against the figures its generating kernel (OpenCASCADE, via
 //! CadQuery) wrote beside it: volume within 0.1 %, area within 0.5 %, faces by surface kind,
-//! closed shells, genus, and a watertight mesh at display and analysis tolerances.
+//! closed shells, genus, and a watertight mesh at display and analysis tolerances. The fixtures in
+//! `fixtures/reader/` (a helical thread of B-spline flanks) are read here only.
 
 use brep::mesh::MeshOptions;
 use brep::solid::{mesh_solid, report_solid};
@@ -11,14 +12,21 @@ fn fixtures_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
 }
 
+/// Every fixture, with those only the reader reads (`fixtures/reader/`, e.g. the helical
+/// thread) as `reader/NAME`.
 fn fixture_names() -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(fixtures_dir())
-        .expect("fixtures/ exists")
-        .filter_map(|e| e.ok())
-        .filter_map(|e| e.file_name().into_string().ok())
-        .filter(|n| n.ends_with(".step"))
-        .map(|n| n.trim_end_matches(".step").to_string())
-        .collect();
+    let mut names = vec![];
+    for sub in ["", "reader/"] {
+        let Ok(dir) = std::fs::read_dir(fixtures_dir().join(sub)) else {
+            continue;
+        };
+        names.extend(
+            dir.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().into_string().ok())
+                .filter(|n| n.ends_with(".step"))
+                .map(|n| format!("{sub}{}", n.trim_end_matches(".step"))),
+        );
+    }
     names.sort();
     names
 }

@@ -1,4 +1,5 @@
-//! `brep::write`: every fixture and corpus file read, written back with `write_step`, and read
+//! `brep::write`: every fixture and corpus file (both shared sets) read, written back with
+//! `write_step`, and read
 //! again must give the same B-rep: same solids, shells, faces, loops, coedges, edges and vertices
 //! in the same order, the same surface and curve parametrisations, the same volume and area to
 //! 1e-6 relative, closed and watertight. Subsets written with `write_step_shells` hold only what
@@ -15,9 +16,17 @@ fn fixtures_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures")
 }
 
-fn corpus_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus");
-    d.is_dir().then_some(d)
+/// The shared corpora found beside the repository (`corpus`, `corpus-more`).
+fn corpus_dirs() -> Vec<PathBuf> {
+    ["corpus", "corpus-more"]
+        .iter()
+        .map(|d| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../../shared")
+                .join(d)
+        })
+        .filter(|d| d.is_dir())
+        .collect()
 }
 
 fn step_files(dir: &Path) -> Vec<PathBuf> {
@@ -371,13 +380,16 @@ fn fixture_round_trip_is_closed_and_watertight() {
 
 #[test]
 fn every_corpus_file_round_trips() {
-    let Some(dir) = corpus_dir() else {
+    let dirs = corpus_dirs();
+    if dirs.is_empty() {
         eprintln!("../shared/corpus not found beside the repository; corpus round trip skipped");
         return;
-    };
+    }
     let mut failures = vec![];
-    for f in step_files(&dir) {
-        failures.extend(round_trip(&f).0);
+    for dir in dirs {
+        for f in step_files(&dir) {
+            failures.extend(round_trip(&f).0);
+        }
     }
     assert!(
         failures.is_empty(),

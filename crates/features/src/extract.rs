@@ -157,6 +157,44 @@ struct Draft {
     heal: Vec<FaceId>,
 }
 
+/// For each void shell, the draft whose faces enclose it (winding number of the draft's mesh
+/// about one of the void's vertices); the base (0) where none does or a draft does not mesh.
+fn void_owners(
+    b: &Brep,
+    drafts: &[Draft],
+    voids: &[Vec<FaceId>],
+    opts: &brep::mesh::MeshOptions,
+) -> Vec<usize> {
+    if voids.is_empty() || drafts.len() < 2 {
+        return vec![0; voids.len()];
+    }
+    let meshes: Vec<Option<brep::mesh::Mesh>> = drafts
+        .iter()
+        .map(|d| mesh_faces(b, &d.faces, opts).ok())
+        .collect();
+    voids
+        .iter()
+        .map(|v| {
+            let vertex = v.iter().find_map(|f| {
+                b.faces[f.idx()].loops.iter().find_map(|l| {
+                    let lp = &b.loops[l.idx()];
+                    lp.coedges
+                        .first()
+                        .map(|c| b.edges[b.coedges[c.idx()].edge.idx()].start)
+                        .or(lp.vertex)
+                })
+            });
+            let Some(p) = vertex.map(|v| b.vertices[v.idx()].point) else {
+                return 0;
+            };
+            meshes
+                .iter()
+                .position(|m| m.as_ref().is_some_and(|m| m.winding_number(&p) > 0.5))
+                .unwrap_or(0)
+        })
+        .collect()
+}
+
 /// Extracts the AM features of one solid.
 pub fn extract(
     part: &Brep,
@@ -173,12 +211,6 @@ pub fn extract(
         .iter()
         .map(|s| b.shells[s.idx()].faces.clone())
         .collect();
-    if !voids.is_empty() {
-        warnings.push(format!(
-            "{} void shell(s) kept with the base feature",
-            voids.len()
-        ));
-    }
 
     // The part as read, meshed once: figures, per-face shares of the volume, adjacency and
     // convexity.
@@ -370,6 +402,22 @@ pub fn extract(
     // The solid check meshes each feature again: coarser than the analysis mesh, since it asks
     // only whether every face meshes, the mesh closes and the volume is positive.
     let check_opts = analysis_options(diag * 4.0);
+    // Each void shell goes with the feature whose shell holds it (the base where none does).
+    let void_owner = void_owners(&b, &drafts, &voids, &check_opts);
+    if !voids.is_empty() {
+        let elsewhere = void_owner.iter().filter(|&&k| k != 0).count();
+        warnings.insert(
+            0,
+            if elsewhere == 0 {
+                format!("{} void shell(s) kept with the base feature", voids.len())
+            } else {
+                format!(
+                    "{} void shell(s) kept with the features holding them ({elsewhere} not in the base)",
+                    voids.len()
+                )
+            },
+        );
+    }
     let mut features = vec![];
     for (k, d) in drafts.iter().enumerate() {
         let shell = ShellId(b.shells.len() as u32);
@@ -381,7 +429,12 @@ pub fn extract(
         for f in &d.faces {
             b.faces[f.idx()].shell = shell;
         }
-        let fvoids = if k == 0 { voids.clone() } else { vec![] };
+        let fvoids: Vec<Vec<FaceId>> = voids
+            .iter()
+            .zip(&void_owner)
+            .filter(|(_, &o)| o == k)
+            .map(|(v, _)| v.clone())
+            .collect();
         let volume = vol_of(&shares, &d.faces).abs()
             - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
         let problems = crate::check::check_solid(&b, &d.faces, &fvoids, &check_opts).problems;

@@ -1,4 +1,5 @@
-//! Properties every extraction must have, on every fixture and every corpus file: the features'
+//! Properties every extraction must have, on every fixture and every file of both shared corpora
+//! (the second set's files that still fail are listed with why): the features'
 //! volumes add up to the part's (measured independently), each feature is a closed, non-empty
 //! solid that re-reads from its exported STEP as the same closed solid, and the dependency order
 //! puts parents first.
@@ -27,9 +28,13 @@ fn check_file(path: &Path, failures: &mut Vec<String>) {
         .unwrap_or_default();
     let part = brep::read_step(path).expect("readable");
     for s in part.brep.solid_ids() {
-        let part_volume = brep::solid::report_solid(&part.brep, s)
-            .expect("report")
-            .volume;
+        let part_volume = match brep::solid::report_solid(&part.brep, s) {
+            Ok(r) => r.volume,
+            Err(e) => {
+                failures.push(format!("{name} solid {}: {e}", s.0));
+                continue;
+            }
+        };
         let tree = match extract(&part.brep, s, &ExtractOptions::default()) {
             Ok(t) => t,
             Err(e) => {
@@ -115,10 +120,19 @@ fn check_file(path: &Path, failures: &mut Vec<String>) {
             );
             match brep::read_step_bytes(text.as_bytes()) {
                 Ok(back) if back.brep.solids.len() == 1 => {
-                    let r = brep::solid::report_solid(&back.brep, SolidId(0)).expect("report");
+                    let r = match brep::solid::report_solid(&back.brep, SolidId(0)) {
+                        Ok(r) => r,
+                        Err(e) => {
+                            failures.push(format!(
+                                "{name}: exported feature {} does not mesh: {e}",
+                                f.id
+                            ));
+                            continue;
+                        }
+                    };
                     if !r.closed || !r.watertight || (r.volume - f.volume).abs() > 5e-3 * f.volume {
                         failures.push(format!(
-                            "{name}: exported feature {} closed={} watertight={} volume {:.3} vs {:.3}",
+                            "{name}: exported feature {} closed={} watertight={} volume {:.6} vs {:.6}",
                             f.id, r.closed, r.watertight, r.volume, f.volume
                         ));
                     }
@@ -147,18 +161,60 @@ fn every_fixture_extracts_into_closed_features_that_add_up() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-#[test]
-fn every_corpus_file_extracts_into_closed_features_that_add_up() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus");
+/// Files of `../shared/corpus-more` whose extraction still fails a property, with what fails
+/// (measured 2026-11-25). A listed file that comes right fails the test until it is taken off.
+const KNOWN_FAILING: [(&str, &str); 3] = [
+    (
+        "onshape_abc_0_13.step",
+        "the part's mesh is not watertight (18 open edges where B-spline trims cross in (u, v); brep tests/corpus.rs)",
+    ),
+    (
+        "psstep13_inductor.step",
+        "exported feature 1's face #63 does not mesh (a loop wraps round its surface, nothing closes it); feature 2 (0.001064 mm^3) re-reads as 0.000737",
+    ),
+    (
+        "solidedge_push_switch.step",
+        "feature 2, a sliver of 0.000089 mm^3, re-reads as 0.000196 mm^3",
+    ),
+];
+
+/// Every file of one shared corpus (`corpus`, `corpus-more`), skipped when it is not beside the
+/// repository; files in `known` are reported, not failed, while they fail.
+fn check_corpus(set: &str, known: &[(&str, &str)]) {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared")
+        .join(set);
     if !dir.exists() {
-        eprintln!("../shared/corpus not found beside the repository; skipped");
+        eprintln!("../shared/{set} not found beside the repository; skipped");
         return;
     }
     let mut failures = vec![];
     for p in steps_in(&dir) {
-        check_file(&p, &mut failures);
+        let mut here = vec![];
+        check_file(&p, &mut here);
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        match known.iter().find(|(f, _)| *f == name) {
+            Some((_, why)) if here.is_empty() => failures.push(format!(
+                "{name} now passes: take it off the known failures ({why})"
+            )),
+            Some((_, why)) => eprintln!("{name}: known failure: {why}: {here:?}"),
+            None => failures.extend(here),
+        }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_corpus_file_extracts_into_closed_features_that_add_up() {
+    check_corpus("corpus", &[]);
+}
+
+#[test]
+fn every_second_corpus_file_extracts_into_closed_features_that_add_up() {
+    check_corpus("corpus-more", &KNOWN_FAILING);
 }
 
 #[test]

@@ -119,6 +119,7 @@ pub(super) fn face_polygons(
             wrapping.push((pts, w));
         }
     }
+    let had_wrapping = !wrapping.is_empty();
     let (sing_v, sing_u) = s.singular_lines();
     while let Some((a, wa)) = wrapping.pop() {
         let axis = if wa[0] != 0 { 0 } else { 1 };
@@ -203,6 +204,20 @@ pub(super) fn face_polygons(
             polys.push(poly);
         }
     }
+    // Poles (vertex loops) and only holes (no loop wraps, none closes through a pole): the face
+    // is the whole closed surface less the holes (Onshape writes a sphere of revolution with
+    // three holes so). Its seam is put where no hole reaches.
+    let holes_only = !had_wrapping
+        && !pole_vertices.is_empty()
+        && !polys.is_empty()
+        && polys.iter().all(|p| !has_bridge(p));
+    if holes_only {
+        if let Some(u0) = periods[0].and_then(|per| free_u(&polys, per)) {
+            if let Some(poly) = full_domain(s, u0, &pole_vertices, positions, opts) {
+                polys.insert(0, poly);
+            }
+        }
+    }
     // Inner loops were unwrapped near their own first point: shift each by whole periods into
     // the outer loop (the one enclosing the largest area).
     if polys.len() > 1 && (periods[0].is_some() || periods[1].is_some()) {
@@ -216,7 +231,7 @@ pub(super) fn face_polygons(
     if polys.is_empty() {
         // No edge loop at all (a whole sphere or torus bounded by a vertex loop, or nothing):
         // the face is the surface's whole closed domain.
-        match full_domain(s, &pole_vertices, positions, opts) {
+        match full_domain(s, 0.0, &pole_vertices, positions, opts) {
             Some(poly) => polys.push(poly),
             None => {
                 return Err(face_err(
@@ -229,6 +244,43 @@ pub(super) fn face_polygons(
     }
 
     Ok((polys, edge_of))
+}
+
+/// Whether a boundary polygon closes through a pole (two consecutive points on one singular
+/// line).
+fn has_bridge(poly: &[Pt]) -> bool {
+    let n = poly.len();
+    (0..n).any(|k| poly[k].sing != 0 && poly[k].sing == poly[(k + 1) % n].sing)
+}
+
+/// A `u` (period `per`) that no polygon reaches: the middle of the widest gap between their `u`
+/// extents taken modulo the period; `None` when they cover every `u`.
+fn free_u(polys: &[Vec<Pt>], per: f64) -> Option<f64> {
+    let mut spans: Vec<(f64, f64)> = vec![];
+    for p in polys {
+        let lo = p.iter().map(|q| q.uv[0]).fold(f64::INFINITY, f64::min);
+        let hi = p.iter().map(|q| q.uv[0]).fold(f64::NEG_INFINITY, f64::max);
+        if !(lo.is_finite() && hi.is_finite()) || hi - lo >= per {
+            return None;
+        }
+        let a = lo.rem_euclid(per);
+        spans.push((a, a + (hi - lo)));
+    }
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+    // Sweep once round the circle from the first span's start.
+    let start = spans.first()?.0;
+    let mut reach = start;
+    let mut best: Option<(f64, f64)> = None;
+    for &(a, b) in spans
+        .iter()
+        .chain(std::iter::once(&(start + per, start + per)))
+    {
+        if a > reach && best.is_none_or(|(w, _)| a - reach > w) {
+            best = Some((a - reach, 0.5 * (a + reach)));
+        }
+        reach = reach.max(b);
+    }
+    best.map(|(_, u)| u.rem_euclid(per))
 }
 
 fn fix_bridge_orientation(poly: &mut [Pt], periods: [Option<f64>; 2], sense: f64) {
@@ -265,16 +317,17 @@ fn fix_bridge_orientation(poly: &mut [Pt], periods: [Option<f64>; 2], sense: f64
 /// The boundary of a surface's whole parameter domain, for faces without edge loops: a closed
 /// surface (both directions periodic, or periodic one way and collapsing to poles the other).
 /// Seam sides share their vertices with the opposite side and pole sides collapse to one
-/// vertex, so the result is watertight.
+/// vertex, so the result is watertight. A periodic `u` runs from `u0` round one period.
 fn full_domain(
     s: &Surface,
+    u0: f64,
     pole_vertices: &[u32],
     positions: &mut Vec<P3>,
     opts: &MeshOptions,
 ) -> Option<Vec<Pt>> {
     let (bu, bv) = s.bounds();
     let (pu, pv) = (s.u_period(), s.v_period());
-    let ur = pu.map(|p| (0.0, p)).or(bu)?;
+    let ur = pu.map(|p| (u0, u0 + p)).or(bu)?;
     let vr = pv.map(|p| (0.0, p)).or(bv)?;
     let (du, dv) = grid_steps(s, ur, vr, opts);
     let (nu, nv) = (step_count(ur, du, 4), step_count(vr, dv, 4));

@@ -16,7 +16,8 @@ impl<'a> Translator<'a> {
             return Err(self.bad(id, "coordinates are not 2 or 3 finite numbers"));
         }
         let z = c.get(2).copied().unwrap_or(0.0);
-        Ok(P3::new(c[0], c[1], z) * self.mm)
+        let p = P3::new(c[0], c[1], z) * self.mm;
+        Ok(self.place.map_or(p, |pl| pl.point(p)))
     }
 
     pub(super) fn direction(&self, id: u64, from: u64) -> R<V3> {
@@ -27,8 +28,10 @@ impl<'a> Translator<'a> {
             return Err(self.bad(id, "direction ratios are not 2 or 3 finite numbers"));
         }
         let v = V3::new(c[0], c[1], c.get(2).copied().unwrap_or(0.0));
-        v.try_normalize(NONZERO)
-            .ok_or_else(|| self.bad(id, "zero-length direction"))
+        let v = v
+            .try_normalize(NONZERO)
+            .ok_or_else(|| self.bad(id, "zero-length direction"))?;
+        Ok(self.place.map_or(v, |pl| pl.dir(v)))
     }
 
     pub(super) fn vector(&self, id: u64, from: u64) -> R<(V3, f64)> {

@@ -4,10 +4,13 @@
 //! Handles, beyond what truck-stepio 0.3 does: the file's length and plane-angle units, closed
 //! edges and seam edges (any edge shape goes into our arena unchanged), `BREP_WITH_VOIDS`,
 //! `OFFSET_SURFACE`, `RECTANGULAR_TRIMMED_SURFACE`, `TRIMMED_CURVE`, and `SURFACE_CURVE`s taken by
-//! their 3-D curve (so a seam that ends at a sphere's pole reads like any other edge).
+//! their 3-D curve (so a seam that ends at a sphere's pole reads like any other edge). Each solid
+//! stands where its assembly places it (`assembly`): a component placed twice is two solids.
 
+mod assembly;
 mod curves;
 mod geometry;
+mod placement;
 mod schema_names;
 mod surfaces;
 mod topology;
@@ -36,7 +39,7 @@ pub fn translate(file: &P21File) -> R<Brep> {
     }
     let default_units = t.default_units();
     let mut unit_names: Vec<LengthUnit> = vec![];
-    for (id, kind) in bodies {
+    for (id, kind, place) in t.placed_bodies(&bodies)? {
         let units = contexts
             .get(&id)
             .and_then(|c| t.context_units(*c).ok())
@@ -46,7 +49,29 @@ pub fn translate(file: &P21File) -> R<Brep> {
         if !unit_names.contains(&units.0) {
             unit_names.push(units.0.clone());
         }
+        t.place = place;
+        t.forget_read();
         t.read_body(id, kind)?;
+    }
+    // Faces whose normal runs against their neighbours' are turned round, as OpenCASCADE heals
+    // them on reading.
+    for k in 0..t.brep.shells.len() {
+        let sh = crate::topology::ShellId(k as u32);
+        if !t.shell_is_closed(sh) {
+            continue;
+        }
+        let turned = crate::orient::orient_shell(&mut t.brep, sh);
+        if !turned.is_empty() {
+            let ids: Vec<String> = turned
+                .iter()
+                .map(|f| format!("#{}", t.brep.faces[f.idx()].step_id))
+                .collect();
+            let sid = t.brep.shells[k].step_id;
+            t.brep.warnings.push(format!(
+                "shell #{sid}: face(s) {} faced against the rest of the shell; turned round",
+                ids.join(", ")
+            ));
+        }
     }
     if t.off_curve.0 > 0 {
         t.brep.warnings.push(format!(

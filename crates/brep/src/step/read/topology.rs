@@ -246,11 +246,15 @@ impl<'a> Translator<'a> {
             loops: vec![],
             shell,
         });
+        // Outer bounds first, each kind in file order (a band may have two outer bounds: read
+        // back from our own writing, their order must not swap).
         let mut loops = vec![];
+        let mut outers = 0;
         for b in bounds {
             let lp = self.read_bound(b, id, face)?;
             if self.brep.loops[lp.idx()].outer {
-                loops.insert(0, lp);
+                loops.insert(outers, lp);
+                outers += 1;
             } else {
                 loops.push(lp);
             }

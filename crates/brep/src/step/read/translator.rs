@@ -22,6 +22,8 @@ pub(super) struct Translator<'a> {
     pub(super) depth: u32,
     /// (count, worst distance, worst edge id) of edge ends off their curve.
     pub(super) off_curve: (usize, f64, u64),
+    /// Where the body being read is placed (an assembly's component), if anywhere.
+    pub(super) place: Option<super::placement::Placement>,
 }
 
 pub(super) fn names_of(e: &Entity) -> String {
@@ -41,6 +43,7 @@ impl<'a> Translator<'a> {
             surfaces: HashMap::new(),
             depth: 0,
             off_curve: (0, 0.0, 0),
+            place: None,
         }
     }
 
@@ -179,6 +182,15 @@ impl<'a> Translator<'a> {
             Some(Param::Str(s)) => s.clone(),
             _ => String::new(),
         }
+    }
+
+    /// Forgets the entities read so far, so that a body read again (placed elsewhere) gets
+    /// geometry of its own.
+    pub(super) fn forget_read(&mut self) {
+        self.vertices.clear();
+        self.edges.clear();
+        self.curves.clear();
+        self.surfaces.clear();
     }
 
     pub(super) fn enter(&mut self, id: u64) -> R<()> {
