@@ -537,3 +537,111 @@ fn set_overrides_any_setting_and_the_settings_used_are_recorded() {
         assert_refused(&o, &words);
     }
 }
+
+/// A real part modelled on its side (SolidWorks 2017, `../shared/corpus`).
+fn leg_fork() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/sw2017_leg_fork.step")
+}
+
+fn plan_file(part: &Path, args: &[&str]) -> Output {
+    Command::new(BIN)
+        .arg("plan")
+        .arg(part)
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+#[test]
+fn a_part_modelled_on_its_side_stands_on_the_face_chosen_or_picked() {
+    let part = leg_fork();
+    let s = Scratch::new("orient");
+    // As modelled, it reaches below the build plate and half of it is not printed: the
+    // self-check refuses the plan (--keep-going writes it, with the warning).
+    let o = plan_file(&part, &["-o", s.path("as").to_str().unwrap()]);
+    assert_refused(&o, &["self-check"]);
+    let o = plan_file(
+        &part,
+        &["--keep-going", "-o", s.path("as").to_str().unwrap()],
+    );
+    assert!(
+        stderr(&o).contains("below the build plate"),
+        "{}",
+        stderr(&o)
+    );
+    // --orient auto stands it on a planar face: nothing below the plate.
+    let auto = s.path("auto");
+    let o = plan_file(&part, &["--orient", "auto", "-o", auto.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        !stderr(&o).contains("below the build plate"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("standing on face #"));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(auto.join("plan.json")).unwrap()).unwrap();
+    let p = &report["placement"];
+    let id = p["base_face"].as_u64().expect("base face");
+    let down: Vec<f64> = p["down"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let m: Vec<Vec<f64>> = p["rotation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            r.as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect()
+        })
+        .collect();
+    // The rotation takes the face's outward normal down.
+    let turned: Vec<f64> = (0..3)
+        .map(|r| (0..3).map(|c| m[r][c] * down[c]).sum())
+        .collect();
+    assert!(turned[0].abs() < 1e-6 && turned[1].abs() < 1e-6 && (turned[2] + 1.0).abs() < 1e-6);
+    assert!(p["rule"].as_str().unwrap().starts_with("auto"));
+    // Every print point stands on or above the plate: the lowest is one layer's top above it.
+    let csv = std::fs::read_to_string(auto.join("toolpath.csv")).unwrap();
+    let zs: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.contains(",print,"))
+        .map(|l| l.split(',').nth(5).unwrap().parse().unwrap())
+        .collect();
+    let lo = zs.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(lo > 0.0 && lo <= 0.2 + 1e-6, "lowest print point {lo}");
+    // The same face given by --base-face: the same plan.
+    let chosen = s.path("chosen");
+    let o = plan_file(
+        &part,
+        &[
+            "--base-face",
+            &id.to_string(),
+            "-o",
+            chosen.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(chosen.join("toolpath.csv")).unwrap(),
+        csv
+    );
+    // A face that is not planar, or not there, is refused.
+    let o = plan_file(
+        &part,
+        &["--base-face", "50", "-o", s.path("x").to_str().unwrap()],
+    );
+    assert_refused(&o, &["face #50 is not planar"]);
+    let o = plan_file(
+        &part,
+        &["--base-face", "1", "-o", s.path("x").to_str().unwrap()],
+    );
+    assert_refused(&o, &["no face #1"]);
+}

@@ -7,6 +7,7 @@ mod extract;
 mod inspect;
 mod mesh;
 mod outputs;
+mod placement;
 mod plan;
 mod profiles;
 mod settings;
@@ -129,6 +130,14 @@ pub struct PlanArgs {
     /// key after `machine.` (`machine.nozzle_temperature=215`)
     #[arg(long, value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Stand the part on the planar face with STEP #id ID: the part is turned so that face's
+    /// outward normal points down [default: as modelled, -Z down]
+    #[arg(long, value_name = "ID", conflicts_with = "orient")]
+    pub base_face: Option<u64>,
+    /// `auto`: stand the part on the planar face that leaves the fewest features growing below
+    /// the horizon (ties: the most planar area down); `modelled`: as the file has it
+    #[arg(long, value_name = "auto|modelled", value_parser = ["auto", "modelled"])]
+    pub orient: Option<String>,
     /// Write the plan even when its self-check fails (a feature with no layer, or extruded
     /// volume more than 3 % from volume x fill): the failures become warnings and plan.json
     /// says `"complete": false`

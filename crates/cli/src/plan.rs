@@ -27,7 +27,20 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     }
     // A feature's bad parameters are reported against the process file (or the part without one).
     let process_file = args.process.as_deref().unwrap_or(path);
-    let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    let auto = args.orient.as_deref() == Some("auto");
+    let (part, placement) = crate::placement::read_placed(path, args.base_face, auto)?;
+    if let Some(p) = &placement {
+        let d = p.down;
+        eprintln!(
+            "features: {}: standing on face #{} (outward normal {:.4} {:.4} {:.4} turned down; {})",
+            path.display(),
+            p.base_face,
+            d[0],
+            d[1],
+            d[2],
+            p.rule
+        );
+    }
     let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg} [{elapsed}]");
     let progress = |p: Progress| match p {
         Progress::Start { features } => bar.set_length(features),
@@ -86,6 +99,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     if args.force {
         outputs.clear_earlier()?;
     }
+    plan.report.placement = placement;
     let csv = outputs.name("toolpath.csv");
     let program: Vec<(String, &[u8])> = plan
         .program

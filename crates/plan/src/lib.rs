@@ -294,6 +294,7 @@ pub fn plan(
         features: reports,
         warnings,
         settings,
+        placement: None,
         outputs: vec![],
     };
     Ok(Plan {

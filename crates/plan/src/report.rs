@@ -199,6 +199,19 @@ impl SettingsEntry {
     }
 }
 
+/// How the part was turned to stand on the build plate (`--base-face`, `--orient auto`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlacementEntry {
+    /// STEP `#id` of the planar face put on the plate.
+    pub base_face: u64,
+    /// Its outward normal in the file's frame: the direction turned to −Z.
+    pub down: [f64; 3],
+    /// The rotation applied about the file's origin (rows first): plate = rotation × file.
+    pub rotation: [[f64; 3]; 3],
+    /// Why this face: `base-face` (chosen), or the `auto` rule and its figures.
+    pub rule: String,
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -216,6 +229,9 @@ pub struct PlanReport {
     pub warnings: Vec<String>,
     /// The settings the plan was made with.
     pub settings: SettingsEntry,
+    /// How the part was turned onto the plate, when it was (set by the caller that turned it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub placement: Option<PlacementEntry>,
     /// The files the plan was written to, beside `plan.json` (set by whoever writes them; the
     /// command line lists them so that `--force` can clear them before the next plan).
     #[serde(skip_serializing_if = "Vec::is_empty")]

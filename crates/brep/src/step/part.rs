@@ -28,3 +28,87 @@ pub fn read_step_bytes(bytes: &[u8]) -> Result<StepPart, ReadError> {
         schemas: file.schemas(),
     })
 }
+
+/// Reads a STEP file from disk with every solid turned so that the unit direction `down` (in
+/// the file's frame) points down, −Z: a part modelled on its side is read standing on the face
+/// whose outward normal is `down`. The turn is the least rotation doing so (about
+/// `down` × −Z; half a turn about X when `down` is +Z), about the file's origin.
+pub fn read_step_turned(path: impl AsRef<Path>, down: [f64; 3]) -> Result<StepPart, ReadError> {
+    let bytes = std::fs::read(path.as_ref())?;
+    let file = super::p21::parse(&bytes)?;
+    let brep = super::read::translate_turned(&file, Some(turn_down(down)))?;
+    Ok(StepPart {
+        brep,
+        schemas: file.schemas(),
+    })
+}
+
+/// The least rotation (a matrix, rows first) taking the unit vector `n` onto −Z (Rodrigues).
+pub fn turn_down(n: [f64; 3]) -> [[f64; 3]; 3] {
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let n = if len > 0.0 {
+        [n[0] / len, n[1] / len, n[2] / len]
+    } else {
+        [0.0, 0.0, -1.0]
+    };
+    // axis = n × (−Z) = (−n_y, n_x, 0); cos = −n_z.
+    let (kx, ky) = (-n[1], n[0]);
+    let s = (kx * kx + ky * ky).sqrt();
+    let c = -n[2];
+    if s < 1e-12 {
+        return if c > 0.0 {
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        } else {
+            [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]
+        };
+    }
+    let (x, y) = (kx / s, ky / s);
+    let t = 1.0 - c;
+    [
+        [c + x * x * t, x * y * t, y * s],
+        [x * y * t, c + y * y * t, -x * s],
+        [-y * s, x * s, c],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::turn_down;
+
+    fn apply(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
+    }
+
+    #[test]
+    fn the_turn_takes_the_direction_down_and_is_a_rotation() {
+        let s = 0.5f64.sqrt();
+        for n in [
+            [1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [s, 0.0, s],
+            [0.3, -0.4, 0.866],
+            [-0.6, 0.0, -0.8],
+        ] {
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let m = turn_down(n);
+            let d = apply(m, [n[0] / l, n[1] / l, n[2] / l]);
+            assert!(
+                (d[0]).abs() < 1e-12 && d[1].abs() < 1e-12 && (d[2] + 1.0).abs() < 1e-12,
+                "{n:?} -> {d:?}"
+            );
+            // Orthonormal with determinant +1.
+            for a in 0..3 {
+                for b in 0..3 {
+                    let dot: f64 = (0..3).map(|k| m[k][a] * m[k][b]).sum();
+                    assert!((dot - if a == b { 1.0 } else { 0.0 }).abs() < 1e-12);
+                }
+            }
+            let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+            assert!((det - 1.0).abs() < 1e-12);
+        }
+    }
+}

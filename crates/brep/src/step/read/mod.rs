@@ -28,6 +28,13 @@ use translator::{Translator, R};
 
 /// Reads a parsed file into a B-rep of every solid it holds.
 pub fn translate(file: &P21File) -> R<Brep> {
+    translate_turned(file, None)
+}
+
+/// [`translate`], every solid turned by the rotation `turn` (a proper rotation matrix, rows
+/// first) about the file's origin, as if the file placed it so.
+pub fn translate_turned(file: &P21File, turn: Option<[[f64; 3]; 3]>) -> R<Brep> {
+    let global = turn.map(placement::Placement::rotation);
     if let Some((from, missing)) = file.first_dangling_ref() {
         return Err(ReadError::Dangling { from, missing });
     }
@@ -49,7 +56,11 @@ pub fn translate(file: &P21File) -> R<Brep> {
         if !unit_names.contains(&units.0) {
             unit_names.push(units.0.clone());
         }
-        t.place = place;
+        t.place = match (&global, place) {
+            (Some(g), Some(p)) => Some(g.then(&p)),
+            (Some(g), None) => Some(*g),
+            (None, p) => p,
+        };
         t.forget_read();
         t.read_body(id, kind)?;
     }

@@ -19,6 +19,14 @@ impl Placement {
         }
     }
 
+    /// The rotation of matrix `m` (rows first) about the origin.
+    pub(super) fn rotation(m: [[f64; 3]; 3]) -> Self {
+        Placement {
+            rot: Matrix3::from_fn(|r, c| m[r][c]),
+            shift: V3::zeros(),
+        }
+    }
+
     /// The placement taking `from`'s frame onto `to`'s.
     pub(super) fn between(from: &Frame, to: &Frame) -> Self {
         let a = Matrix3::from_columns(&[from.x, from.y, from.z]);
