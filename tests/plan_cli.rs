@@ -645,3 +645,32 @@ fn a_part_modelled_on_its_side_stands_on_the_face_chosen_or_picked() {
     );
     assert_refused(&o, &["no face #1"]);
 }
+
+#[test]
+fn a_fixed_axis_against_a_feature_growing_downward_warns() {
+    // The capsule's cone boss grows sideways and down from the cone; its sphere boss grows up.
+    let s = Scratch::new("fixed");
+    let p = s.write("p.toml", "[defaults]\nfixed_tool_axis = [0.0, 0.0, 1.0]\n");
+    let out = s.path("o");
+    let o = plan(
+        "capsule.step",
+        &["--process", &p, "-o", out.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let against: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("fixed_tool_axis points against"))
+        .collect();
+    assert_eq!(against.len(), 1, "{err}");
+    assert!(against[0].contains("warning: feature 1:"), "{err}");
+    // Counted again from toolpath.csv is not possible (the axis is the fixed one), so the
+    // geometry says it: the cone boss's layers face away from +Z, the sphere boss's do not.
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(report["features"][1]["reference"]["surface"], "cone");
+    assert_eq!(report["features"][2]["reference"]["surface"], "sphere");
+    // Without a fixed axis the layers' normals are the axes: no such warning.
+    let o = plan("capsule.step", &["-o", s.path("n").to_str().unwrap()]);
+    assert!(!stderr(&o).contains("fixed_tool_axis"), "{}", stderr(&o));
+}

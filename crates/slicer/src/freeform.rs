@@ -255,6 +255,8 @@ impl FreeformFill<'_> {
         let mut prev_regions: Vec<Region> = vec![];
         let mut layers = vec![];
         let mut points: Vec<PathPoint> = vec![];
+        // Print points whose fixed axis points against the layer normal, and the worst angle.
+        let mut against = (0usize, 0.0f64);
         for (layer, ((&dl, &(_, z)), (regions, paths))) in
             heights.iter().zip(&tops).zip(filled).enumerate()
         {
@@ -290,6 +292,16 @@ impl FreeformFill<'_> {
             for (pts, unheld) in lifted {
                 if pts.len() < 2 {
                     continue;
+                }
+                // A fixed axis pointing against the layer's growth lays beads from below.
+                if let Some(a) = fixed {
+                    for x in &pts[1..] {
+                        let c = a.dot(&x.n).clamp(-1.0, 1.0);
+                        if c < 0.0 {
+                            against.0 += 1;
+                            against.1 = against.1.max(c.acos().to_degrees());
+                        }
+                    }
                 }
                 if unheld > 0 {
                     ff.overhang_points += unheld;
@@ -378,6 +390,12 @@ impl FreeformFill<'_> {
         }
         let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
         fig.finish(id, points.len(), &printed);
+        if against.0 > 0 {
+            fig.warnings.push(format!(
+                "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",
+                against.1, against.0
+            ));
+        }
         if let Some((a, b)) = ff.overhang_layers {
             fig.warnings.push(format!(
                 "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
