@@ -291,7 +291,12 @@ fn a_program_file_as_output_gets_its_outputs_beside_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         s.names(""),
-        ["box.gcode", "box.plan.json", "box.toolpath.csv"],
+        [
+            "box.gcode",
+            "box.plan.json",
+            "box.preview.html",
+            "box.toolpath.csv"
+        ],
         "no folder named box.gcode"
     );
     let text = std::fs::read_to_string(&gcode).unwrap();
@@ -300,7 +305,7 @@ fn a_program_file_as_output_gets_its_outputs_beside_it() {
         serde_json::from_str(&std::fs::read_to_string(s.path("box.plan.json")).unwrap()).unwrap();
     assert_eq!(
         report["outputs"],
-        serde_json::json!(["box.toolpath.csv", "box.gcode"])
+        serde_json::json!(["box.toolpath.csv", "box.gcode", "box.preview.html"])
     );
     // The wrong program kind for the machine is refused.
     let o = plan(

@@ -9,6 +9,7 @@ mod mesh;
 mod outputs;
 mod placement;
 mod plan;
+mod preview;
 mod profiles;
 mod settings;
 
@@ -29,7 +30,8 @@ use std::process::ExitCode;
                   features extract part.step --json --export features/\n  \
                   features inspect part.step --json\n  \
                   features mesh part.step -o part.stl --tolerance 0.02\n  \
-                  features profiles show delta5 > my.toml\n\n\
+                  features profiles show delta5 > my.toml\n  \
+                  features preview part.step -o part.html\n\n\
                   Errors are one line on stderr, `features: <file>: <cause>`, exit code 2; \
                   warnings are lines `features: <file>: warning: ...`."
 )]
@@ -65,12 +67,26 @@ enum Command {
                             features plan part.step --process profiles/process.toml --strict -o out/ --force"
     )]
     Plan(PlanArgs),
+    /// Write a web page that shows the features a part is built from (WebGL, works offline).
+    #[command(after_help = "Examples:\n  features preview part.step -o part.html")]
+    Preview(PreviewArgs),
     /// List the built-in machine and process profiles, or print one as TOML to copy and edit.
     #[command(
         after_help = "Examples:\n  features profiles\n  features profiles show delta5 > my.toml\n  \
                             features plan part.step --machine-profile my.toml -o out/"
     )]
     Profiles(ProfilesArgs),
+}
+
+/// Arguments of `features preview`.
+#[derive(Debug, Args)]
+pub struct PreviewArgs {
+    /// STEP file to read.
+    #[arg(value_name = "PART.step")]
+    pub part: PathBuf,
+    /// The page to write, a self-contained .html file (no network: opens offline)
+    #[arg(short, long, value_name = "FILE.html")]
+    pub output: PathBuf,
 }
 
 /// Arguments of `features profiles`.
@@ -275,6 +291,7 @@ fn run(cmd: &Command) -> Result<(), Failure> {
         Command::Extract(a) => extract::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Profiles(a) => profiles::run(a),
+        Command::Preview(a) => preview::run(a),
     }
 }
 
@@ -296,6 +313,7 @@ fn main() -> ExitCode {
         Command::Extract(a) => a.part.display().to_string(),
         Command::Plan(a) => a.part.display().to_string(),
         Command::Profiles(_) => "profiles".to_string(),
+        Command::Preview(a) => a.part.display().to_string(),
     };
     // The panic is reported below, on one line; the default hook would add a second.
     panic::set_hook(Box::new(|_| {}));

@@ -106,8 +106,12 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         .iter()
         .map(|f| (outputs.name(&f.name), f.bytes.as_slice()))
         .collect();
+    // The preview: the features and the path, in one page that opens offline.
+    let preview_name = outputs.name("preview.html");
+    let page = crate::preview::plan_page(&plan, &path.display().to_string());
     plan.report.outputs = std::iter::once(csv.clone())
         .chain(program.iter().map(|(n, _)| n.clone()))
+        .chain(std::iter::once(preview_name.clone()))
         .collect();
     let json = plan.report.to_json().map_err(|e| Failure::new(path, e))?;
     let written = |name: &str, r: std::io::Result<()>| {
@@ -121,6 +125,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     for (name, bytes) in &program {
         written(name, write_atomic(&dir.join(name), |w| w.write_all(bytes)))?;
     }
+    written(
+        &preview_name,
+        write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),
+    )?;
     // The report last: a folder with plan.json holds a whole plan.
     let report = outputs.name("plan.json");
     written(

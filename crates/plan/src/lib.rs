@@ -91,6 +91,8 @@ pub struct Plan {
     pub toolpath: ToolPath,
     /// The machine program's files, in the order they are written.
     pub program: Vec<ProgramFile>,
+    /// The features the part was planned as (one tree per solid), for previews.
+    pub assembly: features::Assembly,
 }
 
 impl Plan {
@@ -301,6 +303,7 @@ pub fn plan(
         report,
         toolpath,
         program: program.files,
+        assembly,
     })
 }
 

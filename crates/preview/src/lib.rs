@@ -1,0 +1,238 @@
+//! preview: one self-contained HTML file (`preview.html`) that draws a part's features and its
+//! planned tool path with WebGL in any current browser, offline: the viewer's script, its
+//! styles and the data are all inline; the file names no other file and no address.
+//!
+//! - the features' meshes, translucent, one colour each, toggled one by one;
+//! - the tool path as lines, print and travel told apart (travel hidden at first), a range of
+//!   layers over the whole build order, coloured by feature, layer or local layer thickness;
+//! - tool axes as short ticks at a chosen density; orbit (drag), pan (shift-drag or right-drag)
+//!   and zoom (wheel); a legend and the plan's figures beside the view.
+//!
+//! What is drawn is decimated, never what is printed: at most [`MAX_DRAWN_POINTS`] path points
+//! (every k-th point of a long run, the ends of every path kept) and the meshes as the caller
+//! gives them (coarse).
+
+#![warn(missing_docs)]
+
+mod encode;
+
+use encode::{base64_f32, base64_u32};
+use std::fmt::Write as _;
+use toolpath::{MoveKind, ToolPath};
+
+/// Path points drawn at most; longer paths are thinned for the view only.
+pub const MAX_DRAWN_POINTS: usize = 400_000;
+
+/// The viewer (styles and script), inlined into every preview.
+const VIEWER_HTML: &str = include_str!("viewer.html");
+
+/// One feature's surface, triangulated for the view.
+#[derive(Debug, Clone, Default)]
+pub struct FeatureMesh {
+    /// The feature's file-wide id.
+    pub id: usize,
+    /// Its label in the legend (`two5d`, `freeform on cone face #54`, ...).
+    pub label: String,
+    /// Vertex positions, mm.
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles over `positions`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// What a preview shows.
+#[derive(Debug, Clone, Default)]
+pub struct Preview<'a> {
+    /// The title (the part's file).
+    pub title: String,
+    /// The features, in build order.
+    pub features: Vec<FeatureMesh>,
+    /// The planned path, if there is a plan.
+    pub path: Option<&'a ToolPath>,
+    /// Figures shown beside the view: (name, value) in order.
+    pub figures: Vec<(String, String)>,
+}
+
+/// The preview as one HTML document.
+pub fn html(p: &Preview) -> String {
+    let data = data_json(p);
+    let title = escape(&p.title);
+    VIEWER_HTML
+        .replace("__TITLE__", &title)
+        .replace("__DATA__", &data)
+}
+
+/// The points of `path` the view draws: every point where the feature, layer or move kind
+/// changes and the points on either side, and every k-th point of the runs between.
+fn drawn(path: &ToolPath) -> Vec<usize> {
+    let n = path.points.len();
+    let k = n.div_ceil(MAX_DRAWN_POINTS).max(1);
+    let same = |a: usize, b: usize| {
+        let (p, q) = (&path.points[a], &path.points[b]);
+        p.feature == q.feature && p.layer == q.layer && p.kind == q.kind
+    };
+    (0..n)
+        .filter(|&i| {
+            k == 1 || i % k == 0 || i == 0 || i + 1 == n || !same(i - 1, i) || !same(i, i + 1)
+        })
+        .collect()
+}
+
+/// The data the viewer reads: JSON with base64 arrays of little-endian f32 and u32.
+fn data_json(p: &Preview) -> String {
+    let mut meshes = vec![];
+    for f in &p.features {
+        let pos: Vec<f32> = f.positions.iter().flatten().copied().collect();
+        let tri: Vec<u32> = f.triangles.iter().flatten().copied().collect();
+        meshes.push(serde_json::json!({
+            "id": f.id,
+            "label": f.label,
+            "positions": base64_f32(&pos),
+            "triangles": base64_u32(&tri),
+        }));
+    }
+    let mut path = serde_json::Value::Null;
+    if let Some(tp) = p.path {
+        let keep = drawn(tp);
+        // A layer number over the whole build order: it counts up where the feature or its
+        // layer changes.
+        let mut count = 0u32;
+        let global: Vec<u32> = tp
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                if i > 0 {
+                    let a = &tp.points[i - 1];
+                    if a.feature != b.feature || a.layer != b.layer {
+                        count += 1;
+                    }
+                }
+                count
+            })
+            .collect();
+        let mut xyz = Vec::with_capacity(3 * keep.len());
+        let mut axis = Vec::with_capacity(3 * keep.len());
+        let mut thick = Vec::with_capacity(keep.len());
+        let mut info = Vec::with_capacity(3 * keep.len());
+        for &i in &keep {
+            let q = &tp.points[i];
+            xyz.extend(q.p.map(|x| x as f32));
+            axis.extend(q.axis.map(|x| x as f32));
+            thick.push(q.thickness as f32);
+            info.push(q.feature as u32);
+            info.push(global[i]);
+            info.push(u32::from(q.kind == MoveKind::Print));
+        }
+        path = serde_json::json!({
+            "points": keep.len(),
+            "planned_points": tp.points.len(),
+            "xyz": base64_f32(&xyz),
+            "axis": base64_f32(&axis),
+            "thickness": base64_f32(&thick),
+            "info": base64_u32(&info),
+            "layers": count + 1,
+        });
+    }
+    let figures: Vec<serde_json::Value> = p
+        .figures
+        .iter()
+        .map(|(k, v)| serde_json::json!([k, v]))
+        .collect();
+    let json = serde_json::json!({
+        "title": p.title,
+        "features": meshes,
+        "path": path,
+        "figures": figures,
+        "max_drawn_points": MAX_DRAWN_POINTS,
+    });
+    // Inside a <script> element: no `</` may close it early.
+    json.to_string().replace("</", "<\\/")
+}
+
+/// Text for HTML.
+fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
+            '"' => out.push_str("&quot;"),
+            c => {
+                let _ = write!(out, "{c}");
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use toolpath::PathPoint;
+
+    fn point(feature: usize, layer: usize, x: f64, kind: MoveKind) -> PathPoint {
+        PathPoint {
+            feature,
+            layer,
+            kind,
+            p: [x, 0.0, 0.2],
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.2,
+            width: 0.45,
+        }
+    }
+
+    #[test]
+    fn the_page_is_self_contained() {
+        let path = ToolPath {
+            points: vec![
+                point(0, 0, 0.0, MoveKind::Travel),
+                point(0, 0, 1.0, MoveKind::Print),
+            ],
+        };
+        let page = html(&Preview {
+            title: "a <part>.step".into(),
+            features: vec![FeatureMesh {
+                id: 0,
+                label: "two5d".into(),
+                positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                triangles: vec![[0, 1, 2]],
+            }],
+            path: Some(&path),
+            figures: vec![("features".into(), "1".into())],
+        });
+        assert!(page.starts_with("<!DOCTYPE html>"));
+        assert!(page.contains("a &lt;part&gt;.step"));
+        // Nothing fetched: no addresses, no protocol-relative references, no external files.
+        for bad in ["http:", "https:", "//", " src=", "<link"] {
+            assert!(!page.contains(bad), "the page holds `{bad}`");
+        }
+        assert!(!page.contains("__DATA__") && !page.contains("__TITLE__"));
+    }
+
+    #[test]
+    fn long_paths_are_thinned_for_the_view_keeping_every_change() {
+        let n = 3 * MAX_DRAWN_POINTS + 7;
+        let points = (0..n)
+            .map(|i| {
+                let kind = if i % 1000 == 0 {
+                    MoveKind::Travel
+                } else {
+                    MoveKind::Print
+                };
+                point(i / 500_000, (i / 10_000) % 50, i as f64, kind)
+            })
+            .collect();
+        let path = ToolPath { points };
+        let keep = drawn(&path);
+        assert!(keep.len() <= MAX_DRAWN_POINTS + 4 * (n / 1000 + 2) + 2 * (n / 10_000 + 2));
+        assert_eq!(keep.first(), Some(&0));
+        assert_eq!(keep.last(), Some(&(n - 1)));
+        // Every travel and the point before it are kept.
+        for i in (1000..n).step_by(1000) {
+            assert!(keep.binary_search(&i).is_ok() && keep.binary_search(&(i - 1)).is_ok());
+        }
+    }
+}
