@@ -679,3 +679,75 @@ fn a_fixed_axis_against_a_feature_growing_downward_warns() {
     let o = plan("capsule.step", &["-o", s.path("n").to_str().unwrap()]);
     assert!(!stderr(&o).contains("fixed_tool_axis"), "{}", stderr(&o));
 }
+
+#[test]
+fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
+    let s = Scratch::new("gcode");
+    let out = s.path("o");
+    let o = plan("plate_boss_boss.step", &["-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    // `;LAYER:` runs 0, 1, 2, ... over the whole build order: one per feature layer.
+    let global: Vec<usize> = program
+        .lines()
+        .filter_map(|l| l.strip_prefix(";LAYER:"))
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let layers: u64 = report["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["layers"].as_u64().unwrap())
+        .sum();
+    assert_eq!(global, (0..layers as usize).collect::<Vec<_>>());
+    assert_eq!(
+        program.matches(";LAYER_CHANGE\n;Z:").count(),
+        layers as usize
+    );
+    assert_eq!(program.matches(";HEIGHT:0.200\n").count(), layers as usize);
+    assert!(program.contains(";WIDTH:0.450\n"));
+    // The filament is the sum of the tool path's E; its mass by PLA's density.
+    let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
+    let e: f64 = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(9).unwrap().parse::<f64>().unwrap())
+        .sum();
+    let mm = report["filament_mm"].as_f64().unwrap();
+    assert!((mm - e).abs() < 0.01 + 1e-6 * e, "{mm} vs {e}");
+    let g = report["filament_g"].as_f64().unwrap();
+    let want = e * std::f64::consts::PI * 1.75f64.powi(2) / 4.0 * 1.24e-3;
+    assert!((g - want).abs() < 0.01, "{g} vs {want}");
+    // The time lies between the print moves at full speed and every move at the slowest.
+    let t = report["estimated_time_s"].as_f64().unwrap();
+    let print: f64 = report["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["print_length_mm"].as_f64().unwrap())
+        .sum();
+    let travel: f64 = report["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["travel_length_mm"].as_f64().unwrap())
+        .sum();
+    let m: toml::Table = robot_post_profile();
+    let v = |k: &str| m[k].as_float().unwrap();
+    let lo = print / v("print_speed");
+    let hi = print / v("first_layer_speed") + travel / v("travel_speed") + 1e4;
+    assert!(t > lo && t < hi, "{t} s not in ({lo}, {hi})");
+    assert!(program.contains("; estimated printing time (normal mode) = "));
+    assert!(program.contains(&format!("; filament used [mm] = {mm:.2}")));
+}
+
+/// The built-in Marlin profile's keys.
+fn robot_post_profile() -> toml::Table {
+    let o = Command::new(BIN)
+        .args(["profiles", "show", "marlin"])
+        .output()
+        .unwrap();
+    String::from_utf8_lossy(&o.stdout).parse().unwrap()
+}

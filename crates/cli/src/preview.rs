@@ -65,6 +65,18 @@ pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
             ("print length".into(), format!("{print:.1} mm")),
             ("travel length".into(), format!("{travel:.1} mm")),
             ("extruded volume".into(), format!("{volume:.1} mm³")),
+            (
+                "estimated time".into(),
+                plan::estimate::hms(plan.report.estimated_time_s),
+            ),
+            (
+                "filament".into(),
+                format!(
+                    "{:.2} m, {:.1} g",
+                    plan.report.filament_mm / 1000.0,
+                    plan.report.filament_g
+                ),
+            ),
             ("warnings".into(), plan.warnings().len().to_string()),
         ],
     })

@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod estimate;
 pub mod process;
 pub mod report;
 
@@ -266,7 +267,17 @@ pub fn plan(
         });
     }
     let settings = settings_entry(process, machine, &base);
-    let notes = settings.lines();
+    // The estimate first in the header, as slicers write it, then the settings.
+    let est = estimate::estimate(&toolpath, machine);
+    let mut notes = vec![
+        format!(
+            "estimated printing time (normal mode) = {}",
+            estimate::hms(est.time_s)
+        ),
+        format!("filament used [mm] = {:.2}", est.filament_mm),
+        format!("filament used [g] = {:.2}", est.filament_g),
+    ];
+    notes.extend(settings.lines());
     let job = Job {
         source: &options.source,
         stem: &options.stem,
@@ -295,6 +306,9 @@ pub fn plan(
         complete: problems.is_empty(),
         features: reports,
         warnings,
+        estimated_time_s: round(est.time_s, 1e1),
+        filament_mm: round(est.filament_mm, 1e2),
+        filament_g: round(est.filament_g, 1e2),
         settings,
         placement: None,
         outputs: vec![],

@@ -227,6 +227,12 @@ pub struct PlanReport {
     pub features: Vec<FeatureReport>,
     /// Things to know about the plan.
     pub warnings: Vec<String>,
+    /// Estimated printing time, s ([`crate::estimate`]: each move at its speed).
+    pub estimated_time_s: f64,
+    /// Filament fed, mm.
+    pub filament_mm: f64,
+    /// Its mass, g (`filament_density`, PLA's 1.24 g/cm³ by default).
+    pub filament_g: f64,
     /// The settings the plan was made with.
     pub settings: SettingsEntry,
     /// How the part was turned onto the plate, when it was (set by the caller that turned it).

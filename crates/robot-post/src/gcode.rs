@@ -1,7 +1,7 @@
 //! What the G-code posts (Marlin, delta5) share in writing their programs, and the comment
 //! text of every post (KUKA's KRL too).
 
-use toolpath::PathPoint;
+use toolpath::{push_fixed, MoveKind, PathPoint};
 
 /// `s` with line breaks and other control characters replaced by spaces, for comments (G-code
 /// and KRL alike: a comment never spills onto a new line).
@@ -17,24 +17,53 @@ pub(crate) fn push_line(out: &mut String, s: &str) {
     out.push('\n');
 }
 
-/// The `;LAYER:` and `;FEATURE:` comments of a G-code program: written where the point's
-/// layer or feature changes (shared by the Marlin and delta5 posts).
+/// The layer comments of a G-code program, as slicer viewers (PrusaSlicer's G-code viewer,
+/// Cura) read them, written where the point's feature or layer changes (shared by the Marlin
+/// and delta5 posts):
+///
+/// ```text
+/// ;LAYER_CHANGE
+/// ;Z:<machine Z of the layer's first point>
+/// ;HEIGHT:<the layer's thickness>
+/// ;LAYER:<layer number over the whole build order, from 0>
+/// ;FEATURE:<feature id>            (where the feature changes)
+/// ;FEATURE_LAYER:<layer index within the feature, as toolpath.csv's `layer`>
+/// ```
+///
+/// and `;WIDTH:<bead width>` before a print move whose bead width differs from the last one
+/// written by more than half a micrometre.
 #[derive(Debug, Default)]
 pub(crate) struct LayerMarks {
     layer: Option<usize>,
     feature: Option<usize>,
+    /// Layers begun so far over the build order.
+    count: usize,
+    width: Option<f64>,
 }
 
 impl LayerMarks {
-    /// Appends the comment lines `q` starts to `out`.
-    pub(crate) fn write(&mut self, q: &PathPoint, out: &mut String) {
-        if self.layer != Some(q.layer) {
+    /// Appends the comment lines `q` starts to `out`; `z` is the point's machine Z.
+    pub(crate) fn write(&mut self, q: &PathPoint, z: f64, out: &mut String) {
+        let new_feature = self.feature != Some(q.feature);
+        if new_feature || self.layer != Some(q.layer) {
             self.layer = Some(q.layer);
-            out.push_str(&format!(";LAYER:{}\n", q.layer));
+            out.push_str(";LAYER_CHANGE\n;Z:");
+            push_fixed(out, z, 3);
+            out.push_str("\n;HEIGHT:");
+            push_fixed(out, q.thickness, 3);
+            out.push_str(&format!("\n;LAYER:{}\n", self.count));
+            self.count += 1;
+            if new_feature {
+                self.feature = Some(q.feature);
+                out.push_str(&format!(";FEATURE:{}\n", q.feature));
+            }
+            out.push_str(&format!(";FEATURE_LAYER:{}\n", q.layer));
         }
-        if self.feature != Some(q.feature) {
-            self.feature = Some(q.feature);
-            out.push_str(&format!(";FEATURE:{}\n", q.feature));
+        if q.kind == MoveKind::Print && self.width.is_none_or(|w| (w - q.width).abs() > 5e-4) {
+            self.width = Some(q.width);
+            out.push_str(";WIDTH:");
+            push_fixed(out, q.width, 3);
+            out.push('\n');
         }
     }
 }

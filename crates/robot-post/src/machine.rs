@@ -36,6 +36,10 @@ pub struct MachineProfile {
     /// Optional: 0.6 × `nozzle_diameter` when left out ([`MachineProfile::min_bead_width`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_bead_width: Option<f64>,
+    /// Filament density (g/cm³) for the filament mass of a plan's estimate. Optional: PLA's
+    /// 1.24 when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filament_density: Option<f64>,
     /// Printing speed (mm/s).
     pub print_speed: f64,
     /// Printing speed of beads resting on the build plate (mm/s).
@@ -131,6 +135,14 @@ impl MachineProfile {
         for (field, v) in positive {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(field, format!("must be a positive number, got {v}")));
+            }
+        }
+        if let Some(d) = self.filament_density {
+            if !(d.is_finite() && d > 0.0 && d < 30.0) {
+                return Err(bad(
+                    "filament_density",
+                    format!("must be a density in g/cm3 between 0 and 30, got {d}"),
+                ));
             }
         }
         if let Some(w) = self.min_bead_width {

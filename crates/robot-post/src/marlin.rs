@@ -1,7 +1,8 @@
 //! Marlin G-code for 3-axis printers: every feature's tool axis must be +Z.
 //!
-//! The program is what Cura-style G-code viewers expect: `;LAYER:<n>` and `;FEATURE:<id>`
-//! comments, relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
+//! The program is what slicer G-code viewers expect: `;LAYER_CHANGE`, `;Z:`, `;HEIGHT:`,
+//! `;LAYER:<n>` over the whole build order, `;FEATURE:<id>` and `;FEATURE_LAYER:<n>`, `;WIDTH:`
+//! (see `gcode::LayerMarks`), relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
 //! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
 
 use crate::gcode::{comment_text, push_line, LayerMarks};
@@ -53,7 +54,7 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
     w.header(m, source, offset);
     for q in &path.points {
         let t = [q.p[0] + offset[0], q.p[1] + offset[1], q.p[2] + offset[2]];
-        w.comments(q);
+        w.comments(q, t[2]);
         match q.kind {
             MoveKind::Travel => w.travel(t),
             MoveKind::Print => {
@@ -159,9 +160,9 @@ impl Writer {
         self.line("G92 E0");
     }
 
-    /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
-    fn comments(&mut self, q: &PathPoint) {
-        self.marks.write(q, &mut self.out);
+    /// The layer comments (`gcode::LayerMarks`) where the point's layer or feature changes.
+    fn comments(&mut self, q: &PathPoint, z: f64) {
+        self.marks.write(q, z, &mut self.out);
     }
 
     fn retract(&mut self) {

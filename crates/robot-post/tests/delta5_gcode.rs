@@ -235,7 +235,7 @@ fn parse(program: &str) -> Parsed {
     for block in &gc.blocks {
         for c in &block.comments {
             let text = c.value.trim();
-            if let Some(n) = text.strip_prefix("LAYER:") {
+            if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
                 layer = Some(n.parse().unwrap());
             } else if let Some(n) = text.strip_prefix("FEATURE:") {
                 feature = Some(n.parse().unwrap());

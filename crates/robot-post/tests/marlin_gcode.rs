@@ -110,7 +110,7 @@ fn parse(program: &str) -> Parsed {
     for block in &gc.blocks {
         for c in &block.comments {
             let text = c.value.trim();
-            if let Some(n) = text.strip_prefix("LAYER:") {
+            if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
                 layer = Some(n.parse().unwrap());
                 out.layer_comments += 1;
             } else if let Some(n) = text.strip_prefix("FEATURE:") {
@@ -218,8 +218,16 @@ fn marlin_program_reparsed_reproduces_toolpath_csv() {
         "five travels between prints, one at the end"
     );
     assert!(parsed.travels >= 6);
-    // One comment per change: layers 0, 1, 2; features 1, 2, 1, 2, 1, 2.
-    assert_eq!((parsed.layer_comments, parsed.feature_comments), (3, 6));
+    // One layer per (feature, layer) run over the build order: features 1, 2, 1, 2, 1, 2 on
+    // their layers 0, 0, 1, 1, 2, 2 are six layers, numbered 0 to 5 by `;LAYER:`.
+    assert_eq!((parsed.layer_comments, parsed.feature_comments), (6, 6));
+    let global: Vec<usize> = program
+        .lines()
+        .filter_map(|l| l.strip_prefix(";LAYER:"))
+        .map(|n| n.parse().unwrap())
+        .collect();
+    assert_eq!(global, (0..6).collect::<Vec<_>>());
+    assert_eq!(program.matches(";LAYER_CHANGE\n;Z:").count(), 6);
 
     // And the original path (not only its CSV form) is reproduced within the CSV's rounding.
     for (q, r) in path.points.iter().zip(&from_csv.points) {

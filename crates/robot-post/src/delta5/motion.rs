@@ -107,7 +107,7 @@ impl<'a> Writer<'a> {
     /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
     pub(super) fn comments(&mut self, q: &PathPoint) {
         self.current = q.feature;
-        self.marks.write(q, &mut self.out);
+        self.marks.write(q, q.p[2] + self.offset[2], &mut self.out);
     }
 
     /// Refuses a nozzle position outside the work envelope.
