@@ -512,8 +512,10 @@ fn set_overrides_any_setting_and_the_settings_used_are_recorded() {
     assert!(settings["version"].as_str().is_some_and(|v| !v.is_empty()));
     // The program's header says the same, with the version.
     let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
-    let head: Vec<&str> = program.lines().take(120).collect();
-    assert!(head[1].starts_with("; features "), "{}", head[1]);
+    let head: Vec<&str> = program.lines().take(140).collect();
+    // After the source line: the estimate, then the version and the settings.
+    assert!(head[1].starts_with("; estimated printing time"), "{}", head[1]);
+    assert!(head[4].starts_with("; features "), "{}", head[4]);
     for line in [
         "; process.defaults.uniform_layer_height = 0.1",
         "; process.features.0.perimeters = 3",
