@@ -47,7 +47,8 @@ pub struct Delta5Geometry {
     pub resolution_c_deg: f64,
     /// Largest kinematic error (mm) a print move may carry; longer moves are split.
     pub kinematic_error_goal: f64,
-    /// A travel turning B or C by more than this (degrees) goes up to the safe height first.
+    /// A travel turning the bed by more than this in all (degrees of B and C summed over its
+    /// steps) goes up to the safe height first.
     pub reorient_lift_deg: f64,
     /// Clearance (mm) of the safe height above the part's swing sphere and the hop.
     pub reorient_clearance: f64,
