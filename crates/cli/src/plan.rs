@@ -27,6 +27,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             .file_stem()
             .map_or("part".into(), |s| s.to_string_lossy().into()),
         keep_going: args.keep_going,
+        allow_collisions: args.allow_collisions,
         progress: Some(&progress),
     };
     let plan = plan::plan(&part, &process, &machine, &options).map_err(|e| match e {
@@ -37,6 +38,13 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             }
             let n = problems.len();
             Failure::new(path, format!("the plan fails its self-check for {n} feature(s) (listed above); nothing written (--keep-going writes it anyway)"))
+        }
+        PlanError::Collisions(lines) => {
+            for l in &lines {
+                eprintln!("features: {}: {l}", path.display());
+            }
+            let n = lines.len();
+            Failure::new(path, format!("the print head collides in {n} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)"))
         }
         e => Failure::new(path, e),
     })?;

@@ -5,7 +5,7 @@
 //! F's earlier layers. Colliding travels are re-routed over the material when a lift clears them
 //! ([`check_and_route`]).
 
-use crate::deposit::Deposit;
+use crate::deposit::{Deposit, GRAIN_SPACING};
 use crate::head::{Head, HeadShape};
 use crate::table::Table;
 use toolpath::vec3::{add, norm, scale, sub, unit, V3};
@@ -90,12 +90,28 @@ impl Scene {
         })
     }
 
-    /// Deposits the beads of the print points `points[range]` (each from the point before it).
+    /// Deposits the beads of the print points `points[range]` (each from the point before it):
+    /// along each run of beads, grains at most [`GRAIN_SPACING`] apart and, where the planned
+    /// points lie closer, at least half that apart (every point of a bead is then within a
+    /// quarter of the spacing of a grain), the run's ends always.
     fn deposit(&mut self, points: &[PathPoint], range: std::ops::Range<usize>) {
+        let mut last: Option<V3> = None;
         for j in range {
-            if j > 0 && points[j].kind == MoveKind::Print {
-                self.deposit
-                    .add_bead(points[j - 1].p, points[j].p, points[j].feature);
+            let q = &points[j];
+            if j == 0 || q.kind != MoveKind::Print {
+                last = None;
+                continue;
+            }
+            let from = last.unwrap_or(points[j - 1].p);
+            if last.is_none() {
+                self.deposit.add(from, q.feature);
+            }
+            let ends = points.get(j + 1).is_none_or(|n| n.kind != MoveKind::Print);
+            if ends || norm(sub(q.p, from)) >= GRAIN_SPACING / 2.0 {
+                self.deposit.add_bead(from, q.p, q.feature);
+                last = Some(q.p);
+            } else {
+                last = Some(from);
             }
         }
     }
@@ -143,12 +159,28 @@ fn move_collision(scene: &Scene, pts: &[PathPoint], i: usize) -> Option<Collisio
 /// Lifts tried for a detour, as multiples of the head's length (then the material's height).
 const LIFTS: [f64; 4] = [0.05, 0.15, 0.5, 1.0];
 
+/// What [`check_and_route`] does with travel moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Travels {
+    /// Checked, and lifted over the material where they collide.
+    Route,
+    /// Neither checked nor changed: the post replaces them with travels of its own (the KUKA
+    /// post's retreat, rise, cross and approach).
+    Skip,
+}
+
 /// [`check`], re-routing each colliding travel over the material: from its start up its tool
-/// axis, across, and down the next point's axis, by the least lift (a share of the head's
+/// axis, across at one height, and down the next point's axis, by the least lift (a share of the head's
 /// length, or clear of the highest material) that makes all three moves clear. A travel no lift
-/// clears is left as planned and reported. The detour's points are travel points of the
+/// clears (or whose head collides at either end) is left as planned and reported. With
+/// [`Travels::Skip`] travels are left alone. The detour's points are travel points of the
 /// travel's end point (same feature, layer, width and thickness). Returns the collisions left.
-pub fn check_and_route(path: &mut ToolPath, head: &Head, table: Option<Table>) -> Vec<Collision> {
+pub fn check_and_route(
+    path: &mut ToolPath,
+    head: &Head,
+    table: Option<Table>,
+    travels: Travels,
+) -> Vec<Collision> {
     let mut scene = Scene::new(head, table);
     let pts = std::mem::take(&mut path.points);
     let mut out: Vec<PathPoint> = Vec::with_capacity(pts.len());
@@ -159,7 +191,8 @@ pub fn check_and_route(path: &mut ToolPath, head: &Head, table: Option<Table>) -
             scene.deposit(&pts, group..i);
             group = i;
         }
-        if let Some(c) = move_collision(&scene, &pts, i) {
+        let skip = travels == Travels::Skip && pts[i].kind == MoveKind::Travel;
+        if let Some(c) = (!skip).then(|| move_collision(&scene, &pts, i)).flatten() {
             match (c.kind, i.checked_sub(1)) {
                 (MoveKind::Travel, Some(j)) => match detour(&scene, &pts[j], &pts[i], head) {
                     Some(via) => out.extend(via),
@@ -184,7 +217,11 @@ pub fn check_and_route(path: &mut ToolPath, head: &Head, table: Option<Table>) -
 /// everything, or `None` when no lift tried clears it.
 fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[PathPoint; 2]> {
     let (ua, ub) = (unit(a.axis)?, unit(b.axis)?);
-    let above = scene.deposit.z_max() - a.p[2].min(b.p[2]);
+    // A head that collides at either end collides on every route between them.
+    if scene.at(a.p, ua).is_some() || scene.at(b.p, ub).is_some() {
+        return None;
+    }
+    let above = scene.deposit.z_max() - a.p[2].max(b.p[2]);
     let lifts = LIFTS
         .iter()
         .map(|f| f * head.body_length)
@@ -193,8 +230,10 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
         if !(s.is_finite() && s > 0.0) {
             continue;
         }
-        let up = add(a.p, scale(ua, s / ua[2].max(0.1)));
-        let over = add(b.p, scale(ub, s / ub[2].max(0.1)));
+        // Both ends up their axes to one height, `s` over the higher: across level.
+        let z = a.p[2].max(b.p[2]) + s;
+        let up = add(a.p, scale(ua, (z - a.p[2]) / ua[2].max(0.1)));
+        let over = add(b.p, scale(ub, (z - b.p[2]) / ub[2].max(0.1)));
         let clear = scene.sweep(a.p, ua, up, ua).is_none()
             && scene.sweep(up, ua, over, ub).is_none()
             && scene.sweep(over, ub, b.p, ub).is_none();

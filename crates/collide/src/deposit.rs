@@ -1,9 +1,12 @@
-//! What is deposited: grains sampled along the beads' top centrelines, kept in a hierarchy of
-//! occupied cells (1 mm up to 64 mm) so a query visits only the cells near the head's surface
-//! and skips whole boxes the head's distance bound clears.
+//! What is deposited: grains sampled along the beads' top centrelines, kept in an octree of
+//! occupied cells (1 mm up to 64 mm), each with the tight box of its grains, so a query visits
+//! only the boxes near the head's surface: a box is skipped when the head's distance bound
+//! clears it, or when it lies wholly at or below the tip's level across the tool axis (the
+//! layers the tip rests on).
 
 use crate::head::HeadShape;
-use std::collections::{HashMap, HashSet};
+use std::cell::Cell;
+use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use toolpath::vec3::{dot, norm, sub, V3};
 
@@ -43,32 +46,51 @@ impl Hasher for KeyHasher {
 
 type Fast = BuildHasherDefault<KeyHasher>;
 
-/// A point of deposited material and the feature that laid it.
+/// A point of deposited material and the feature that laid it. Single precision: a tenth of a
+/// micrometre at a metre from the origin, far below the tolerance.
 #[derive(Debug, Clone, Copy)]
 struct Grain {
-    p: V3,
-    feature: usize,
+    p: [f32; 3],
+    feature: u32,
 }
 
-/// The material deposited so far.
+/// No child, no grain.
+const NONE: u32 = u32::MAX;
+
+/// A cell of the hierarchy: the tight box of the grains under it, its occupied children, and
+/// (the finest cells) its grains, as an index into [`Deposit`]'s cells.
+#[derive(Debug, Clone)]
+struct Node {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    children: [u32; 8],
+    first: u32,
+}
+
+/// The material deposited so far: an octree of cells `CELL · 2^k` on a fixed lattice, each
+/// holding the tight box of its grains, under top cells found by hashing their index.
 #[derive(Default)]
 pub struct Deposit {
-    /// Finest cells and their grains.
-    cells: HashMap<Key, Vec<Grain>, Fast>,
-    /// `coarse[k]`: occupied cells of side `CELL · 2^(k+1)`.
-    coarse: Vec<HashSet<Key, Fast>>,
-    /// The top level's cells, in the order they were first occupied.
-    top: Vec<Key>,
+    nodes: Vec<Node>,
+    /// The grains of each finest cell.
+    cells: Vec<Vec<Grain>>,
+    /// Top cells (side `CELL · 2^LEVELS`) by index.
+    top: HashMap<Key, u32, Fast>,
+    /// The top cells' nodes, in the order they were first occupied.
+    roots: Vec<u32>,
     /// Highest grain, mm (−∞ when empty).
     z_max: f64,
+    /// The finest cell of the last grain found inside the head: asked first next time, since
+    /// the moves after a colliding one mostly meet the same material.
+    hint: Cell<u32>,
 }
 
 impl Deposit {
     /// Nothing deposited.
     pub fn new() -> Deposit {
         Deposit {
-            coarse: vec![HashSet::default(); LEVELS],
             z_max: f64::NEG_INFINITY,
+            hint: Cell::new(NONE),
             ..Deposit::default()
         }
     }
@@ -78,21 +100,55 @@ impl Deposit {
         self.z_max
     }
 
+    fn node(&mut self, p: [f32; 3]) -> u32 {
+        self.nodes.push(Node {
+            lo: p,
+            hi: p,
+            children: [NONE; 8],
+            first: NONE,
+        });
+        (self.nodes.len() - 1) as u32
+    }
+
     /// Deposits one grain at `p`, laid by `feature`.
     pub fn add(&mut self, p: V3, feature: usize) {
         let key = p.map(|x| (x / CELL).floor() as i32);
-        self.cells
-            .entry(key)
-            .or_default()
-            .push(Grain { p, feature });
-        for (k, level) in self.coarse.iter_mut().enumerate() {
-            let up = key.map(|i| i >> (k + 1));
-            if !level.insert(up) {
+        let top = key.map(|i| i >> LEVELS);
+        let p32 = p.map(|x| x as f32);
+        let mut at = match self.top.get(&top) {
+            Some(&n) => n,
+            None => {
+                let n = self.node(p32);
+                self.top.insert(top, n);
+                self.roots.push(n);
+                n
+            }
+        };
+        for level in (0..=LEVELS).rev() {
+            let node = &mut self.nodes[at as usize];
+            node.lo = std::array::from_fn(|k| node.lo[k].min(p32[k]));
+            node.hi = std::array::from_fn(|k| node.hi[k].max(p32[k]));
+            if level == 0 {
+                if node.first == NONE {
+                    node.first = self.cells.len() as u32;
+                    self.cells.push(vec![]);
+                }
+                self.cells[node.first as usize].push(Grain {
+                    p: p32,
+                    feature: feature as u32,
+                });
                 break;
             }
-            if k + 1 == LEVELS {
-                self.top.push(up);
-            }
+            let bit = |i: i32| ((i >> (level - 1)) & 1) as usize;
+            let slot = bit(key[0]) | bit(key[1]) << 1 | bit(key[2]) << 2;
+            at = match node.children[slot] {
+                NONE => {
+                    let n = self.node(p32);
+                    self.nodes[at as usize].children[slot] = n;
+                    n
+                }
+                n => n,
+            };
         }
         self.z_max = self.z_max.max(p[2]);
     }
@@ -117,7 +173,18 @@ impl Deposit {
             axis,
             tol,
         };
-        self.top.iter().find_map(|&key| q.visit(LEVELS, key))
+        let hint = self.hint.get();
+        if hint != NONE {
+            if let Some(f) = q.grains(&self.nodes[hint as usize]) {
+                return Some(f);
+            }
+        }
+        let found = self.roots.iter().find_map(|&n| q.visit(n));
+        if let Some((f, leaf)) = found {
+            self.hint.set(leaf);
+            return Some(f);
+        }
+        None
     }
 }
 
@@ -139,40 +206,41 @@ impl Query<'_> {
         self.shape.distance(h, r)
     }
 
-    /// The occupied cell `key` of `level` (0 the finest), known to be occupied.
-    fn visit(&self, level: usize, key: Key) -> Option<usize> {
-        let size = CELL * (1u32 << level) as f64;
-        let centre = key.map(|i| (i as f64 + 0.5) * size);
-        let rho = size * 0.5 * 3f64.sqrt();
-        // No point of the box lies deeper than `tol` inside the head.
-        if self.distance(centre) - rho >= -self.tol {
+    /// The feature of the first grain of the finest cell `node` deeper than the tolerance
+    /// inside the head.
+    fn grains(&self, node: &Node) -> Option<usize> {
+        self.d.cells[node.first as usize]
+            .iter()
+            .find(|g| self.distance(g.p.map(f64::from)) < -self.tol)
+            .map(|g| g.feature as usize)
+    }
+
+    /// The first grain under node `n` deeper than the tolerance inside the head: its feature
+    /// and its finest cell.
+    fn visit(&self, n: u32) -> Option<(usize, u32)> {
+        let node = &self.d.nodes[n as usize];
+        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
+        // Half the box, a little more for the single-precision corners.
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        // Every grain of the box lies at or below the tip's level (the layers under it).
+        let h = dot(sub(centre, self.tip), self.axis);
+        let reach = half[0] * self.axis[0].abs()
+            + half[1] * self.axis[1].abs()
+            + half[2] * self.axis[2].abs();
+        if h + reach <= self.tol {
             return None;
         }
-        if level == 0 {
-            let grains = self.d.cells.get(&key)?;
-            return grains
-                .iter()
-                .find(|g| self.distance(g.p) < -self.tol)
-                .map(|g| g.feature);
+        // No point of the box lies deeper than the tolerance inside the head.
+        if self.distance(centre) - norm(half) >= -self.tol {
+            return None;
         }
-        for c in 0..8 {
-            let child = [
-                key[0] * 2 + (c & 1),
-                key[1] * 2 + ((c >> 1) & 1),
-                key[2] * 2 + ((c >> 2) & 1),
-            ];
-            let occupied = if level == 1 {
-                self.d.cells.contains_key(&child)
-            } else {
-                self.d.coarse[level - 2].contains(&child)
-            };
-            if occupied {
-                if let Some(f) = self.visit(level - 1, child) {
-                    return Some(f);
-                }
-            }
+        if node.first != NONE {
+            return self.grains(node).map(|f| (f, n));
         }
-        None
+        node.children
+            .iter()
+            .filter(|&&c| c != NONE)
+            .find_map(|&c| self.visit(c))
     }
 }
 

@@ -20,7 +20,9 @@ mod head;
 mod order;
 mod table;
 
-pub use check::{check, check_and_route, Collision, Obstacle, Scene, SWEEP_STEP, TOLERANCE};
+pub use check::{
+    check, check_and_route, Collision, Obstacle, Scene, Travels, SWEEP_STEP, TOLERANCE,
+};
 pub use deposit::{Deposit, GRAIN_SPACING};
 pub use head::{Head, HeadShape};
 pub use order::interleave;
