@@ -250,3 +250,65 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
+        PathPoint {
+            feature,
+            layer,
+            kind,
+            p,
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.2,
+            width: 0.45,
+        }
+    }
+
+    /// A wall 5 mm tall (feature 0, lower than the head's body is above its tip), then travels
+    /// from its top down to the plate 15 mm beside it and across, through the wall.
+    fn wall_and_travel() -> ToolPath {
+        let mut points = vec![];
+        for layer in 0..25 {
+            let z = 0.2 * (layer + 1) as f64;
+            points.push(pt(0, layer, MoveKind::Travel, [0.0, -10.0, z]));
+            points.push(pt(0, layer, MoveKind::Print, [0.0, 10.0, z]));
+        }
+        // From the wall's top to the far side at the plate, through the wall.
+        points.push(pt(1, 0, MoveKind::Travel, [-15.0, 0.0, 0.2]));
+        points.push(pt(1, 0, MoveKind::Travel, [15.0, 0.0, 0.2]));
+        points.push(pt(1, 0, MoveKind::Print, [25.0, 0.0, 0.2]));
+        ToolPath { points }
+    }
+
+    #[test]
+    fn a_travel_through_a_wall_is_lifted_over_it() {
+        let head = Head::default();
+        let table = Some(Table::Plane { z: 0.0 });
+        let path = wall_and_travel();
+        let found = check(&path, &head, table);
+        assert!(found
+            .iter()
+            .any(|c| c.kind == MoveKind::Travel && c.hits == Obstacle::Feature(0)));
+        let mut routed = path.clone();
+        let left = check_and_route(&mut routed, &head, table, Travels::Route);
+        // Every travel through the wall got a detour, and nothing collides after it.
+        assert!(left.is_empty(), "{left:?}");
+        assert!(routed.points.len() > path.points.len());
+        assert!(check(&routed, &head, table).is_empty());
+        let top = routed
+            .points
+            .iter()
+            .map(|q| q.p[2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!(top > 5.0, "the detour rises over the wall: {top}");
+        // Skipped travels: neither checked nor changed.
+        let mut skipped = path.clone();
+        let left = check_and_route(&mut skipped, &head, table, Travels::Skip);
+        assert_eq!(skipped, path);
+        assert!(left.iter().all(|c| c.kind == MoveKind::Print));
+    }
+}
