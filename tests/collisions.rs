@@ -15,9 +15,10 @@ const BIN: &str = env!("CARGO_BIN_EXE_features");
 /// length, body radius, body top (from the tip).
 const HEAD: (f64, f64, f64, f64, f64) = (0.5, 30.0, 8.0, 20.0, 60.0);
 
-/// Depth (mm) a point must lie inside the head to count here: the planner counts 0.1 mm and keeps
-/// grains within 0.25 mm of every bead point, so every move found here is one it must report.
-const DEPTH: f64 = 0.4;
+/// Depth (mm) a point must lie inside the head to count here: the planner keeps grains within
+/// 0.25 mm of every bead point and counts a quarter-millimetre cell holding one when all of it
+/// lies 0.1 mm inside (its centre 0.1 + 0.22 mm), so every move found here is one it reports.
+const DEPTH: f64 = 0.6;
 
 struct Out(PathBuf);
 

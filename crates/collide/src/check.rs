@@ -15,7 +15,8 @@ use toolpath::{MoveKind, PathPoint, ToolPath};
 /// farthest point (a turn of the tool axis sweeps the body's top furthest).
 pub const SWEEP_STEP: f64 = 1.0;
 
-/// Depth (mm) material must lie inside the head, or the head below the table surface, to count:
+/// Depth (mm) material must lie inside the head (a quarter-millimetre cell of it wholly, see
+/// [`crate::Deposit`]), or the head below the table surface, to count:
 /// the tip rests on the layer below and beside the beads of its own layer, and bead surfaces
 /// are not exact.
 pub const TOLERANCE: f64 = 0.1;
@@ -182,34 +183,44 @@ pub fn check_and_route(
     travels: Travels,
 ) -> Vec<Collision> {
     let mut scene = Scene::new(head, table);
-    let pts = std::mem::take(&mut path.points);
-    let mut out: Vec<PathPoint> = Vec::with_capacity(pts.len());
+    let pts = &path.points;
+    // Detours by the index of the point they go before; the path is rebuilt once, if at all.
+    let mut detours: Vec<(usize, [PathPoint; 2])> = vec![];
     let mut left = vec![];
     let mut group = 0;
     for i in 0..pts.len() {
         if i > 0 && !same_group(&pts[i - 1], &pts[i]) {
-            scene.deposit(&pts, group..i);
+            scene.deposit(pts, group..i);
             group = i;
         }
         let skip = travels == Travels::Skip && pts[i].kind == MoveKind::Travel;
-        if let Some(c) = (!skip).then(|| move_collision(&scene, &pts, i)).flatten() {
-            match (c.kind, i.checked_sub(1)) {
-                (MoveKind::Travel, Some(j)) => match detour(&scene, &pts[j], &pts[i], head) {
-                    Some(via) => out.extend(via),
-                    None => left.push(Collision {
-                        index: out.len(),
-                        ..c
-                    }),
-                },
-                _ => left.push(Collision {
-                    index: out.len(),
-                    ..c
-                }),
-            }
+        let Some(c) = (!skip).then(|| move_collision(&scene, pts, i)).flatten() else {
+            continue;
+        };
+        let via = match (c.kind, i.checked_sub(1)) {
+            (MoveKind::Travel, Some(j)) => detour(&scene, &pts[j], &pts[i], head),
+            _ => None,
+        };
+        match via {
+            Some(via) => detours.push((i, via)),
+            None => left.push(Collision {
+                index: i + 2 * detours.len(),
+                ..c
+            }),
         }
-        out.push(pts[i]);
     }
-    path.points = out;
+    if !detours.is_empty() {
+        let old = std::mem::take(&mut path.points);
+        let mut points = Vec::with_capacity(old.len() + 2 * detours.len());
+        let mut from = 0;
+        for (i, via) in detours {
+            points.extend_from_slice(&old[from..i]);
+            points.extend(via);
+            from = i;
+        }
+        points.extend_from_slice(&old[from..]);
+        path.points = points;
+    }
     left
 }
 

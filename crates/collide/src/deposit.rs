@@ -1,8 +1,10 @@
-//! What is deposited: grains sampled along the beads' top centrelines, kept in an octree of
-//! occupied cells (1 mm up to 64 mm), each with the tight box of its grains, so a query visits
-//! only the boxes near the head's surface: a box is skipped when the head's distance bound
-//! clears it, or when it lies wholly at or below the tip's level across the tool axis (the
-//! layers the tip rests on).
+//! What is deposited: grains sampled along the beads' top centrelines, kept as occupied cells of
+//! a quarter millimetre (a 64-bit mask per millimetre cell) under an octree of cells up to
+//! 1,024 mm, each with the tight box of its quarter cells, so a query visits only the boxes near
+//! the head's surface: a box is skipped when the head's distance bound clears it, or when it
+//! lies wholly at or below the tip's level across the tool axis (the layers the tip rests on).
+//! A quarter cell counts as inside the head when all of it is (its centre deeper than the
+//! tolerance plus its half-diagonal).
 
 use crate::head::HeadShape;
 use std::cell::Cell;
@@ -10,12 +12,19 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use toolpath::vec3::{dot, norm, sub, V3};
 
-/// Side of the finest cells, mm.
+/// Side of the finest cells (one mask each), mm.
 const CELL: f64 = 1.0;
-/// Coarser levels above the finest: the top cells are `CELL · 2^LEVELS` (64 mm).
-const LEVELS: usize = 6;
+/// Quarter cells per side of a finest cell (4 × 4 × 4 = 64 bits).
+const SPLIT: i32 = 4;
+/// Side of a quarter cell, mm.
+const SUB: f64 = CELL / SPLIT as f64;
+/// Coarser levels above the finest: the top cells are `CELL · 2^LEVELS` (1,024 mm), so a
+/// part has few of them, each asked by every query.
+const LEVELS: usize = 10;
 /// Largest spacing of grains along a bead, mm.
 pub const GRAIN_SPACING: f64 = 0.5;
+/// Half the diagonal of a quarter cell, mm: how far its centre may lie from a grain in it.
+pub const GRAIN_SLACK: f64 = SUB * 0.866_025_403_784_438_6;
 
 /// A cell index at some level.
 type Key = [i32; 3];
@@ -46,42 +55,45 @@ impl Hasher for KeyHasher {
 
 type Fast = BuildHasherDefault<KeyHasher>;
 
-/// A point of deposited material and the feature that laid it. Single precision: a tenth of a
-/// micrometre at a metre from the origin, far below the tolerance.
+/// A finest cell: its index, which quarter cells hold material, their lowest and highest index
+/// per axis, and the first feature that laid any.
 #[derive(Debug, Clone, Copy)]
-struct Grain {
-    p: [f32; 3],
+struct Leaf {
+    key: Key,
+    mask: u64,
+    lo: [u8; 3],
+    hi: [u8; 3],
     feature: u32,
 }
 
-/// No child, no grain.
+/// No child.
 const NONE: u32 = u32::MAX;
 
-/// A cell of the hierarchy: the tight box of the grains under it, its occupied children, and
-/// (the finest cells) its grains, as an index into [`Deposit`]'s cells.
+/// A cell of the hierarchy above the finest: the tight box of the quarter-cell centres under
+/// it and its occupied children (nodes, or at level 1 leaves).
 #[derive(Debug, Clone)]
 struct Node {
     lo: [f32; 3],
     hi: [f32; 3],
     children: [u32; 8],
-    first: u32,
 }
 
-/// The material deposited so far: an octree of cells `CELL · 2^k` on a fixed lattice, each
-/// holding the tight box of its grains, under top cells found by hashing their index.
+/// The material deposited so far.
 #[derive(Default)]
 pub struct Deposit {
     nodes: Vec<Node>,
-    /// The grains of each finest cell.
-    cells: Vec<Vec<Grain>>,
+    leaves: Vec<Leaf>,
     /// Top cells (side `CELL · 2^LEVELS`) by index.
     top: HashMap<Key, u32, Fast>,
     /// The top cells' nodes, in the order they were first occupied.
     roots: Vec<u32>,
+    /// The last leaf written and the nodes above it (top first): beads run on, so the next
+    /// grain mostly falls in the same leaf.
+    last: Option<(Key, u32, [u32; LEVELS])>,
     /// Highest grain, mm (−∞ when empty).
     z_max: f64,
-    /// The finest cell of the last grain found inside the head: asked first next time, since
-    /// the moves after a colliding one mostly meet the same material.
+    /// The last leaf found inside the head: asked first next time, since the moves after a
+    /// colliding one mostly meet the same material.
     hint: Cell<u32>,
 }
 
@@ -100,55 +112,81 @@ impl Deposit {
         self.z_max
     }
 
-    fn node(&mut self, p: [f32; 3]) -> u32 {
+    fn node(&mut self, c: [f32; 3]) -> u32 {
         self.nodes.push(Node {
-            lo: p,
-            hi: p,
+            lo: c,
+            hi: c,
             children: [NONE; 8],
-            first: NONE,
         });
         (self.nodes.len() - 1) as u32
     }
 
-    /// Deposits one grain at `p`, laid by `feature`.
-    pub fn add(&mut self, p: V3, feature: usize) {
-        let key = p.map(|x| (x / CELL).floor() as i32);
+    /// The leaf of `key` and the nodes above it, made where missing.
+    fn find(&mut self, key: Key, c: [f32; 3], feature: usize) -> (u32, [u32; LEVELS]) {
         let top = key.map(|i| i >> LEVELS);
-        let p32 = p.map(|x| x as f32);
         let mut at = match self.top.get(&top) {
             Some(&n) => n,
             None => {
-                let n = self.node(p32);
+                let n = self.node(c);
                 self.top.insert(top, n);
                 self.roots.push(n);
                 n
             }
         };
-        for level in (0..=LEVELS).rev() {
-            let node = &mut self.nodes[at as usize];
-            node.lo = std::array::from_fn(|k| node.lo[k].min(p32[k]));
-            node.hi = std::array::from_fn(|k| node.hi[k].max(p32[k]));
-            if level == 0 {
-                if node.first == NONE {
-                    node.first = self.cells.len() as u32;
-                    self.cells.push(vec![]);
-                }
-                self.cells[node.first as usize].push(Grain {
-                    p: p32,
-                    feature: feature as u32,
-                });
-                break;
-            }
+        let mut path = [NONE; LEVELS];
+        for level in (1..=LEVELS).rev() {
+            path[LEVELS - level] = at;
             let bit = |i: i32| ((i >> (level - 1)) & 1) as usize;
             let slot = bit(key[0]) | bit(key[1]) << 1 | bit(key[2]) << 2;
-            at = match node.children[slot] {
-                NONE => {
-                    let n = self.node(p32);
-                    self.nodes[at as usize].children[slot] = n;
-                    n
-                }
-                n => n,
+            let child = self.nodes[at as usize].children[slot];
+            let child = if child != NONE {
+                child
+            } else if level == 1 {
+                self.leaves.push(Leaf {
+                    key,
+                    mask: 0,
+                    lo: [SPLIT as u8; 3],
+                    hi: [0; 3],
+                    feature: feature as u32,
+                });
+                (self.leaves.len() - 1) as u32
+            } else {
+                self.node(c)
             };
+            self.nodes[at as usize].children[slot] = child;
+            at = child;
+        }
+        (at, path)
+    }
+
+    /// Deposits one grain at `p`, laid by `feature`: its quarter cell is occupied.
+    pub fn add(&mut self, p: V3, feature: usize) {
+        let key = p.map(|x| (x / CELL).floor() as i32);
+        let sub: [i32; 3] =
+            std::array::from_fn(|k| (((p[k] / CELL).fract() + 1.0).fract() * SPLIT as f64) as i32);
+        let sub = sub.map(|s| s.clamp(0, SPLIT - 1));
+        let c: [f32; 3] = std::array::from_fn(|k| {
+            (f64::from(key[k]) * CELL + (f64::from(sub[k]) + 0.5) * SUB) as f32
+        });
+        let (leaf, path) = match self.last {
+            Some((k, leaf, path)) if k == key => (leaf, path),
+            _ => {
+                let (leaf, path) = self.find(key, c, feature);
+                self.last = Some((key, leaf, path));
+                (leaf, path)
+            }
+        };
+        let bit = 1u64 << (sub[0] + SPLIT * sub[1] + SPLIT * SPLIT * sub[2]);
+        let l = &mut self.leaves[leaf as usize];
+        if l.mask & bit == 0 {
+            l.mask |= bit;
+            l.lo = std::array::from_fn(|k| l.lo[k].min(sub[k] as u8));
+            l.hi = std::array::from_fn(|k| l.hi[k].max(sub[k] as u8));
+            for &n in &path {
+                let node = &mut self.nodes[n as usize];
+                node.lo = std::array::from_fn(|k| node.lo[k].min(c[k]));
+                node.hi = std::array::from_fn(|k| node.hi[k].max(c[k]));
+            }
         }
         self.z_max = self.z_max.max(p[2]);
     }
@@ -163,8 +201,9 @@ impl Deposit {
         }
     }
 
-    /// The feature of a grain lying more than `tol` inside the head with its tip at `tip` and
-    /// unit tool axis `axis`, if any.
+    /// The feature of a quarter cell lying wholly more than `tol` inside the head with its tip at
+    /// `tip` and unit tool axis `axis`, if any (the first feature that laid material in its
+    /// millimetre cell).
     pub fn first_inside(&self, shape: &HeadShape, tip: V3, axis: V3, tol: f64) -> Option<usize> {
         let q = Query {
             d: self,
@@ -175,11 +214,11 @@ impl Deposit {
         };
         let hint = self.hint.get();
         if hint != NONE {
-            if let Some(f) = q.grains(&self.nodes[hint as usize]) {
+            if let Some(f) = q.leaf(hint) {
                 return Some(f);
             }
         }
-        let found = self.roots.iter().find_map(|&n| q.visit(n));
+        let found = self.roots.iter().find_map(|&n| q.visit(n, LEVELS));
         if let Some((f, leaf)) = found {
             self.hint.set(leaf);
             return Some(f);
@@ -206,41 +245,61 @@ impl Query<'_> {
         self.shape.distance(h, r)
     }
 
-    /// The feature of the first grain of the finest cell `node` deeper than the tolerance
-    /// inside the head.
-    fn grains(&self, node: &Node) -> Option<usize> {
-        self.d.cells[node.first as usize]
-            .iter()
-            .find(|g| self.distance(g.p.map(f64::from)) < -self.tol)
-            .map(|g| g.feature as usize)
-    }
-
-    /// The first grain under node `n` deeper than the tolerance inside the head: its feature
-    /// and its finest cell.
-    fn visit(&self, n: u32) -> Option<(usize, u32)> {
-        let node = &self.d.nodes[n as usize];
-        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
-        // Half the box, a little more for the single-precision corners.
-        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
-        // Every grain of the box lies at or below the tip's level (the layers under it).
+    /// Whether the box of `centre` ± `half` may hold a point deeper than `depth` inside the
+    /// head: not wholly at or below the tip's level, not cleared by the distance bound.
+    fn may_hold(&self, centre: V3, half: V3, depth: f64) -> bool {
         let h = dot(sub(centre, self.tip), self.axis);
         let reach = half[0] * self.axis[0].abs()
             + half[1] * self.axis[1].abs()
             + half[2] * self.axis[2].abs();
-        if h + reach <= self.tol {
+        h + reach > depth && self.distance(centre) - norm(half) < -depth
+    }
+
+    /// The feature of leaf `n` if one of its quarter cells lies wholly deeper than the
+    /// tolerance inside the head.
+    fn leaf(&self, n: u32) -> Option<usize> {
+        let l = &self.d.leaves[n as usize];
+        let depth = self.tol + GRAIN_SLACK;
+        let origin = l.key.map(|i| f64::from(i) * CELL);
+        // The box of its quarter-cell centres.
+        let centre: V3 = std::array::from_fn(|k| {
+            origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
+        });
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB);
+        if !self.may_hold(centre, half, depth) {
             return None;
         }
-        // No point of the box lies deeper than the tolerance inside the head.
-        if self.distance(centre) - norm(half) >= -self.tol {
+        let mut mask = l.mask;
+        while mask != 0 {
+            let b = mask.trailing_zeros() as i32;
+            mask &= mask - 1;
+            let s = [b % SPLIT, (b / SPLIT) % SPLIT, b / (SPLIT * SPLIT)];
+            let c: V3 = std::array::from_fn(|k| origin[k] + (f64::from(s[k]) + 0.5) * SUB);
+            if self.distance(c) < -depth {
+                return Some(l.feature as usize);
+            }
+        }
+        None
+    }
+
+    /// The first quarter cell under node `n` (of `level`, 1 and up) wholly deeper than the
+    /// tolerance inside the head: its feature and its leaf.
+    fn visit(&self, n: u32, level: usize) -> Option<(usize, u32)> {
+        let node = &self.d.nodes[n as usize];
+        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
+        // Half the box of the quarter-cell centres, with their slack (and a little for the
+        // single-precision corners).
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        if !self.may_hold(centre, half, self.tol + GRAIN_SLACK) {
             return None;
         }
-        if node.first != NONE {
-            return self.grains(node).map(|f| (f, n));
-        }
-        node.children
-            .iter()
-            .filter(|&&c| c != NONE)
-            .find_map(|&c| self.visit(c))
+        node.children.iter().filter(|&&c| c != NONE).find_map(|&c| {
+            if level == 1 {
+                self.leaf(c).map(|f| (f, c))
+            } else {
+                self.visit(c, level - 1)
+            }
+        })
     }
 }
 
@@ -249,7 +308,7 @@ mod tests {
     use super::*;
     use crate::Head;
 
-    /// The hierarchy answers as a scan of every grain does.
+    /// The hierarchy answers as a scan of every grain's quarter cell does.
     #[test]
     fn hierarchy_agrees_with_a_scan() {
         let shape = Head::default().shape();
@@ -275,10 +334,12 @@ mod tests {
             [-31.0, 0.0, 0.0],
             [25.0, 25.0, 3.0],
         ] {
+            // Each grain's quarter cell, by its centre.
             let scan = grains.iter().any(|&p| {
-                let v = sub(p, tip);
+                let c = p.map(|x| ((x / SUB).floor() + 0.5) * SUB);
+                let v = sub(c, tip);
                 let h = dot(v, up);
-                shape.distance(h, (dot(v, v) - h * h).max(0.0).sqrt()) < -0.1
+                shape.distance(h, (dot(v, v) - h * h).max(0.0).sqrt()) < -0.1 - GRAIN_SLACK
             });
             assert_eq!(
                 d.first_inside(&shape, tip, up, 0.1).is_some(),

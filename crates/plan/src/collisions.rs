@@ -59,11 +59,7 @@ pub fn avoid(
         _ => Travels::Route,
     };
     let groups = sibling_groups(features);
-    let original = (!groups.is_empty()).then(|| path.clone());
     let left = check_and_route(path, &head, Some(table), travels);
-    let Some(original) = original else {
-        return left;
-    };
     // Groups one of whose members hits another.
     let crowded: Vec<&Vec<usize>> = groups
         .iter()
@@ -77,7 +73,9 @@ pub fn avoid(
     if crowded.is_empty() {
         return left;
     }
-    let mut mixed = original;
+    // The travels lifted for the first order go along with their layers: still travels, checked
+    // again in the new order.
+    let mut mixed = path.clone();
     for g in crowded {
         if let Some(m) = interleave(&mixed, g) {
             mixed = m;
