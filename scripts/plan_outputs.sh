@@ -15,7 +15,8 @@ run() { # part machine
   local dir="$out/$name"
   rm -rf "$dir"; mkdir -p "$dir"
   # Relative paths so both runs print the same source; 300 s bounds a runaway part.
-  (cd "$root" && timeout 300 "$bin" plan "$part" --machine "$machine" --keep-going --allow-unreachable -o "$dir" \
+  # PLAN_ARGS: extra arguments for the binary (a newer one: --allow-collisions).
+  (cd "$root" && timeout 300 "$bin" plan "$part" --machine "$machine" --keep-going --allow-unreachable ${PLAN_ARGS:-} -o "$dir" \
       >"$dir/stdout" 2>"$dir/stderr"; echo $? >"$dir/rc")
   # The stdout line names the output folder, which differs between runs.
   sed -i "s#$dir#OUT#" "$dir/stdout"

@@ -129,7 +129,7 @@ fn run_ours(exe: &Path, step: &Path, machine: &str, dir: &Path) -> OursRun {
     let mut cmd = Command::new(exe);
     cmd.arg("plan")
         .arg(step)
-        .args(["--machine", machine])
+        .args(["--machine", machine, "--allow-collisions"])
         .arg("-o")
         .arg(&out);
     match run_measured(&mut cmd, &log) {

@@ -534,6 +534,7 @@ fn run_ours(step: &Path) -> Result<Ours, String> {
     let options = plan::Options {
         source: step.display().to_string(),
         stem: "part".into(),
+        allow_collisions: true,
         ..Default::default()
     };
     let planned = plan::plan(&part, &plan::Process::default(), &machine, &options)

@@ -159,6 +159,10 @@ pub struct PlanArgs {
     /// says `"complete": false`
     #[arg(long)]
     pub keep_going: bool,
+    /// Write the plan even when the print head meets material built before a move, or the
+    /// table (plan.json counts the colliding moves per feature): the lines become warnings
+    #[arg(long)]
+    pub allow_collisions: bool,
 }
 
 /// Arguments of `features extract`.

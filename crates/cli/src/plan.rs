@@ -55,6 +55,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         source: path.display().to_string(),
         stem: outputs.stem(&part_stem),
         keep_going: args.keep_going,
+        allow_collisions: args.allow_collisions,
         progress: Some(&progress),
     };
     let result = plan::plan(&part, &process, &machine, &options);
@@ -67,6 +68,13 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             }
             let n = problems.len();
             Failure::new(path, format!("the plan fails its self-check for {n} feature(s) (listed above); nothing written (--keep-going writes it anyway)"))
+        }
+        PlanError::Collisions(lines) => {
+            for l in &lines {
+                eprintln!("features: {}: {l}", path.display());
+            }
+            let n = lines.len();
+            Failure::new(path, format!("the print head collides in {n} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)"))
         }
         e => Failure::new(path, e),
     })?;

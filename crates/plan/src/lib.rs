@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod collisions;
 pub mod estimate;
 pub mod process;
 pub mod report;
@@ -48,6 +49,10 @@ pub enum PlanError {
     /// layer, or its extruded volume is off its volume × fill.
     #[error("the plan fails its self-check for {} feature(s)", .0.len())]
     SelfCheck(Vec<PlanProblem>),
+    /// The head meets material or the table on some moves (and
+    /// [`Options::allow_collisions`] is off): one line per feature.
+    #[error("the head collides in {} feature(s)", .0.len())]
+    Collisions(Vec<String>),
 }
 
 /// Where a plan is: reported to [`Options::progress`].
@@ -79,6 +84,9 @@ pub struct Options<'a> {
     /// Return the plan even when it fails its self-check: the failures become warnings and the
     /// report says `"complete": false`.
     pub keep_going: bool,
+    /// Return the plan even when the head meets material or the table on some moves: the
+    /// lines become warnings (`plan.json` reports the moves either way).
+    pub allow_collisions: bool,
     /// Told where the plan is.
     pub progress: Option<&'a (dyn Fn(Progress) + Sync)>,
 }
@@ -247,6 +255,7 @@ pub fn plan(
                 warnings: fw,
                 orientation: None,
                 post: None,
+                collision: Default::default(),
             });
             plans.push((id, plan));
             tell(Progress::FeatureDone);
@@ -265,6 +274,13 @@ pub fn plan(
             rate_max_deg_per_mm_before: round(o.rate_max_deg_per_mm_before, 1e6),
             rate_max_deg_per_mm_after: round(o.rate_max_deg_per_mm_after, 1e6),
         });
+    }
+    // The head against what is built before each move and the table (issue 18).
+    let collided = collisions::entries(&collisions::avoid(&mut toolpath, machine, &reports));
+    let points = collisions::points(&toolpath);
+    for r in &mut reports {
+        r.collision = collided.get(&r.feature.id).cloned().unwrap_or_default();
+        r.points = points.get(&r.feature.id).copied().unwrap_or(0);
     }
     let settings = settings_entry(process, machine, &base);
     // The estimate first in the header, as slicers write it, then the settings.
@@ -298,6 +314,13 @@ pub fn plan(
             return Err(PlanError::SelfCheck(problems));
         }
         warnings.extend(problems.iter().map(|p| p.to_string()));
+    }
+    let collided = collisions::lines(&collided);
+    if !collided.is_empty() {
+        if !options.allow_collisions {
+            return Err(PlanError::Collisions(collided));
+        }
+        warnings.extend(collided);
     }
     let report = PlanReport {
         schema: PLAN_SCHEMA,

@@ -162,6 +162,38 @@ pub struct FeatureReport {
     /// The post's figures (delta5 and KUKA).
     #[serde(flatten)]
     pub post: Option<PostEntry>,
+    /// Moves of the head into material or the table left after avoidance.
+    #[serde(flatten)]
+    pub collision: CollisionEntry,
+}
+
+/// A feature's colliding moves (issue 18): the moves, print or travel, whose swept head meets
+/// material deposited before them or the table.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct CollisionEntry {
+    /// Colliding moves.
+    pub collisions: usize,
+    /// The first of them; `null` when none.
+    pub first_collision: Option<FirstCollision>,
+}
+
+/// Where the first colliding move of a feature meets what.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FirstCollision {
+    /// Tip position (part coordinates, mm, rounded to 1e-3) where the head meets it.
+    pub position: [f64; 3],
+    /// The feature id whose material it meets, or `"table"`.
+    pub hits: HitEntry,
+}
+
+/// What a colliding move hits: a feature id, or a name (`"table"`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum HitEntry {
+    /// Material of this feature.
+    Feature(usize),
+    /// Something not a feature: `"table"`.
+    Named(String),
 }
 
 /// The settings a plan was made with: the planner's version and the full process and machine

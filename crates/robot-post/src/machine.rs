@@ -62,6 +62,11 @@ pub struct MachineProfile {
     pub retraction_speed: f64,
     /// Nozzle lift during travel moves (mm); 0 for none.
     pub z_hop: f64,
+    /// The print head's shape (`[head]` table: a nozzle cone under a body cylinder), for the
+    /// collision check; the built-in profiles have [`collide::Head::default`], which a profile
+    /// without the table gets too.
+    #[serde(default)]
+    pub head: collide::Head,
     /// The bed's kinematics (`[delta5]` table); required when `kind = "delta5"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delta5: Option<crate::delta5::geometry::Delta5Geometry>,
@@ -200,6 +205,9 @@ impl MachineProfile {
             (MachineKind::Kuka, _, None) => return Err(self.missing_table("[kuka]", "kuka")),
             _ => {}
         }
+        self.head
+            .validate()
+            .map_err(|(field, reason)| bad(field, reason))?;
         if let Some(d) = &self.delta5 {
             d.validate(&self.name)?;
         }
@@ -295,6 +303,17 @@ mod tests {
             assert_eq!(p.z_hop, 0.2);
             assert_eq!(MachineKind::from_name(kind.as_str()), Some(kind));
         }
+        for kind in MachineKind::ALL {
+            // The head of issue 18, exactly.
+            let h = MachineProfile::builtin(kind).head;
+            assert_eq!(h.nozzle_tip_radius, 0.5);
+            assert_eq!(h.nozzle_cone_half_angle_deg, 30.0);
+            assert_eq!(h.nozzle_length, 8.0);
+            assert_eq!(h.body_radius, 20.0);
+            assert_eq!(h.body_length, 60.0);
+        }
+        let d = MachineProfile::builtin(MachineKind::Delta5);
+        assert_eq!(d.delta5.map(|g| g.table_radius), Some(100.0));
         let m = MachineProfile::builtin(MachineKind::Marlin);
         assert_eq!(m.bed_size, [220.0, 220.0, 250.0]);
         assert!(!m.bed_origin_centre);

@@ -110,7 +110,7 @@ pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
 /// centre of the print points on the C axis, the lowest bead bottom (`p − thickness·axis` over
 /// print points) on the table surface. A path without print points is placed by its travel
 /// points; an empty path gets no offset.
-pub(crate) fn table_offset(path: &ToolPath) -> [f64; 3] {
+pub fn table_offset(path: &ToolPath) -> [f64; 3] {
     let placed = placed_points(path);
     if placed.is_empty() {
         return [0.0; 3];

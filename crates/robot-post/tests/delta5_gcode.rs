@@ -931,7 +931,7 @@ fn delta5_profile_table_is_documented_and_checked() {
         .filter(|l| !l.starts_with('#') && l.contains(" = "))
         .map(|l| l.split(" = ").next().unwrap())
         .collect();
-    assert_eq!(keys.len(), 15);
+    assert_eq!(keys.len(), 16);
     for (i, l) in lines.iter().enumerate() {
         if !l.starts_with('#') && l.contains(" = ") {
             assert!(

@@ -47,10 +47,20 @@ pub struct Delta5Geometry {
     pub resolution_c_deg: f64,
     /// Largest kinematic error (mm) a print move may carry; longer moves are split.
     pub kinematic_error_goal: f64,
-    /// A travel turning B or C by more than this (degrees) goes up to the safe height first.
+    /// A travel turning the bed by more than this in all (degrees of B and C summed over its
+    /// steps) goes up to the safe height first.
     pub reorient_lift_deg: f64,
     /// Clearance (mm) of the safe height above the part's swing sphere and the hop.
     pub reorient_clearance: f64,
+    /// Radius (mm) of the table disc, which tilts and turns with B and C (the head must stay
+    /// clear of it); 100 when the key is left out.
+    #[serde(default = "default_table_radius")]
+    pub table_radius: f64,
+}
+
+/// The table radius of a `[delta5]` table without the key, mm.
+fn default_table_radius() -> f64 {
+    100.0
 }
 
 impl Delta5Geometry {
@@ -151,6 +161,7 @@ impl Delta5Geometry {
                 1e4,
                 false,
             ),
+            ("delta5.table_radius", self.table_radius, 0.0, 1e6, true),
         ] {
             let above = if lo_open { v > lo } else { v >= lo };
             if !(v.is_finite() && above && v <= hi) {

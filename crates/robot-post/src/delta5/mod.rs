@@ -31,8 +31,9 @@
 //! by more than `max_c_step_deg` and the kinematic error stays within its goal.
 //!
 //! Travels: after printing the filament is retracted and the nozzle lifted by `z_hop` along the
-//! current tool axis (machine +Z). A travel that turns B or C by more than `reorient_lift_deg`
-//! first goes up to the safe height (above the sphere the part sweeps about the B/C crossing,
+//! current tool axis (machine +Z). A travel (the run of travel points between two print moves,
+//! taken whole) that turns the bed by more than `reorient_lift_deg` in all (B and C, every
+//! step) first goes up to the safe height (above the sphere the part sweeps about the B/C crossing,
 //! plus `z_hop` and `reorient_clearance`), turns the bed there, moves over the next point and
 //! comes down; a smaller one goes straight to the next point at hop height. Then the nozzle
 //! lowers by the hop (along the new tool axis) and un-retracts.
@@ -158,15 +159,38 @@ pub fn delta5(
     // About 45 bytes a point: the program is not grown by doubling (a copy of it at each step).
     w.out.reserve(48 * path.points.len());
     let mut previous: Option<usize> = None;
+    // Points up to here were passed by a travel lifted to the safe height.
+    let mut passed = 0;
     for (i, q) in path.points.iter().enumerate() {
-        w.comments(q);
+        if i < passed {
+            continue;
+        }
         match q.kind {
-            MoveKind::Travel => w.travel(q, &poses[i])?,
+            MoveKind::Travel => {
+                // The whole travel (its run of travel points) turns the bed further than the
+                // lift rule allows: one travel at the safe height to its last point.
+                let end = i + path.points[i..]
+                    .iter()
+                    .take_while(|p| p.kind == MoveKind::Travel)
+                    .count();
+                if w.turn(&poses[i..end]) > g.reorient_lift_deg {
+                    for p in &path.points[i..end] {
+                        w.comments(p);
+                    }
+                    w.travel(&path.points[end - 1], &poses[end - 1], true)?;
+                    passed = end;
+                    previous = Some(end - 1);
+                    continue;
+                }
+                w.comments(q);
+                w.travel(q, &poses[i], false)?
+            }
             MoveKind::Print => {
+                w.comments(q);
                 let from = match previous {
                     Some(j) if w.at.is_some() => j,
                     _ => {
-                        w.travel(q, &poses[i])?;
+                        w.travel(q, &poses[i], false)?;
                         i
                     }
                 };

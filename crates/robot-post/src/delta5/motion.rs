@@ -168,8 +168,29 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
-    /// To the point `q` (bed at `pose`) at hop height; see the module documentation.
-    pub(super) fn travel(&mut self, q: &PathPoint, pose: &Pose) -> Result<(), PostError> {
+    /// How far a travel from where the machine is through the poses `run` turns the bed in
+    /// all: the turns of B and of C summed over its steps (degrees).
+    pub(super) fn turn(&self, run: &[Pose]) -> f64 {
+        let Some(at) = self.at else {
+            return 0.0;
+        };
+        let (mut b, mut c) = (at[3], at[4]);
+        let mut turn = 0.0;
+        for p in run {
+            turn += (p.b - b).abs() + (p.c - c).abs();
+            (b, c) = (p.b, p.c);
+        }
+        turn
+    }
+
+    /// To the point `q` (bed at `pose`) at hop height, by the safe height when `lift` or when
+    /// this step turns B or C by more than `reorient_lift_deg`; see the module documentation.
+    pub(super) fn travel(
+        &mut self,
+        q: &PathPoint,
+        pose: &Pose,
+        lift: bool,
+    ) -> Result<(), PostError> {
         if self.printing {
             self.retract();
         }
@@ -179,7 +200,7 @@ impl<'a> Writer<'a> {
         let hop = self.hop_z(target[2]);
         let reorient = match self.at {
             Some(at) => {
-                (target[3] - at[3]).abs() > self.g.reorient_lift_deg
+                lift || (target[3] - at[3]).abs() > self.g.reorient_lift_deg
                     || (target[4] - at[4]).abs() > self.g.reorient_lift_deg
             }
             None => true,

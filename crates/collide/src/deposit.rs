@@ -1,0 +1,353 @@
+//! What is deposited: grains sampled along the beads' top centrelines, kept as occupied cells of
+//! a quarter millimetre (a 64-bit mask per millimetre cell) under an octree of cells up to
+//! 1,024 mm, each with the tight box of its quarter cells, so a query visits only the boxes near
+//! the head's surface: a box is skipped when the head's distance bound clears it, or when it
+//! lies wholly at or below the tip's level across the tool axis (the layers the tip rests on).
+//! A quarter cell counts as inside the head when all of it is (its centre deeper than the
+//! tolerance plus its half-diagonal).
+
+use crate::head::HeadShape;
+use std::cell::Cell;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+use toolpath::vec3::{dot, norm, sub, V3};
+
+/// Side of the finest cells (one mask each), mm.
+const CELL: f64 = 1.0;
+/// Quarter cells per side of a finest cell (4 × 4 × 4 = 64 bits).
+const SPLIT: i32 = 4;
+/// Side of a quarter cell, mm.
+const SUB: f64 = CELL / SPLIT as f64;
+/// Coarser levels above the finest: the top cells are `CELL · 2^LEVELS` (1,024 mm), so a
+/// part has few of them, each asked by every query.
+const LEVELS: usize = 10;
+/// Largest spacing of grains along a bead, mm.
+pub const GRAIN_SPACING: f64 = 0.5;
+/// Half the diagonal of a quarter cell, mm: how far its centre may lie from a grain in it.
+pub const GRAIN_SLACK: f64 = SUB * 0.866_025_403_784_438_6;
+
+/// A cell index at some level.
+type Key = [i32; 3];
+
+/// A multiplicative hash for cell keys (the std SipHash dominates the lookups otherwise).
+#[derive(Default, Clone, Copy)]
+pub(crate) struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_i32(&mut self, v: i32) {
+        self.write_u64(v as u32 as u64);
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+}
+
+type Fast = BuildHasherDefault<KeyHasher>;
+
+/// A finest cell: its index, which quarter cells hold material, their lowest and highest index
+/// per axis, and the first feature that laid any.
+#[derive(Debug, Clone, Copy)]
+struct Leaf {
+    key: Key,
+    mask: u64,
+    lo: [u8; 3],
+    hi: [u8; 3],
+    feature: u32,
+}
+
+/// No child.
+const NONE: u32 = u32::MAX;
+
+/// A cell of the hierarchy above the finest: the tight box of the quarter-cell centres under
+/// it and its occupied children (nodes, or at level 1 leaves).
+#[derive(Debug, Clone)]
+struct Node {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    children: [u32; 8],
+}
+
+/// The material deposited so far.
+#[derive(Default)]
+pub struct Deposit {
+    nodes: Vec<Node>,
+    leaves: Vec<Leaf>,
+    /// Top cells (side `CELL · 2^LEVELS`) by index.
+    top: HashMap<Key, u32, Fast>,
+    /// The top cells' nodes, in the order they were first occupied.
+    roots: Vec<u32>,
+    /// The last leaf written and the nodes above it (top first): beads run on, so the next
+    /// grain mostly falls in the same leaf.
+    last: Option<(Key, u32, [u32; LEVELS])>,
+    /// Highest grain, mm (−∞ when empty).
+    z_max: f64,
+    /// The last leaf found inside the head: asked first next time, since the moves after a
+    /// colliding one mostly meet the same material.
+    hint: Cell<u32>,
+}
+
+impl Deposit {
+    /// Nothing deposited.
+    pub fn new() -> Deposit {
+        Deposit {
+            z_max: f64::NEG_INFINITY,
+            hint: Cell::new(NONE),
+            ..Deposit::default()
+        }
+    }
+
+    /// Highest deposited grain, mm; −∞ when nothing is deposited.
+    pub fn z_max(&self) -> f64 {
+        self.z_max
+    }
+
+    fn node(&mut self, c: [f32; 3]) -> u32 {
+        self.nodes.push(Node {
+            lo: c,
+            hi: c,
+            children: [NONE; 8],
+        });
+        (self.nodes.len() - 1) as u32
+    }
+
+    /// The leaf of `key` and the nodes above it, made where missing.
+    fn find(&mut self, key: Key, c: [f32; 3], feature: usize) -> (u32, [u32; LEVELS]) {
+        let top = key.map(|i| i >> LEVELS);
+        let mut at = match self.top.get(&top) {
+            Some(&n) => n,
+            None => {
+                let n = self.node(c);
+                self.top.insert(top, n);
+                self.roots.push(n);
+                n
+            }
+        };
+        let mut path = [NONE; LEVELS];
+        for level in (1..=LEVELS).rev() {
+            path[LEVELS - level] = at;
+            let bit = |i: i32| ((i >> (level - 1)) & 1) as usize;
+            let slot = bit(key[0]) | bit(key[1]) << 1 | bit(key[2]) << 2;
+            let child = self.nodes[at as usize].children[slot];
+            let child = if child != NONE {
+                child
+            } else if level == 1 {
+                self.leaves.push(Leaf {
+                    key,
+                    mask: 0,
+                    lo: [SPLIT as u8; 3],
+                    hi: [0; 3],
+                    feature: feature as u32,
+                });
+                (self.leaves.len() - 1) as u32
+            } else {
+                self.node(c)
+            };
+            self.nodes[at as usize].children[slot] = child;
+            at = child;
+        }
+        (at, path)
+    }
+
+    /// Deposits one grain at `p`, laid by `feature`: its quarter cell is occupied.
+    pub fn add(&mut self, p: V3, feature: usize) {
+        let key = p.map(|x| (x / CELL).floor() as i32);
+        let sub: [i32; 3] =
+            std::array::from_fn(|k| (((p[k] / CELL).fract() + 1.0).fract() * SPLIT as f64) as i32);
+        let sub = sub.map(|s| s.clamp(0, SPLIT - 1));
+        let c: [f32; 3] = std::array::from_fn(|k| {
+            (f64::from(key[k]) * CELL + (f64::from(sub[k]) + 0.5) * SUB) as f32
+        });
+        let (leaf, path) = match self.last {
+            Some((k, leaf, path)) if k == key => (leaf, path),
+            _ => {
+                let (leaf, path) = self.find(key, c, feature);
+                self.last = Some((key, leaf, path));
+                (leaf, path)
+            }
+        };
+        let bit = 1u64 << (sub[0] + SPLIT * sub[1] + SPLIT * SPLIT * sub[2]);
+        let l = &mut self.leaves[leaf as usize];
+        if l.mask & bit == 0 {
+            l.mask |= bit;
+            l.lo = std::array::from_fn(|k| l.lo[k].min(sub[k] as u8));
+            l.hi = std::array::from_fn(|k| l.hi[k].max(sub[k] as u8));
+            for &n in &path {
+                let node = &mut self.nodes[n as usize];
+                node.lo = std::array::from_fn(|k| node.lo[k].min(c[k]));
+                node.hi = std::array::from_fn(|k| node.hi[k].max(c[k]));
+            }
+        }
+        self.z_max = self.z_max.max(p[2]);
+    }
+
+    /// Deposits the bead from `a` to `b` as grains at most [`GRAIN_SPACING`] apart (`b`
+    /// included, `a` not: it ends the bead before).
+    pub fn add_bead(&mut self, a: V3, b: V3, feature: usize) {
+        let n = (norm(sub(b, a)) / GRAIN_SPACING).ceil().clamp(1.0, 1e5) as usize;
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            self.add(std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t), feature);
+        }
+    }
+
+    /// The feature of a quarter cell lying wholly more than `tol` inside the head with its tip at
+    /// `tip` and unit tool axis `axis`, if any (the first feature that laid material in its
+    /// millimetre cell).
+    pub fn first_inside(&self, shape: &HeadShape, tip: V3, axis: V3, tol: f64) -> Option<usize> {
+        let q = Query {
+            d: self,
+            shape,
+            tip,
+            axis,
+            tol,
+        };
+        let hint = self.hint.get();
+        if hint != NONE {
+            if let Some(f) = q.leaf(hint) {
+                return Some(f);
+            }
+        }
+        let found = self.roots.iter().find_map(|&n| q.visit(n, LEVELS));
+        if let Some((f, leaf)) = found {
+            self.hint.set(leaf);
+            return Some(f);
+        }
+        None
+    }
+}
+
+/// One head position asked of a [`Deposit`].
+struct Query<'a> {
+    d: &'a Deposit,
+    shape: &'a HeadShape,
+    tip: V3,
+    axis: V3,
+    tol: f64,
+}
+
+impl Query<'_> {
+    /// The head's distance bound at `p`.
+    fn distance(&self, p: V3) -> f64 {
+        let d = sub(p, self.tip);
+        let h = dot(d, self.axis);
+        let r = (dot(d, d) - h * h).max(0.0).sqrt();
+        self.shape.distance(h, r)
+    }
+
+    /// Whether the box of `centre` ± `half` may hold a point deeper than `depth` inside the
+    /// head: not wholly at or below the tip's level, not cleared by the distance bound.
+    fn may_hold(&self, centre: V3, half: V3, depth: f64) -> bool {
+        let h = dot(sub(centre, self.tip), self.axis);
+        let reach = half[0] * self.axis[0].abs()
+            + half[1] * self.axis[1].abs()
+            + half[2] * self.axis[2].abs();
+        h + reach > depth && self.distance(centre) - norm(half) < -depth
+    }
+
+    /// The feature of leaf `n` if one of its quarter cells lies wholly deeper than the
+    /// tolerance inside the head.
+    fn leaf(&self, n: u32) -> Option<usize> {
+        let l = &self.d.leaves[n as usize];
+        let depth = self.tol + GRAIN_SLACK;
+        let origin = l.key.map(|i| f64::from(i) * CELL);
+        // The box of its quarter-cell centres.
+        let centre: V3 = std::array::from_fn(|k| {
+            origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
+        });
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB);
+        if !self.may_hold(centre, half, depth) {
+            return None;
+        }
+        let mut mask = l.mask;
+        while mask != 0 {
+            let b = mask.trailing_zeros() as i32;
+            mask &= mask - 1;
+            let s = [b % SPLIT, (b / SPLIT) % SPLIT, b / (SPLIT * SPLIT)];
+            let c: V3 = std::array::from_fn(|k| origin[k] + (f64::from(s[k]) + 0.5) * SUB);
+            if self.distance(c) < -depth {
+                return Some(l.feature as usize);
+            }
+        }
+        None
+    }
+
+    /// The first quarter cell under node `n` (of `level`, 1 and up) wholly deeper than the
+    /// tolerance inside the head: its feature and its leaf.
+    fn visit(&self, n: u32, level: usize) -> Option<(usize, u32)> {
+        let node = &self.d.nodes[n as usize];
+        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
+        // Half the box of the quarter-cell centres, with their slack (and a little for the
+        // single-precision corners).
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        if !self.may_hold(centre, half, self.tol + GRAIN_SLACK) {
+            return None;
+        }
+        node.children.iter().filter(|&&c| c != NONE).find_map(|&c| {
+            if level == 1 {
+                self.leaf(c).map(|f| (f, c))
+            } else {
+                self.visit(c, level - 1)
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Head;
+
+    /// The hierarchy answers as a scan of every grain's quarter cell does.
+    #[test]
+    fn hierarchy_agrees_with_a_scan() {
+        let shape = Head::default().shape();
+        let mut d = Deposit::new();
+        let mut grains = vec![];
+        // A wall 30 mm long, 12 mm tall, at x = 10, and a floor.
+        for i in 0..60 {
+            for k in 0..60 {
+                let p = [10.0, -15.0 + i as f64 * 0.5, k as f64 * 0.2];
+                d.add(p, 1);
+                grains.push(p);
+            }
+            let p = [-20.0 + i as f64 * 0.7, 3.0, 0.2];
+            d.add(p, 2);
+            grains.push(p);
+        }
+        let up = [0.0, 0.0, 1.0];
+        for tip in [
+            [0.0, 0.0, 0.4],
+            [0.0, 0.0, 5.0],
+            [9.0, 0.0, 12.4],
+            [10.0, 0.0, 4.0],
+            [-31.0, 0.0, 0.0],
+            [25.0, 25.0, 3.0],
+        ] {
+            // Each grain's quarter cell, by its centre.
+            let scan = grains.iter().any(|&p| {
+                let c = p.map(|x| ((x / SUB).floor() + 0.5) * SUB);
+                let v = sub(c, tip);
+                let h = dot(v, up);
+                shape.distance(h, (dot(v, v) - h * h).max(0.0).sqrt()) < -0.1 - GRAIN_SLACK
+            });
+            assert_eq!(
+                d.first_inside(&shape, tip, up, 0.1).is_some(),
+                scan,
+                "{tip:?}"
+            );
+        }
+        // The wall's side under the body: the tip at 0.4 beside it has the wall 10 mm away.
+        assert_eq!(d.first_inside(&shape, [0.0, 0.0, 0.4], up, 0.1), Some(1));
+    }
+}

@@ -1,0 +1,29 @@
+//! collide: print-head collisions (issue 18).
+//!
+//! - [`Head`]: the head's shape, the machine profile's `[head]` table (a nozzle cone under a
+//!   body cylinder on the tool axis);
+//! - [`Table`]: the machine's table in part coordinates (a plane, or the disc of a B/C bed);
+//! - [`Deposit`]: the material laid so far, grains along the beads' top centrelines in a
+//!   hierarchy of occupied cells, asked whether any grain lies inside the head;
+//! - [`check`]: every move of a [`toolpath::ToolPath`], the head swept along it, against what
+//!   was deposited before it (earlier features, the feature's earlier layers) and the table;
+//!   [`check_and_route`] also lifts colliding travels over the material;
+//! - [`interleave`]: sibling features printed layer by layer in turn, when that clears the head.
+//!
+//! It reads only the tool path: the beads a feature lays are the material it leaves.
+
+#![warn(missing_docs)]
+
+mod check;
+mod deposit;
+mod head;
+mod order;
+mod table;
+
+pub use check::{
+    check, check_and_route, Collision, Obstacle, Scene, Travels, SWEEP_STEP, TOLERANCE,
+};
+pub use deposit::{Deposit, GRAIN_SPACING};
+pub use head::{Head, HeadShape};
+pub use order::interleave;
+pub use table::Table;
