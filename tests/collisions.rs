@@ -66,6 +66,7 @@ fn plan(name: &str, machine: &str) -> Planned {
             "--machine",
             machine,
             "--allow-collisions",
+            "--allow-unreachable",
             "--keep-going",
             "-o",
         ])
