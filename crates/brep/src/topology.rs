@@ -175,6 +175,18 @@ impl Brep {
     pub fn face_surface(&self, id: FaceId) -> &Surface {
         &self.surfaces[self.faces[id.idx()].surface.idx()]
     }
+    /// A planar face's unit normal pointing out of its solid (into whatever grows from it);
+    /// `None` for a face that is not planar.
+    pub fn plane_normal(&self, id: FaceId) -> Option<crate::math::V3> {
+        match self.face_surface(id) {
+            Surface::Plane { frame } => Some(if self.face(id).same_sense {
+                frame.z
+            } else {
+                -frame.z
+            }),
+            _ => None,
+        }
+    }
     /// The point of a face's surface at `(u, v)`.
     pub fn face_point(&self, id: FaceId, u: f64, v: f64) -> P3 {
         self.face_surface(id).eval(u, v)

@@ -36,17 +36,22 @@ pub fn read_placed(
             .ok_or_else(|| {
                 Failure::new(path, format!("--base-face {id}: no face #{id} in the file"))
             })?;
-        let down = outward_plane_normal(b, face).ok_or_else(|| {
+        let down = b.plane_normal(face).ok_or_else(|| {
             Failure::new(
                 path,
                 format!(
                     "--base-face {id}: face #{id} is not planar (a {} face): the part stands on a planar face",
-                    surface_name(b, face)
+                    features::extract::surface_kind(b.face_surface(face))
                 ),
             )
         })?;
-        let (part, entry) = turned(path, part, id, down, "base-face".into())?;
-        return Ok((part, Some(entry)));
+        let d = [down.x, down.y, down.z];
+        let part = if stands(down) {
+            part
+        } else {
+            brep::read_step_turned(path, d).map_err(|e| Failure::new(path, e))?
+        };
+        return Ok((part, Some(entry(id, d, "base-face".into()))));
     }
     if !auto {
         return Ok((part, None));
@@ -58,8 +63,9 @@ pub fn read_placed(
             "--orient auto: the part has no planar face to stand on",
         ));
     }
-    // (features needing an axis below the horizon, −area, index) for each candidate.
-    let mut best: Option<((usize, f64, usize), &Candidate)> = None;
+    // (features needing an axis below the horizon, −area, index) for each candidate, with the
+    // part read turned onto it.
+    let mut best: Option<((usize, f64, usize), &Candidate, StepPart)> = None;
     for (k, c) in candidates.iter().enumerate() {
         let turned = brep::read_step_turned(path, [c.down.x, c.down.y, c.down.z])
             .map_err(|e| Failure::new(path, e))?;
@@ -73,11 +79,14 @@ pub fn read_placed(
             .filter(|f| f.reference.normal.is_some_and(|n| n[2] < -1e-3))
             .count();
         let key = (below, -c.area, k);
-        if best.is_none_or(|(b, _)| key.partial_cmp(&b) == Some(std::cmp::Ordering::Less)) {
-            best = Some((key, c));
+        if best
+            .as_ref()
+            .is_none_or(|(b, _, _)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
+        {
+            best = Some((key, c, turned));
         }
     }
-    let Some(((below, _, _), c)) = best else {
+    let Some(((below, _, _), c, turned)) = best else {
         return Err(Failure::new(
             path,
             "--orient auto: the features of no candidate placement could be extracted",
@@ -88,35 +97,27 @@ pub fn read_placed(
         candidates.len(),
         c.area
     );
-    let (part, entry) = turned(path, part, c.face_id, c.down, rule)?;
-    Ok((part, Some(entry)))
+    // The part as read when the winner already points down, else as the loop read it turned.
+    let part = if stands(c.down) { part } else { turned };
+    let d = [c.down.x, c.down.y, c.down.z];
+    Ok((part, Some(entry(c.face_id, d, rule))))
 }
 
-/// The part read again turned so that `down` points down, unless it already does.
-fn turned(
-    path: &Path,
-    part: StepPart,
-    face: u64,
-    down: V3,
-    rule: String,
-) -> Result<(StepPart, PlacementEntry), Failure> {
-    let d = [down.x, down.y, down.z];
-    let rotation = brep::turn_down(d);
-    let part = if down.z < -1.0 + 1e-12 {
-        part
-    } else {
-        brep::read_step_turned(path, d).map_err(|e| Failure::new(path, e))?
-    };
+/// Whether `down` already points down (−Z): the part stands as modelled.
+fn stands(down: V3) -> bool {
+    down.z < -1.0 + 1e-12
+}
+
+/// What plan.json records of standing the part on face `face`, whose outward normal `down` is
+/// turned to −Z.
+fn entry(face: u64, down: [f64; 3], rule: String) -> PlacementEntry {
     let r = |x: f64| plan::report::round(x, 1e9);
-    Ok((
-        part,
-        PlacementEntry {
-            base_face: face,
-            down: d.map(r),
-            rotation: rotation.map(|row| row.map(r)),
-            rule,
-        },
-    ))
+    PlacementEntry {
+        base_face: face,
+        down: down.map(r),
+        rotation: brep::turn_down(down).map(|row| row.map(r)),
+        rule,
+    }
 }
 
 /// A direction the part may stand on.
@@ -135,7 +136,7 @@ fn candidates(b: &Brep) -> Vec<Candidate> {
     let mut out: Vec<(Candidate, f64)> = vec![];
     for k in 0..b.faces.len() {
         let f = FaceId(k as u32);
-        let Some(n) = outward_plane_normal(b, f) else {
+        let Some(n) = b.plane_normal(f) else {
             continue;
         };
         let area = face_area(b, f);
@@ -163,18 +164,6 @@ fn candidates(b: &Brep) -> Vec<Candidate> {
     out
 }
 
-/// The outward unit normal of a planar face.
-fn outward_plane_normal(b: &Brep, f: FaceId) -> Option<V3> {
-    match b.face_surface(f) {
-        brep::surface::Surface::Plane { frame } => Some(if b.face(f).same_sense {
-            frame.z
-        } else {
-            -frame.z
-        }),
-        _ => None,
-    }
-}
-
 /// A face's area from its mesh (0 when it does not mesh).
 fn face_area(b: &Brep, f: FaceId) -> f64 {
     let Ok(m) = mesh_faces(b, &[f], &MeshOptions::default()) else {
@@ -187,13 +176,4 @@ fn face_area(b: &Brep, f: FaceId) -> f64 {
             0.5 * (c - a).cross(&(d - a)).norm()
         })
         .sum()
-}
-
-/// The kind of a face's surface, as `inspect` names it.
-fn surface_name(b: &Brep, f: FaceId) -> String {
-    format!("{:?}", b.face_surface(f))
-        .split([' ', '{', '('])
-        .next()
-        .unwrap_or("curved")
-        .to_lowercase()
 }

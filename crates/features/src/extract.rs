@@ -613,28 +613,18 @@ fn concave_chains(b: &Brep, faces: &[FaceId], g: &aag::Aag) -> Vec<Vec<EdgeId>> 
     out
 }
 
-fn surface_kind(s: &Surface) -> String {
+/// The kind of a surface as features name references (`plane`, `cone`, ...): an offset
+/// surface by its basis.
+pub fn surface_kind(s: &Surface) -> String {
     match s {
         Surface::Offset { basis, .. } => surface_kind(basis),
         s => s.kind().to_string(),
     }
 }
 
-/// A plane's unit normal pointing out of `f` (into whatever grows from it).
-fn plane_normal(b: &Brep, f: FaceId) -> Option<V3> {
-    match b.face_surface(f) {
-        Surface::Plane { frame } => Some(if b.face(f).same_sense {
-            frame.z
-        } else {
-            -frame.z
-        }),
-        _ => None,
-    }
-}
-
 fn host_reference(b: &Brep, t: FaceId) -> Reference {
     let s = b.face_surface(t);
-    let normal = plane_normal(b, t).map(|n| [n.x, n.y, n.z]);
+    let normal = b.plane_normal(t).map(|n| [n.x, n.y, n.z]);
     Reference {
         surface: surface_kind(s),
         face: Some(t),
@@ -647,7 +637,7 @@ fn host_reference(b: &Brep, t: FaceId) -> Reference {
 fn base_reference(b: &Brep, faces: &[FaceId], warnings: &mut Vec<String>) -> Reference {
     let mut best: Option<(f64, FaceId)> = None;
     for &f in faces {
-        let Some(n) = plane_normal(b, f) else {
+        let Some(n) = b.plane_normal(f) else {
             continue;
         };
         if n.z > -1.0 + 1e-6 {
@@ -685,7 +675,7 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
     let mut top = vec![];
     let mut sides = vec![];
     for &f in faces {
-        match plane_normal(b, f) {
+        match b.plane_normal(f) {
             Some(m) if par(&m, &n) && m.dot(&n) < 0.0 => bottom.push(f),
             Some(m) if par(&m, &n) && m.dot(&n) > 0.0 => top.push(f),
             _ => sides.push(f),
@@ -722,7 +712,7 @@ fn two5d_subtype(b: &Brep, faces: &[FaceId], r: &Reference) -> String {
     }
     // Directions every side face could be swept along.
     let mut dirs: Vec<V3> = vec![n];
-    let side_planes: Vec<V3> = sides.iter().filter_map(|&f| plane_normal(b, f)).collect();
+    let side_planes: Vec<V3> = sides.iter().filter_map(|&f| b.plane_normal(f)).collect();
     for s in &sides {
         match b.face_surface(*s) {
             Surface::Cylinder { frame, .. } => dirs.push(frame.z),
