@@ -2,7 +2,6 @@
 //! to copy and edit (`features profiles show delta5 > my.toml`, then `--machine-profile
 //! my.toml`).
 
-use crate::settings::builtin_text;
 use crate::{emit, Failure, ProfilesAction, ProfilesArgs};
 use robot_post::machine::{MachineKind, MachineProfile, PROCESS_TOML};
 
@@ -53,7 +52,7 @@ fn show(name: &str) -> Result<&'static str, Failure> {
         return Ok(PROCESS_TOML);
     }
     MachineKind::from_name(name)
-        .map(builtin_text)
+        .map(MachineProfile::builtin_toml)
         .ok_or_else(|| Failure {
             path: name.to_string(),
             cause: "no such profile: the built-in ones are marlin, delta5, kuka and process (features profiles lists them)".into(),

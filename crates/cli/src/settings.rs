@@ -64,10 +64,13 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
                     cause: hint,
                 }
             })?;
-            (builtin_text(kind).to_string(), format!("built-in {name}"))
+            (
+                MachineProfile::builtin_toml(kind).to_string(),
+                format!("built-in {name}"),
+            )
         }
         (None, None) => (
-            builtin_text(MachineKind::Marlin).to_string(),
+            MachineProfile::builtin_toml(MachineKind::Marlin).to_string(),
             "built-in marlin".into(),
         ),
     };
@@ -95,15 +98,6 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
         .validate_for_nozzle(machine.nozzle_diameter)
         .map_err(|e| Failure::new(settings, e))?;
     Ok((process, machine))
-}
-
-/// The bundled TOML text of a built-in machine profile (comments kept).
-pub fn builtin_text(kind: MachineKind) -> &'static str {
-    match kind {
-        MachineKind::Marlin => robot_post::machine::MARLIN_TOML,
-        MachineKind::Delta5 => robot_post::machine::DELTA5_TOML,
-        MachineKind::Kuka => robot_post::machine::KUKA_TOML,
-    }
 }
 
 /// One `--set KEY=VALUE`: a process key (`uniform_layer_height` is `[defaults]`'s;

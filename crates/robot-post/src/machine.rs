@@ -82,13 +82,18 @@ pub const MIN_BEAD_SHARE: f64 = 0.6;
 impl MachineProfile {
     /// The built-in profile of `kind`, parsed from the bundled `profiles/<kind>.toml`.
     pub fn builtin(kind: MachineKind) -> MachineProfile {
-        let text = match kind {
+        // The bundled files are checked by the test `builtin_profiles_parse_and_validate`.
+        MachineProfile::from_toml(MachineProfile::builtin_toml(kind))
+            .expect("bundled machine profile is valid")
+    }
+
+    /// The bundled `profiles/<kind>.toml` text of the built-in profile of `kind`, comments kept.
+    pub fn builtin_toml(kind: MachineKind) -> &'static str {
+        match kind {
             MachineKind::Marlin => MARLIN_TOML,
             MachineKind::Delta5 => DELTA5_TOML,
             MachineKind::Kuka => KUKA_TOML,
-        };
-        // The bundled files are checked by the test `builtin_profiles_parse_and_validate`.
-        MachineProfile::from_toml(text).expect("bundled machine profile is valid")
+        }
     }
 
     /// Reads a profile from TOML text and validates it ([`MachineProfile::validate`]).
