@@ -353,13 +353,7 @@ fn settings_entry(
 ) -> SettingsEntry {
     let json = |v: Result<serde_json::Value, serde_json::Error>| v.unwrap_or_default();
     let mut features = serde_json::Map::new();
-    let mut ids: Vec<(usize, &String)> = process
-        .features
-        .keys()
-        .filter_map(|k| k.parse().ok().map(|n| (n, k)))
-        .collect();
-    ids.sort();
-    for (_, key) in ids {
+    for (_, key) in process.feature_keys() {
         let p = base.patched(&process.features[key]);
         features.insert(key.clone(), json(serde_json::to_value(p)));
     }

@@ -96,15 +96,20 @@ impl Process {
             .unwrap_or_default()
     }
 
-    /// Checks that every `[features.<id>]` names one of the part's `count` features.
-    pub fn validate_feature_ids(&self, count: usize) -> Result<(), ProcessError> {
+    /// The `[features.<id>]` tables' keys with their ids, by id.
+    pub fn feature_keys(&self) -> Vec<(usize, &String)> {
         let mut ids: Vec<(usize, &String)> = self
             .features
             .keys()
             .filter_map(|k| k.parse().ok().map(|n| (n, k)))
             .collect();
         ids.sort();
-        for (n, key) in ids {
+        ids
+    }
+
+    /// Checks that every `[features.<id>]` names one of the part's `count` features.
+    pub fn validate_feature_ids(&self, count: usize) -> Result<(), ProcessError> {
+        for (n, key) in self.feature_keys() {
             if n >= count {
                 let have = match count {
                     0 => "no feature".to_string(),
@@ -128,9 +133,7 @@ impl Process {
     pub fn validate_for_nozzle(&self, nozzle: f64) -> Result<(), ProcessError> {
         let base = self.base();
         let mut tables: Vec<(String, LayerParams)> = vec![("defaults".into(), base.clone())];
-        let mut ids: Vec<&String> = self.features.keys().collect();
-        ids.sort();
-        for id in ids {
+        for (_, id) in self.feature_keys() {
             tables.push((format!("features.{id}"), base.patched(&self.features[id])));
         }
         let h = (MIN_LAYER_HEIGHT, MAX_LAYER_HEIGHT_SHARE * nozzle);
