@@ -122,13 +122,7 @@ fn to_text(source: &str, solids: &[Solid], together: &[String]) -> String {
             branch: &str,
         ) {
             let f = &t.features[k];
-            let r = &f.reference;
-            let on = match (r.surface.as_str(), r.step_face) {
-                ("build_plate", Some(id)) => format!("on the build plate (face #{id})"),
-                ("build_plate", None) => "on the build plate".to_string(),
-                (kind, Some(id)) => format!("on {kind} face #{id}"),
-                (kind, None) => format!("on {kind}"),
-            };
+            let on = reference_text(&f.reference);
             let _ = writeln!(
                 out,
                 "{lead}{branch}feature {}  {} {}  {}  {:.3} mm^3{}",
@@ -209,4 +203,15 @@ fn export(dir: &Path, solids: &[Solid]) -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Where a feature grows from, as the tree and the preview say it: `on the build plate (face
+/// #17)`, `on cone face #54`.
+pub fn reference_text(r: &features::Reference) -> String {
+    match (r.surface.as_str(), r.step_face) {
+        ("build_plate", Some(id)) => format!("on the build plate (face #{id})"),
+        ("build_plate", None) => "on the build plate".to_string(),
+        (kind, Some(id)) => format!("on {kind} face #{id}"),
+        (kind, None) => format!("on {kind}"),
+    }
 }

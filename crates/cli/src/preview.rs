@@ -20,12 +20,7 @@ pub fn feature_meshes(assembly: &Assembly) -> Vec<FeatureMesh> {
         let opts = MeshOptions::with_tolerance((size * VIEW_TOLERANCE_SHARE).max(0.05));
         for &k in &t.build_order {
             let f = &t.features[k];
-            let r = &f.reference;
-            let on = match (r.surface.as_str(), r.step_face) {
-                ("build_plate", _) => "on the build plate".to_string(),
-                (kind, Some(id)) => format!("on {kind} face #{id}"),
-                (kind, None) => format!("on {kind}"),
-            };
+            let on = crate::extract::reference_text(&f.reference);
             let mut mesh = FeatureMesh {
                 id: offset + f.id,
                 label: format!("{} {on}", f.kind.as_str()),
