@@ -2,6 +2,9 @@
 //! `toolpath.csv`, independently of the planner's check (crates/collide), and the travels of the
 //! written programs against the beads laid before them.
 
+#[path = "common/readback.rs"]
+mod readback;
+
 use robot_post::machine::MachineProfile;
 use robot_post::MachineKind;
 use serde_json::Value;
@@ -373,56 +376,13 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The program's moves, as (rapid, `[X, Y, Z, B, C]` after the move, E), modal.
-fn moves(program: &str) -> Vec<(bool, [f64; 5], Option<f64>)> {
-    let mut at = [0.0f64; 5];
-    let mut out = vec![];
-    for line in program.lines() {
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let cmd = words.next().unwrap_or("");
-        if cmd != "G0" && cmd != "G1" {
-            continue;
-        }
-        let mut e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let v: f64 = v.parse().expect("number");
-            match k {
-                "X" => at[0] = v,
-                "Y" => at[1] = v,
-                "Z" => at[2] = v,
-                "B" => at[3] = v,
-                "C" => at[4] = v,
-                "E" => e = Some(v),
-                _ => {}
-            }
-        }
-        out.push((cmd == "G0", at, e));
-    }
-    out
-}
-
-/// The header's `; offset X.. Y.. Z..` (machine or table = part + offset).
-fn offset(program: &str) -> [f64; 3] {
-    let v: Vec<f64> = program
-        .lines()
-        .find_map(|l| l.strip_prefix("; offset "))
-        .expect("offset")
-        .split_whitespace()
-        .take(3)
-        .map(|w| w[1..].parse().expect("number"))
-        .collect();
-    [v[0], v[1], v[2]]
-}
-
 /// Every travel (`G0`) of the program, followed in steps of at most 0.1 mm of the tip in part
 /// coordinates, against the beads laid before it; for delta5 also the bed's turn in all
 /// (degrees of B and C) below the safe height of each travel, at most `reorient_lift_deg`.
 fn check_travels(name: &str, machine: MachineKind, run: &Planned) {
     let m = MachineProfile::builtin(machine);
     let g = m.delta5.clone();
-    let off = offset(&run.program);
+    let off = readback::offset(&run.program);
     let to_part = |j: [f64; 5]| match &g {
         Some(g) => robot_post::delta5::forward(j, g, off).0,
         None => [j[0] - off[0], j[1] - off[1], j[2] - off[2]],
@@ -445,7 +405,7 @@ fn check_travels(name: &str, machine: MachineKind, run: &Planned) {
     let mut turn = 0.0;
     let mut from = [0.0; 5];
     let (mut travels, mut checked) = (0, 0);
-    for (rapid, to, e) in moves(&run.program) {
+    for (rapid, to, e) in readback::moves(&run.program) {
         if rapid {
             let (a, b) = (to_part(from), to_part(to));
             let joint = ((to[3] - from[3]).abs() + (to[4] - from[4]).abs()) / 0.05;

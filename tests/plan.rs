@@ -2,6 +2,9 @@
 //! matches the part's, every print point lies inside the part, every layer lies on its plane,
 //! and the G-code parsed back reproduces `toolpath.csv`.
 
+#[path = "common/readback.rs"]
+mod readback;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -337,45 +340,14 @@ fn delta5_round_trip(name: &str, gcode: &str, csv: &str, profile: &str) {
     use robot_post::machine::MachineProfile;
     let m = MachineProfile::from_toml(profile).expect("profile");
     let g = m.delta5.clone().expect("[delta5]");
-    let offset: Vec<f64> = gcode
-        .lines()
-        .find_map(|l| l.strip_prefix("; offset "))
-        .expect("offset comment")
-        .split_whitespace()
-        .take(3)
-        .map(|w| w[1..].parse::<f64>().expect("offset number"))
+    let offset = readback::offset(gcode);
+    // The end of every G1 that extrudes. A print move carries E (a very short one may round
+    // to E0.00000); retraction moves carry a negative E and no motion.
+    let prints: Vec<[f64; 5]> = readback::moves(gcode)
+        .into_iter()
+        .filter(|(rapid, _, e)| !rapid && e.is_some_and(|e| e >= 0.0))
+        .map(|(_, at, _)| at)
         .collect();
-    let offset = [offset[0], offset[1], offset[2]];
-    // Modal X Y Z B C; the end of every G1 that extrudes.
-    let mut at = [0.0f64; 5];
-    let mut prints = vec![];
-    for line in gcode.lines() {
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
-        if cmd != "G1" && cmd != "G0" {
-            continue;
-        }
-        let mut e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let v: f64 = v.parse().expect("number");
-            match k {
-                "X" => at[0] = v,
-                "Y" => at[1] = v,
-                "Z" => at[2] = v,
-                "B" => at[3] = v,
-                "C" => at[4] = v,
-                "E" => e = Some(v),
-                _ => {}
-            }
-        }
-        // A print move carries E (a very short one may round to E0.00000); retraction
-        // moves carry a negative E and no motion.
-        if cmd == "G1" && e.is_some_and(|e| e >= 0.0) {
-            prints.push(at);
-        }
-    }
     let cone = g.singularity_cone_deg;
     let mut k = 0;
     let mut checked = 0;
