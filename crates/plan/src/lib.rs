@@ -24,7 +24,8 @@ use rayon::prelude::*;
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
 use robot_post::{Job, PostFigures, ProgramFile};
-use slicer::orient::{smooth, OrientationFigures};
+use slicer::orient::{limit_tilt, smooth, OrientationFigures};
+
 use slicer::params::LayerParams;
 use slicer::toolpath::{MoveKind, ToolPath};
 use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
@@ -251,6 +252,7 @@ pub fn plan(
                         .concave_radius
                         .is_finite()
                         .then(|| round(ff.concave_radius, 1e3)),
+                    layer_strategy: ff.layers.to_string(),
                 }),
                 warnings: fw,
                 orientation: None,
@@ -267,6 +269,19 @@ pub fn plan(
     let mut toolpath = sequence(plans);
     // Orientation smoothing between planning and posting.
     let orientation = smooth(&mut toolpath, &process.orientation);
+    // A B/C bed: axes that curved layers tip past the B limit are tilted back to it, inside
+    // the orientation's tolerance cone (half its opening); farther, the post refuses them.
+    if let Ok(g) = machine.delta5_table() {
+        let limit = g.b_limits_deg[0].abs().max(g.b_limits_deg[1].abs());
+        let slack = 0.5 * process.orientation.cone_angle_deg;
+        for (id, (n, worst)) in limit_tilt(&mut toolpath, limit, slack) {
+            if let Some(r) = reports.iter_mut().find(|r| r.feature.id == id) {
+                r.warnings.push(format!(
+                    "feature {id}: {n} tool axes tilted by up to {worst:.3} degrees towards +Z to stay within the machine's B limit of {limit} degrees"
+                ));
+            }
+        }
+    }
     for r in &mut reports {
         r.orientation = orientation.get(&r.feature.id).map(|o| OrientationFigures {
             step_max_deg_before: round(o.step_max_deg_before, 1e6),

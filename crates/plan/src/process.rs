@@ -156,6 +156,18 @@ impl Process {
             for &a in &p.adaptive_layer_height {
                 checks.push(("adaptive_layer_height".into(), a, h, why_h.clone()));
             }
+            checks.push((
+                "min_layer_height".into(),
+                p.min_layer_height,
+                h,
+                why_h.clone(),
+            ));
+            checks.push((
+                "max_layer_height".into(),
+                p.max_layer_height,
+                h,
+                why_h.clone(),
+            ));
             if let Some(o) = p.uniform_offset {
                 checks.push(("uniform_offset".into(), o, w, why_w.clone()));
             }

@@ -77,6 +77,9 @@ pub struct FreeformEntry {
     pub overhang_points: usize,
     /// Smallest concave radius of the reference under the feature, mm; `null` when none.
     pub concave_radius_mm: Option<f64>,
+    /// The layers it got: `offset` (offsets of the reference surface) or `transition`
+    /// (morphing the base into the top; `layer_strategy`).
+    pub layer_strategy: String,
 }
 
 /// What the post found for one feature, by machine.

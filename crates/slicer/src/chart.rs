@@ -9,6 +9,7 @@
 use crate::error::PlanError;
 use crate::geom2d::{Point2, Region};
 use crate::tolerance::{DEGENERATE_LENGTH, SINGULAR_DET};
+use crate::transition::TopField;
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
 use brep::surface::Surface;
@@ -52,6 +53,10 @@ pub struct Chart<'a> {
     pub(crate) sign: f64,
     /// The chart's form.
     pub kind: ChartKind,
+    /// Transition layers: when set, the chart's normal coordinate is the morph level
+    /// `w = d / h_T(q)` (0 on the base, 1 on the top) instead of the distance `d`
+    /// ([`crate::transition`]).
+    pub(crate) blend: Option<&'a TopField>,
 }
 
 impl<'a> Chart<'a> {
@@ -60,6 +65,7 @@ impl<'a> Chart<'a> {
         Chart {
             surf,
             sign: 1.0,
+            blend: None,
             kind: ChartKind::Native {
                 u0: 0.0,
                 v0: 0.0,
@@ -173,9 +179,57 @@ impl<'a> Chart<'a> {
         }
     }
 
-    /// The point at chart `q` and distance `d` from the reference, and the unit normal there
-    /// (the offset surface's normal is the reference's).
+    /// The same chart with its normal coordinate the morph level towards `top`.
+    pub(crate) fn blended<'b>(&self, top: &'b TopField) -> Chart<'b>
+    where
+        'a: 'b,
+    {
+        Chart {
+            surf: self.surf,
+            sign: self.sign,
+            kind: self.kind,
+            blend: Some(top),
+        }
+    }
+
+    /// The point at chart `q` and level `d` (the distance from the reference, or on a blended
+    /// chart the morph level), and the unit normal of the layer surface there: the reference's
+    /// on an offset (its normal is the reference's), by central differences on a transition
+    /// layer (TSN).
     pub fn at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
+        let Some(top) = self.blend else {
+            return self.offset_at(q, d);
+        };
+        let plain = Chart {
+            blend: None,
+            ..*self
+        };
+        let (p, n) = plain.offset_at(q, d * top.height(q))?;
+        if d == 0.0 {
+            return Some((p, n));
+        }
+        let e = 1e-3;
+        let side = |k: usize, s: f64| {
+            let mut x = q;
+            x[k] += s * e;
+            plain.offset_at(x, d * top.height(x)).map(|r| r.0)
+        };
+        let (Some(a), Some(b), Some(c), Some(g)) =
+            (side(0, 1.0), side(0, -1.0), side(1, 1.0), side(1, -1.0))
+        else {
+            return Some((p, n));
+        };
+        let m = (a - b).cross(&(c - g));
+        let len = m.norm();
+        if !(len.is_finite() && len > 0.0) {
+            return Some((p, n));
+        }
+        let m = m / len;
+        Some((p, if m.dot(&n) < 0.0 { -m } else { m }))
+    }
+
+    /// [`Chart::at`] on an offset of the reference.
+    fn offset_at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
         let (u, v) = self.uv(q)?;
         let (f, n) = match self.kind {
             ChartKind::Native { .. } => self.eval_ext(u, v)?,
@@ -186,7 +240,8 @@ impl<'a> Chart<'a> {
             .then_some((p, n))
     }
 
-    /// Chart coordinates and distance `d` of `p` (its nearest point on the reference).
+    /// Chart coordinates and distance `d` of `p` (its nearest point on the reference); on a
+    /// blended chart, the morph level instead of the distance.
     pub fn inverse(&self, p: &P3) -> Option<(Point2, f64)> {
         let (mut u, mut v) = self.surf.project(p, None);
         let (mut f, mut n) = (self.surf.eval(u, v), self.normal_at(u, v)?);
@@ -231,6 +286,11 @@ impl<'a> Chart<'a> {
                 [(u - u0) * su, (v - v0) * sv]
             }
             ChartKind::Ortho { c, e1, e2 } => [(f - c).dot(&e1), (f - c).dot(&e2)],
+        };
+        // On a blended chart, the level: the distance over the top's there.
+        let d = match self.blend {
+            Some(top) => d / top.height(q).max(crate::tolerance::MICROMETRE),
+            None => d,
         };
         (q[0].is_finite() && q[1].is_finite() && d.is_finite()).then_some((q, d))
     }
@@ -326,6 +386,7 @@ pub(crate) fn choose_chart<'a>(
         return Ok(Chart {
             surf,
             sign,
+            blend: None,
             kind: ChartKind::Native {
                 u0,
                 v0,
@@ -340,6 +401,7 @@ pub(crate) fn choose_chart<'a>(
     let chart = Chart {
         surf,
         sign,
+        blend: None,
         kind: ChartKind::Ortho { c, e1, e2 },
     };
     // The projection chart needs the reference to be a height field over the tangent plane.

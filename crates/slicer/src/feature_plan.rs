@@ -23,6 +23,13 @@ pub enum LayerSurface {
         /// The offset `z_k`, mm.
         offset: f64,
     },
+    /// A transition layer (Isa & Lazoglu 2019, Eq. 4): the morph `L = (1 − w)·B + w·T` of the
+    /// feature's base B (its reference region) into its top T at level `w = n/N`, each point
+    /// `w·h_T(q)` from the reference along its normal.
+    Blend {
+        /// The morph level `n/N`, in (0, 1].
+        level: f64,
+    },
 }
 
 /// One bead path of a layer, as ranges of its feature's [`FeaturePlan::points`]: the travel

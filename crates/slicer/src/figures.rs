@@ -63,4 +63,7 @@ pub struct FreeformFigures {
     pub overhang_points: usize,
     /// First and last layer (1-based) with such points.
     pub overhang_layers: Option<(usize, usize)>,
+    /// `offset` (offsets of the reference surface) or `transition` (layers morphing the base
+    /// into the top).
+    pub layers: &'static str,
 }

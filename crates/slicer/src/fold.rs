@@ -52,6 +52,7 @@ pub(crate) fn fold_check(
     let chart = Chart {
         surf,
         sign,
+        blend: None,
         kind: ChartKind::Native { u0, v0, su, sv },
     };
     let f0 = surf.eval(u0, v0);

@@ -39,10 +39,11 @@ use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
 use crate::lift::{lift, Lifted};
-use crate::params::{LayerParams, PathMode};
+use crate::params::{LayerParams, LayerStrategy, PathMode};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
+use crate::transition::{levels, Levels, TopField, MIN_OVERLAP};
 use brep::math::{P3, V3};
 use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
@@ -91,8 +92,10 @@ pub struct FreeformFill<'a> {
     bead: Bead,
     fixed: Option<V3>,
     heights: Vec<f64>,
-    /// Each layer's middle and top offset.
+    /// Each layer's middle and top level: offsets, or morph levels with transition layers.
     tops: Vec<(f64, f64)>,
+    /// Transition layers: the top's distance field and the number of layers N.
+    blend: Option<(TopField, usize)>,
     /// Each layer's regions and fill paths in the chart.
     filled: Vec<(Vec<Region>, Vec<FillPath>)>,
     fig: FeatureFigures,
@@ -129,7 +132,8 @@ pub fn fill_freeform<'a>(
         return Err(err("its mesh is empty".into()));
     }
     let below = crate::planar::below_plate(tree, &mesh.positions);
-    let mesh = refined(&mesh, MAX_MAPPED_EDGE);
+    let raw = mesh;
+    let mesh = refined(&raw, MAX_MAPPED_EDGE);
     // Offset deterioration first: a concave reference under the feature folds its offsets
     // before they reach the feature's top, and the feature may not even have a chart then
     // (a rib standing across a trough maps onto both of its flanks).
@@ -145,7 +149,7 @@ pub fn fill_freeform<'a>(
         mapped = mapped_mesh(&chart, &mesh, id)?;
     }
     let top = mapped.positions.iter().map(|p| p.z).fold(0.0f64, f64::max);
-    let heights = params.layer_heights(top);
+    let mut heights = params.layer_heights(top);
     // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature.
     let stride = (mapped.positions.len() / 300).max(1);
     let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
@@ -161,11 +165,11 @@ pub fn fill_freeform<'a>(
         f64::INFINITY
     };
     let spacing = params.spacing(bead.width);
-    let fig = FeatureFigures {
+    let mut fig = FeatureFigures {
         below_plate: below,
         ..FeatureFigures::default()
     };
-    let ff = FreeformFigures {
+    let mut ff = FreeformFigures {
         chart: match chart.kind {
             ChartKind::Native { .. } => "native",
             ChartKind::Ortho { .. } => "projection",
@@ -173,7 +177,55 @@ pub fn fill_freeform<'a>(
         concave_radius,
         overhang_points: 0,
         overhang_layers: None,
+        layers: "offset",
     };
+    // Offset or transition layers (issue 17): see crate::transition.
+    let blend = match params.layer_strategy {
+        LayerStrategy::Offset => None,
+        strategy => {
+            let forced = strategy == LayerStrategy::Transition;
+            match TopField::build(&chart, b, &raw, &f.heal_faces, &mapped, id)? {
+                None if forced => {
+                    return Err(err(
+                        "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
+                    ))
+                }
+                None => None,
+                Some(field) if field.overlap < MIN_OVERLAP && !forced => {
+                    fig.warnings.push(format!(
+                        "feature {id}: offset layers, not transition layers: its top covers {:.0} % of its base along the reference's normals (it leans over), and layers morphing one into the other along them would not follow its sides",
+                        100.0 * field.overlap
+                    ));
+                    None
+                }
+                Some(field) => match levels(field.range, params) {
+                    Levels::Offset => None,
+                    Levels::Transition(n) => Some((field, n)),
+                    Levels::Infeasible(lo, hi) => {
+                        let (a, _, b) = field.range;
+                        let why = format!(
+                            "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}",
+                            params.max_layer_height, params.min_layer_height
+                        );
+                        if forced {
+                            return Err(err(why));
+                        }
+                        fig.warnings.push(format!(
+                            "feature {id}: offset layers, not transition layers: {why}"
+                        ));
+                        None
+                    }
+                },
+            }
+        }
+    };
+    if let Some((field, n)) = &blend {
+        // Nominal thicknesses for the fold check and the layers' figures; each point's is
+        // h_T(q)/N.
+        heights = vec![field.range.2 / *n as f64; *n];
+        ff.layers = "transition";
+    }
+    let ff = ff;
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -184,10 +236,37 @@ pub fn fill_freeform<'a>(
     // Each layer's regions and fill depend on that layer alone: computed in parallel, then
     // ordered, lifted and joined by travel one layer after the other.
     let mut tops = Vec::with_capacity(heights.len());
-    for &dl in &heights {
-        tops.push((z + 0.5 * dl, z + dl));
-        z += dl;
+    match &blend {
+        Some((_, n)) => {
+            for k in 0..*n {
+                tops.push(((k as f64 + 0.5) / *n as f64, (k + 1) as f64 / *n as f64));
+            }
+        }
+        None => {
+            for &dl in &heights {
+                tops.push((z + 0.5 * dl, z + dl));
+                z += dl;
+            }
+        }
     }
+    // With transition layers the mesh is sliced at morph levels: each vertex's distance over
+    // the top's there.
+    let layer_chart = match &blend {
+        Some((field, _)) => chart.blended(field),
+        None => chart,
+    };
+    let sliced = match &blend {
+        Some((field, _)) => {
+            let mut m = mapped.clone();
+            for p in &mut m.positions {
+                p.z /= field.height([p.x, p.y]).max(MICROMETRE);
+            }
+            m
+        }
+        None => mapped,
+    };
+    let base_chart = chart;
+    let (chart, mapped) = (layer_chart, sliced);
     let filled: Vec<(Vec<Region>, Vec<FillPath>)> = tops
         .par_iter()
         .enumerate()
@@ -220,7 +299,8 @@ pub fn fill_freeform<'a>(
         .collect();
     Ok(FreeformFill {
         id,
-        chart,
+        chart: base_chart,
+        blend,
         params: params.clone(),
         bead,
         fixed,
@@ -240,6 +320,7 @@ impl FreeformFill<'_> {
         let FreeformFill {
             id,
             chart,
+            blend,
             params,
             bead,
             fixed,
@@ -250,6 +331,19 @@ impl FreeformFill<'_> {
             mut ff,
         } = self;
         let params = &params;
+        // Transition layers: the chart's level is the morph level, a layer 1/N of it, and a
+        // point's thickness h_T(q)/N (crate::transition).
+        let chart = match &blend {
+            Some((field, _)) => chart.blended(field),
+            None => chart,
+        };
+        let levels = blend.as_ref().map(|(field, n)| (field, *n as f64));
+        let thick = |q: Point2, dl: f64| match levels {
+            Some((field, n)) => field.height(q) / n,
+            None => dl,
+        };
+        // Thinnest, summed and thickest thickness over the print points.
+        let mut spread = (f64::INFINITY, 0.0f64, 0.0f64, 0usize);
         let mut cursor = entry;
         let cursor = &mut cursor;
         let mut prev_regions: Vec<Region> = vec![];
@@ -319,11 +413,16 @@ impl FreeformFill<'_> {
                 // Travel: up one layer over the start of the path, along the layer above
                 // (clear of this layer's beads on a curved surface), then down.
                 let first = pts[0];
-                let lift_to = z + dl;
+                // One layer up, in the chart's level.
+                let step = match levels {
+                    Some((_, n)) => 1.0 / n,
+                    None => dl,
+                };
+                let lift_to = z + step;
                 let mut travel: Vec<(P3, V3)> = vec![];
                 if let Some(c) = *cursor {
                     if let Some((qc, dc)) = chart.inverse(&c) {
-                        let hz = lift_to.max(dc + dl);
+                        let hz = lift_to.max(dc + step);
                         let span = dist2(first.q, qc).sqrt();
                         let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
                         for i in 0..=n {
@@ -350,7 +449,7 @@ impl FreeformFill<'_> {
                         p: [p.x, p.y, p.z],
                         axis: axis(n),
                         e: 0.0,
-                        thickness: dl,
+                        thickness: thick(first.q, dl),
                         width: bead.width,
                     });
                     *cursor = Some(p);
@@ -359,7 +458,10 @@ impl FreeformFill<'_> {
                 for w in pts.windows(2) {
                     let l = (w[1].p - w[0].p).norm();
                     let width = 0.5 * (w[0].w + w[1].w);
-                    let e = bead.filament_length(width, dl, l);
+                    // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
+                    let t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
+                    let e = bead.filament_length(width, t, l);
+                    spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
                     fig.print_length += l;
                     fig.filament += e;
                     points.push(PathPoint {
@@ -369,7 +471,7 @@ impl FreeformFill<'_> {
                         p: [w[1].p.x, w[1].p.y, w[1].p.z],
                         axis: axis(w[1].n),
                         e,
-                        thickness: dl,
+                        thickness: t,
                         width,
                     });
                 }
@@ -383,13 +485,19 @@ impl FreeformFill<'_> {
                 layers.push(Layer {
                     index: layer,
                     thickness: dl,
-                    surface: LayerSurface::Offset { offset: z },
+                    surface: match levels {
+                        Some(_) => LayerSurface::Blend { level: z },
+                        None => LayerSurface::Offset { offset: z },
+                    },
                     paths: layer_paths,
                 });
             }
         }
         let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
         fig.finish(id, points.len(), &printed);
+        if levels.is_some() && spread.3 > 0 {
+            fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
+        }
         if against.0 > 0 {
             fig.warnings.push(format!(
                 "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",

@@ -45,6 +45,7 @@ pub mod params;
 pub mod planar;
 mod region_fill;
 mod tolerance;
+pub mod transition;
 pub mod verify;
 
 pub use toolpath;

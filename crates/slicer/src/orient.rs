@@ -326,6 +326,36 @@ pub fn filter_axes(s: &[f64], axes: &[[f64; 3]], filter: Filter, window_mm: f64)
         .collect()
 }
 
+/// Tilts every axis that leans more than `max_tilt_deg` from +Z (a B/C bed's B limit), by at
+/// most `slack_deg`, up to that limit in the plane of the axis and +Z (a hair inside it, so the
+/// post's check holds): the tool-axis counterpart of a machine limit, for axes that a curved
+/// layer's normal tips just past it (a feature on a vertical wall whose layers lean down by a
+/// degree). Axes farther out are left for the post to refuse. Returns, per feature, how many
+/// axes were tilted and the largest tilt, degrees.
+pub fn limit_tilt(
+    path: &mut ToolPath,
+    max_tilt_deg: f64,
+    slack_deg: f64,
+) -> BTreeMap<usize, (usize, f64)> {
+    let mut out: BTreeMap<usize, (usize, f64)> = BTreeMap::new();
+    let target = (max_tilt_deg - 1e-7).to_radians();
+    for p in &mut path.points {
+        let Some(a) = unit(p.axis) else { continue };
+        let tilt = a[2].clamp(-1.0, 1.0).acos();
+        let over = tilt.to_degrees() - max_tilt_deg;
+        let r = a[0].hypot(a[1]);
+        if over <= 0.0 || over > slack_deg || r < 1e-12 {
+            continue;
+        }
+        let (s, c) = target.sin_cos();
+        p.axis = [s * a[0] / r, s * a[1] / r, c];
+        let e = out.entry(p.feature).or_default();
+        e.0 += 1;
+        e.1 = e.1.max(tilt.to_degrees() - target.to_degrees());
+    }
+    out
+}
+
 /// Brings a smoothed axis back into the tolerance cone of opening angle γ =
 /// `cone_angle_deg` around its planned axis (Eq. 4–7). Returns a unit vector.
 ///

@@ -36,6 +36,36 @@ pub enum LayerHeightPattern {
     Adaptive,
 }
 
+/// How a freeform feature's layers are shaped (issue 17, `layer_strategy`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerStrategy {
+    /// Offsets of the reference surface (feature-based AM paper): exact where the feature's
+    /// top is itself an offset; the top is cut by the last layers elsewhere.
+    Offset,
+    /// Transition layers that morph the base into the top (Isa & Lazoglu 2019, Eq. 4): the
+    /// last layer lies on the top. An error where the top comes so close to the base that no
+    /// number of layers keeps every point's thickness within
+    /// `[min_layer_height, max_layer_height]`.
+    Transition,
+    /// Transition layers where the top is not an offset of the reference within `tolerance`
+    /// and they can keep the thickness bounds; offset layers (with a warning saying why)
+    /// where they cannot.
+    Auto,
+}
+
+/// How the tool axis of a freeform feature's wall paths is chosen (issue 17,
+/// `wall_orientation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WallOrientation {
+    /// Along the layer surface's normal (TSN) like every other path.
+    Normal,
+    /// Side-surface tangent (SST, Isa & Lazoglu 2019, Eq. 3) on the outermost ring of each
+    /// layer: perpendicular to the side surface's normal and the path's tangent.
+    Sst,
+}
+
 /// Layer and path parameters of one feature.
 ///
 /// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
@@ -70,6 +100,14 @@ pub struct LayerParams {
     /// puts it along the layer surface's normal at the point; a vector fixes it (the paper:
     /// "the direction could be constant for the entire layers if needed"). Normalised on use.
     pub fixed_tool_axis: Option<[f64; 3]>,
+    /// Offset, transition or (the default) automatic choice of a freeform feature's layers.
+    pub layer_strategy: LayerStrategy,
+    /// Tool axis of wall paths: layer normal (the default) or side-surface tangent.
+    pub wall_orientation: WallOrientation,
+    /// Thinnest local thickness of a transition layer, mm. Default 0.1.
+    pub min_layer_height: f64,
+    /// Thickest local thickness of a transition layer, mm. Default 0.3.
+    pub max_layer_height: f64,
 }
 
 impl Default for LayerParams {
@@ -86,6 +124,10 @@ impl Default for LayerParams {
             perimeters: 2,
             raster_angle_deg: 45.0,
             fixed_tool_axis: None,
+            layer_strategy: LayerStrategy::Auto,
+            wall_orientation: WallOrientation::Normal,
+            min_layer_height: 0.1,
+            max_layer_height: 0.3,
         }
     }
 }
@@ -209,6 +251,14 @@ impl LayerParams {
                 self.raster_angle_deg
             ));
         }
+        positive("min_layer_height", self.min_layer_height)?;
+        positive("max_layer_height", self.max_layer_height)?;
+        if self.min_layer_height > self.max_layer_height {
+            return Err(format!(
+                "min_layer_height ({}) must not exceed max_layer_height ({})",
+                self.min_layer_height, self.max_layer_height
+            ));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > 1e-9) {
@@ -256,6 +306,18 @@ impl LayerParams {
         if let Some(v) = p.fixed_tool_axis {
             out.fixed_tool_axis = Some(v);
         }
+        if let Some(v) = p.layer_strategy {
+            out.layer_strategy = v;
+        }
+        if let Some(v) = p.wall_orientation {
+            out.wall_orientation = v;
+        }
+        if let Some(v) = p.min_layer_height {
+            out.min_layer_height = v;
+        }
+        if let Some(v) = p.max_layer_height {
+            out.max_layer_height = v;
+        }
         out
     }
 }
@@ -299,6 +361,18 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::fixed_tool_axis`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fixed_tool_axis: Option<[f64; 3]>,
+    /// Overrides [`LayerParams::layer_strategy`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layer_strategy: Option<LayerStrategy>,
+    /// Overrides [`LayerParams::wall_orientation`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_orientation: Option<WallOrientation>,
+    /// Overrides [`LayerParams::min_layer_height`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_layer_height: Option<f64>,
+    /// Overrides [`LayerParams::max_layer_height`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_layer_height: Option<f64>,
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ mod support;
 
 use features::{FeatureKind, FeatureTree};
 use slicer::freeform::plan_freeform;
-use slicer::params::{LayerParams, PathMode};
+use slicer::params::{LayerParams, LayerStrategy, PathMode};
 use slicer::planar::{Bead, PlanError};
 use slicer::toolpath::{MoveKind, PathPoint};
 use std::collections::HashMap;
@@ -114,6 +114,11 @@ struct Checked {
 /// Plans every freeform feature of `name` with `params` and checks the properties on
 /// every print point.
 fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> {
+    // The properties of offset layers (transition layers: tests/transition.rs).
+    let params = &LayerParams {
+        layer_strategy: LayerStrategy::Offset,
+        ..params.clone()
+    };
     let t = tree(name);
     let area = std::f64::consts::PI * BEAD.filament_diameter.powi(2) / 4.0;
     let mut out = vec![];

@@ -210,6 +210,7 @@ fn stretched_chart(surf: &Surface) -> Chart<'_> {
     Chart {
         surf,
         sign: 1.0,
+        blend: None,
         kind: ChartKind::Native {
             u0: 0.0,
             v0: 0.0,

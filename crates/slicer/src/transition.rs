@@ -1,0 +1,427 @@
+//! Transition layers of a freeform feature (Isa & Lazoglu 2019, seed 000, section 3.3): layers
+//! that morph the feature's base B into its top T, so that the last layer lies on T and the top
+//! has no stair-steps.
+//!
+//! - **Base, top, sides (section 3.1, Fig. 4).** B is where the feature grows from: its
+//!   reference region, `d = 0` in the chart of the reference surface (see [`crate::chart`]).
+//!   T is the feature's faces that look the way it grows: the faces other than its healing
+//!   faces whose area-weighted normal, in chart space `(s, t, d)`, points up (`d`-share at
+//!   least [`TOP_SHARE`]). The rest are the sides S_i.
+//! - **Correspondence.** B and T of a real part are trimmed faces of unrelated surfaces, not
+//!   the aligned `(u, v)` patches the paper assumes. The correspondence is the chart's: the
+//!   point of T over chart point `q` is the one met along the reference's normal N(q), at
+//!   distance `h_T(q)` ([`TopField`]). Where T does not cover `q` (over a side leaning out, or
+//!   past T's edge) `h_T` is continued smoothly from T's values (nearest value, then relaxed).
+//! - **Layers, Eq. 4.** `L_n(q) = (1 − n/N)·B(q) + (n/N)·T(q)` is, in the chart, the surface
+//!   `d = (n/N)·h_T(q)`: the chart's normal coordinate `w = d / h_T(q)` is 0 on B and 1 on T,
+//!   and layer n spans `w ∈ [(n−1)/N, n/N]`. A point's local thickness is `h_T(q)/N`.
+//! - **Outlines, Eq. 5–8.** The paper fits each blended layer's outline to the side surfaces
+//!   by interpolated displacements. Here the layer's region is the section of the feature's
+//!   mesh mapped into `(s, t, w)` by the plane `w = (n − ½)/N`: the side faces cut at that
+//!   level of the morph, so the outline lies on the sides by construction, and the layer
+//!   surface inside it is the blend.
+//! - **N.** With `h_min`, `h_max`, `h_mean` the base-to-top distance over T, every point's
+//!   thickness lies in `[h_min/N, h_max/N]`: N must be in
+//!   `[ceil(h_max / max_layer_height), floor(h_min / min_layer_height)]`; it is the number of
+//!   that range nearest `h_mean / uniform_layer_height`. An empty range (the top comes too
+//!   close to the base somewhere for one N) is [`Levels::Infeasible`].
+//! - **Orientation (TSN).** The layer surface's normal, from the chart by central differences.
+
+use crate::chart::{mapped_mesh, refined, Chart};
+use crate::error::PlanError;
+use crate::geom2d::Point2;
+use crate::params::LayerParams;
+use brep::math::P3;
+use brep::mesh::{FaceTriangulation, Mesh};
+use brep::topology::FaceId;
+use std::collections::VecDeque;
+
+/// A face belongs to the top when the `d`-share of its area-weighted normal in chart space is
+/// at least this (its mean normal within 60° of the growth direction).
+pub(crate) const TOP_SHARE: f64 = 0.5;
+
+/// Longest edge of the top's triangles sampled into a [`TopField`], mm.
+const TOP_EDGE: f64 = 0.25;
+
+/// Most cells of a [`TopField`] grid.
+const MAX_CELLS: f64 = 400_000.0;
+
+/// The top's distance from the base along the reference's normal, `h_T(q)`, sampled on a grid
+/// of the chart and interpolated bilinearly; continued past the top's footprint.
+#[derive(Debug, Clone)]
+pub struct TopField {
+    origin: Point2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    h: Vec<f64>,
+    /// Least, mean and greatest base-to-top distance over the top, mm.
+    pub range: (f64, f64, f64),
+    /// The share of the base (the feature's healing faces, seen in the chart) that the top
+    /// covers along the reference's normals: near 1 for a feature standing upright on its
+    /// base, small for one leaning over (a pitched blade, whose top lies over another part of
+    /// the reference than its root).
+    pub overlap: f64,
+}
+
+impl TopField {
+    /// `h_T` of the feature whose mesh is `mesh` (its faces' triangulations) and whose healing
+    /// faces are `heal`, in `chart`; `mapped` is the refined mesh already mapped into
+    /// `(s, t, d)` (its bounds set the grid). `None` when the feature has no top face.
+    pub(crate) fn build(
+        chart: &Chart,
+        brep: &brep::Brep,
+        mesh: &Mesh,
+        heal: &[FaceId],
+        mapped: &Mesh,
+        id: usize,
+    ) -> Result<Option<TopField>, PlanError> {
+        // The top faces, each as its own triangles (refined, so that d is near linear over
+        // every triangle of the chart).
+        let mut top = Mesh {
+            positions: mesh.positions.clone(),
+            faces: vec![],
+            edge_points: Default::default(),
+            edge_params: Default::default(),
+        };
+        let mut base = Mesh {
+            positions: mesh.positions.clone(),
+            faces: vec![],
+            edge_points: Default::default(),
+            edge_params: Default::default(),
+        };
+        let mut probe = Mesh {
+            positions: vec![],
+            faces: vec![],
+            edge_points: Default::default(),
+            edge_params: Default::default(),
+        };
+        for ft in &mesh.faces {
+            if ft.triangles.is_empty() {
+                continue;
+            }
+            if heal.contains(&ft.face) {
+                base.faces.push(ft.clone());
+                continue;
+            }
+            // The face's up-share from a sample of its triangles in chart space.
+            let stride = (ft.triangles.len() / 64).max(1);
+            probe.positions.clear();
+            let mut tris: Vec<[u32; 3]> = vec![];
+            for t in ft.triangles.iter().step_by(stride) {
+                let base = probe.positions.len() as u32;
+                for &k in t {
+                    probe
+                        .positions
+                        .push(mesh.positions[ft.vertex[k as usize] as usize]);
+                }
+                tris.push([base, base + 1, base + 2]);
+            }
+            probe.faces = vec![FaceTriangulation {
+                face: ft.face,
+                uv: vec![[0.0, 0.0]; probe.positions.len()],
+                vertex: (0..probe.positions.len() as u32).collect(),
+                triangles: tris.clone(),
+            }];
+            let Ok(m) = mapped_mesh(chart, &probe, id) else {
+                continue;
+            };
+            let (mut up, mut all) = (0.0, 0.0);
+            for t in &tris {
+                let [a, b, c] = t.map(|k| m.positions[k as usize]);
+                let n = (b - a).cross(&(c - a));
+                up += n.z;
+                all += n.norm();
+            }
+            if all > 0.0 && up >= TOP_SHARE * all {
+                top.faces.push(ft.clone());
+            }
+        }
+        if top.faces.is_empty() {
+            return Ok(None);
+        }
+        // Linear over each triangle in the chart, d's slope strays by about edge / radius of
+        // curvature from the top's: each top face refined to a quarter millimetre, the new
+        // points put back on its exact surface (the slicing mesh's own facets stray by degrees
+        // at its chord tolerance), keeps it near 0.3° on R = 47 mm.
+        let mut pieces = vec![];
+        for ft in &top.faces {
+            let one = Mesh {
+                positions: mesh.positions.clone(),
+                faces: vec![ft.clone()],
+                edge_points: Default::default(),
+                edge_params: Default::default(),
+            };
+            let mut fine = compact(&refined(&compact(&one), TOP_EDGE));
+            let surf = brep.face_surface(ft.face);
+            for p in &mut fine.positions {
+                let (u, v) = surf.project(p, None);
+                let on = surf.eval(u, v);
+                if (on - *p).norm() < TOP_EDGE {
+                    *p = on;
+                }
+            }
+            pieces.push(fine);
+        }
+        let top = merge(&pieces);
+        let top = mapped_mesh(chart, &top, id)?;
+        // The grid over the whole feature's chart box.
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &mapped.positions {
+            lo = [lo[0].min(p.x), lo[1].min(p.y)];
+            hi = [hi[0].max(p.x), hi[1].max(p.y)];
+        }
+        let span = [(hi[0] - lo[0]).max(1e-3), (hi[1] - lo[1]).max(1e-3)];
+        let cell = (span[0] * span[1] / MAX_CELLS).sqrt().clamp(0.05, 5.0);
+        let nx = (span[0] / cell).ceil() as usize + 3;
+        let ny = (span[1] / cell).ceil() as usize + 3;
+        let origin = [lo[0] - cell, lo[1] - cell];
+        let mut h = vec![f64::NEG_INFINITY; nx * ny];
+        for t in top.triangles() {
+            let [a, b, c] = t.map(|k| top.positions[k as usize]);
+            raster(&mut h, origin, cell, nx, ny, a, b, c);
+        }
+        let covered: Vec<bool> = h.iter().map(|v| v.is_finite()).collect();
+        // The base's cells, and how many of them the top covers.
+        let overlap = if base.faces.is_empty() {
+            1.0
+        } else {
+            let base = mapped_mesh(chart, &compact(&base), id)?;
+            let mut under = vec![f64::NEG_INFINITY; nx * ny];
+            for t in base.triangles() {
+                let [a, b, c] = t.map(|k| base.positions[k as usize]);
+                let flat = |p: P3| P3::new(p.x, p.y, 0.0);
+                raster(&mut under, origin, cell, nx, ny, flat(a), flat(b), flat(c));
+            }
+            let n = under.iter().filter(|v| v.is_finite()).count();
+            let both = (0..h.len())
+                .filter(|&i| covered[i] && under[i].is_finite())
+                .count();
+            if n == 0 {
+                1.0
+            } else {
+                both as f64 / n as f64
+            }
+        };
+        let vals: Vec<f64> = h.iter().copied().filter(|v| v.is_finite()).collect();
+        if vals.is_empty() {
+            return Ok(None);
+        }
+        let hmin = vals.iter().copied().fold(f64::INFINITY, f64::min);
+        let hmax = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let hmean = vals.iter().sum::<f64>() / vals.len() as f64;
+        // Continue past the footprint: nearest covered value (breadth first), then relaxed
+        // towards the mean of the neighbours, covered cells held.
+        let mut queue: VecDeque<usize> = (0..h.len()).filter(|&i| covered[i]).collect();
+        while let Some(i) = queue.pop_front() {
+            let (x, y) = (i % nx, i / nx);
+            let v = h[i];
+            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let (a, b) = (x as i64 + dx, y as i64 + dy);
+                if a < 0 || b < 0 || a >= nx as i64 || b >= ny as i64 {
+                    continue;
+                }
+                let j = b as usize * nx + a as usize;
+                if !h[j].is_finite() {
+                    h[j] = v;
+                    queue.push_back(j);
+                }
+            }
+        }
+        for _ in 0..40 {
+            let prev = h.clone();
+            for y in 0..ny {
+                for x in 0..nx {
+                    let i = y * nx + x;
+                    if covered[i] {
+                        continue;
+                    }
+                    let (mut s, mut k) = (0.0, 0.0);
+                    for (a, b) in [
+                        (x.wrapping_sub(1), y),
+                        (x + 1, y),
+                        (x, y.wrapping_sub(1)),
+                        (x, y + 1),
+                    ] {
+                        if a < nx && b < ny {
+                            s += prev[b * nx + a];
+                            k += 1.0;
+                        }
+                    }
+                    h[i] = s / k;
+                }
+            }
+        }
+        Ok(Some(TopField {
+            origin,
+            cell,
+            nx,
+            ny,
+            h,
+            range: (hmin, hmean, hmax),
+            overlap,
+        }))
+    }
+
+    /// `h_T(q)`, mm: bilinear between cell centres, held at the grid's edge beyond it.
+    pub fn height(&self, q: Point2) -> f64 {
+        let fx = ((q[0] - self.origin[0]) / self.cell - 0.5).clamp(0.0, (self.nx - 1) as f64);
+        let fy = ((q[1] - self.origin[1]) / self.cell - 0.5).clamp(0.0, (self.ny - 1) as f64);
+        if !(fx.is_finite() && fy.is_finite()) {
+            return self.range.1;
+        }
+        let (x0, y0) = (fx.floor() as usize, fy.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(self.nx - 1), (y0 + 1).min(self.ny - 1));
+        let (tx, ty) = (fx - x0 as f64, fy - y0 as f64);
+        let at = |x: usize, y: usize| self.h[y * self.nx + x];
+        let a = at(x0, y0) * (1.0 - tx) + at(x1, y0) * tx;
+        let b = at(x0, y1) * (1.0 - tx) + at(x1, y1) * tx;
+        a * (1.0 - ty) + b * ty
+    }
+}
+
+/// The meshes as one triangle list (one face triangulation).
+fn merge(pieces: &[Mesh]) -> Mesh {
+    let mut positions = vec![];
+    let mut triangles = vec![];
+    for m in pieces {
+        let base = positions.len() as u32;
+        positions.extend(m.positions.iter().copied());
+        triangles.extend(m.triangles().into_iter().map(|t| t.map(|k| k + base)));
+    }
+    let n = positions.len();
+    Mesh {
+        positions,
+        faces: vec![FaceTriangulation {
+            face: pieces
+                .first()
+                .and_then(|m| m.faces.first())
+                .map(|f| f.face)
+                .unwrap_or(FaceId(0)),
+            uv: vec![[0.0, 0.0]; n],
+            vertex: (0..n as u32).collect(),
+            triangles,
+        }],
+        edge_points: Default::default(),
+        edge_params: Default::default(),
+    }
+}
+
+/// Keeps only the vertices a mesh's triangles use (one face triangulation).
+fn compact(m: &Mesh) -> Mesh {
+    let tris = m.triangles();
+    let mut map = vec![u32::MAX; m.positions.len()];
+    let mut positions = vec![];
+    let mut out = Vec::with_capacity(tris.len());
+    for t in tris {
+        out.push(t.map(|k| {
+            let k = k as usize;
+            if map[k] == u32::MAX {
+                map[k] = positions.len() as u32;
+                positions.push(m.positions[k]);
+            }
+            map[k]
+        }));
+    }
+    let n = positions.len();
+    Mesh {
+        positions,
+        faces: vec![FaceTriangulation {
+            face: m.faces.first().map(|f| f.face).unwrap_or(FaceId(0)),
+            uv: vec![[0.0, 0.0]; n],
+            vertex: (0..n as u32).collect(),
+            triangles: out,
+        }],
+        edge_points: Default::default(),
+        edge_params: Default::default(),
+    }
+}
+
+/// Writes the triangle's `d` (its `z`) into the cells whose centres it covers, keeping the
+/// greatest.
+#[allow(clippy::too_many_arguments)]
+fn raster(h: &mut [f64], origin: Point2, cell: f64, nx: usize, ny: usize, a: P3, b: P3, c: P3) {
+    let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if det.abs() < 1e-12 {
+        return;
+    }
+    let ix = |x: f64| ((x - origin[0]) / cell - 0.5).max(0.0);
+    let iy = |y: f64| ((y - origin[1]) / cell - 0.5).max(0.0);
+    let x0 = ix(a.x.min(b.x).min(c.x)).floor() as usize;
+    let x1 = (ix(a.x.max(b.x).max(c.x)).ceil() as usize).min(nx - 1);
+    let y0 = iy(a.y.min(b.y).min(c.y)).floor() as usize;
+    let y1 = (iy(a.y.max(b.y).max(c.y)).ceil() as usize).min(ny - 1);
+    let eps = 1e-9;
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let px = origin[0] + (x as f64 + 0.5) * cell;
+            let py = origin[1] + (y as f64 + 0.5) * cell;
+            let l1 = ((b.x - px) * (c.y - py) - (c.x - px) * (b.y - py)) / det;
+            let l2 = ((c.x - px) * (a.y - py) - (a.x - px) * (c.y - py)) / det;
+            let l3 = 1.0 - l1 - l2;
+            if l1 >= -eps && l2 >= -eps && l3 >= -eps {
+                let d = l1 * a.z + l2 * b.z + l3 * c.z;
+                let i = y * nx + x;
+                if d > h[i] {
+                    h[i] = d;
+                }
+            }
+        }
+    }
+}
+
+/// How many transition layers a feature gets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Levels {
+    /// The top is an offset of the reference within the tolerance: offset layers are exact.
+    Offset,
+    /// N transition layers.
+    Transition(usize),
+    /// No N keeps every point's thickness within the bounds: `(lo, hi)` is the range N must
+    /// lie in (`lo > hi`).
+    Infeasible(usize, usize),
+}
+
+/// The least share of its base a top must cover for transition layers along the reference's
+/// normals to be a morph of the feature (see [`TopField::overlap`]).
+pub(crate) const MIN_OVERLAP: f64 = 0.5;
+
+/// The number of transition layers for base-to-top distances `range` (least, mean, greatest):
+/// see the module documentation.
+pub(crate) fn levels(range: (f64, f64, f64), params: &LayerParams) -> Levels {
+    let (hmin, hmean, hmax) = range;
+    if hmax - hmin <= params.tolerance {
+        return Levels::Offset;
+    }
+    let lo = ((hmax / params.max_layer_height) - 1e-9).ceil().max(1.0) as usize;
+    let hi = ((hmin / params.min_layer_height) + 1e-9).floor().max(0.0) as usize;
+    if lo > hi {
+        return Levels::Infeasible(lo, hi);
+    }
+    let want = (hmean / params.uniform_layer_height).round().max(1.0) as usize;
+    Levels::Transition(want.clamp(lo, hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_keep_thickness_bounds_and_aim_at_the_layer_height() {
+        let p = LayerParams::default();
+        // 7..11 mm, mean 9: N = 45 is within [ceil(11/0.3), floor(7/0.1)] = [37, 70].
+        assert_eq!(levels((7.0, 9.0, 11.0), &p), Levels::Transition(45));
+        // An offset top.
+        assert_eq!(levels((5.0, 5.0, 5.02), &p), Levels::Offset);
+        // 1..10 mm: N would have to be at least 34 and at most 10.
+        assert_eq!(levels((1.0, 5.0, 10.0), &p), Levels::Infeasible(34, 10));
+        // 2..5 mm, mean 3.5: 18 wanted, at most 20, at least 17.
+        assert_eq!(levels((2.0, 3.5, 5.0), &p), Levels::Transition(18));
+        // Thick target clamped to the thinnest allowed N.
+        let q = LayerParams {
+            uniform_layer_height: 0.5,
+            ..p
+        };
+        assert_eq!(levels((3.0, 4.0, 6.0), &q), Levels::Transition(20));
+    }
+}

@@ -1,0 +1,319 @@
+//! Transition layers (issue 17; Isa & Lazoglu 2019, Eq. 1 and 4): checked on every print point
+//! against the fixtures' exact faces, not against the planner's own top field: thickness within
+//! its bounds, the last layer on the top, each layer resting on the one below, volume.
+
+use brep::math::{P3, V3};
+use brep::mesh::{mesh_faces, Mesh, MeshOptions};
+mod support;
+
+use features::{FeatureKind, FeatureTree};
+use slicer::freeform::plan_freeform;
+use slicer::params::{LayerParams, LayerStrategy};
+use slicer::planar::Bead;
+use slicer::toolpath::{MoveKind, PathPoint};
+use std::collections::HashMap;
+use support::tree;
+
+const BEAD: Bead = Bead {
+    width: 0.45,
+    filament_diameter: 1.75,
+};
+
+/// The distance from `p` to the nearest triangle of `mesh`, and that triangle's unit normal.
+fn nearest_triangle(mesh: &Mesh, p: &P3) -> (f64, V3) {
+    let seg = |a: &P3, b: &P3| {
+        let ab = b - a;
+        let t = ((p - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+        (p - (a + ab * t)).norm()
+    };
+    let mut best = (f64::INFINITY, V3::z());
+    for t in mesh.triangles() {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let nrm = (b - a).cross(&(c - a));
+        if nrm.norm() < 1e-15 {
+            continue;
+        }
+        let nu = nrm / nrm.norm();
+        let h = (p - a).dot(&nu);
+        let q = p - nu * h;
+        let inside = [(a, b), (b, c), (c, a)]
+            .iter()
+            .all(|(u, v)| (v - u).cross(&(q - u)).dot(&nrm) >= 0.0);
+        let d = if inside {
+            h.abs()
+        } else {
+            seg(&a, &b).min(seg(&b, &c)).min(seg(&c, &a))
+        };
+        if d < best.0 {
+            best = (d, nu);
+        }
+    }
+    best
+}
+
+/// Print points of one layer on a hash grid, for the nearest one to a query.
+struct Grid {
+    cell: f64,
+    cells: HashMap<(i64, i64, i64), Vec<P3>>,
+}
+
+impl Grid {
+    fn new(points: impl Iterator<Item = P3>, cell: f64) -> Grid {
+        let mut cells: HashMap<(i64, i64, i64), Vec<P3>> = HashMap::new();
+        for p in points {
+            let k = (
+                (p.x / cell).floor() as i64,
+                (p.y / cell).floor() as i64,
+                (p.z / cell).floor() as i64,
+            );
+            cells.entry(k).or_default().push(p);
+        }
+        Grid { cell, cells }
+    }
+
+    /// Points within one cell's reach of `p`.
+    fn near(&self, p: &P3) -> Vec<P3> {
+        let c = |x: f64| (x / self.cell).floor() as i64;
+        let mut out = vec![];
+        for a in c(p.x) - 1..=c(p.x) + 1 {
+            for b in c(p.y) - 1..=c(p.y) + 1 {
+                for d in c(p.z) - 1..=c(p.z) + 1 {
+                    if let Some(v) = self.cells.get(&(a, b, d)) {
+                        out.extend(v.iter().filter(|q| (*q - p).norm() <= self.cell));
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Plans freeform feature `id` of `name` with the default process (layer_strategy = auto),
+/// asserts it got transition layers, and checks the issue's properties on every print point.
+fn check_transition(name: &str, id: usize) {
+    let t: FeatureTree = tree(name);
+    let f = &t.features[id];
+    assert_eq!(f.kind, FeatureKind::Freeform, "{name} feature {id}");
+    let params = LayerParams::default();
+    let plan = plan_freeform(&t, f, &params, BEAD, None)
+        .unwrap_or_else(|e| panic!("{name} feature {id}: {e}"));
+    let ff = plan.freeform.expect("freeform figures");
+    assert_eq!(
+        ff.layers, "transition",
+        "{name} feature {id}: auto chose offset layers"
+    );
+    let pts: Vec<PathPoint> = plan.points.clone();
+    let prints: Vec<&PathPoint> = pts.iter().filter(|p| p.kind == MoveKind::Print).collect();
+    assert!(
+        prints.len() > 100,
+        "{name} feature {id}: too few print points"
+    );
+    // Thickness bounds, unit axes.
+    for p in &prints {
+        assert!(
+            p.thickness >= params.min_layer_height - 1e-9
+                && p.thickness <= params.max_layer_height + 1e-9,
+            "{name} feature {id}: thickness {} outside [{}, {}]",
+            p.thickness,
+            params.min_layer_height,
+            params.max_layer_height
+        );
+        let a = V3::from(p.axis);
+        assert!((a.norm() - 1.0).abs() < 1e-6, "axis not unit");
+    }
+    // The top: the feature's faces other than its healing faces and its sides, i.e. those
+    // its last layer's points lie on. Meshed finely, independently of the planner.
+    let faces: Vec<_> = f
+        .faces
+        .iter()
+        .copied()
+        .filter(|x| !f.heal_faces.contains(x))
+        .collect();
+    let shells: Vec<Mesh> = faces
+        .iter()
+        .map(|x| mesh_faces(&t.brep, &[*x], &MeshOptions::with_tolerance(0.005)).expect("meshes"))
+        .collect();
+    let last = prints.iter().map(|p| p.layer).max().expect("layers");
+    let (mut worst, mut worst_axis, mut interior) = (0.0f64, 0.0f64, 0usize);
+    for p in prints.iter().filter(|p| p.layer == last) {
+        let x = P3::from(p.p);
+        // The nearest face and how far the next one is (a side, near the top's edge).
+        let mut near: Vec<(f64, usize)> = shells
+            .iter()
+            .enumerate()
+            .map(|(k, m)| (nearest_triangle(m, &x).0, k))
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (d, k) = near[0];
+        let side = near.get(1).map_or(f64::INFINITY, |x| x.0);
+        // The exact surface's normal at the point's foot (the mesh's facets stray by degrees).
+        let s = t.brep.face_surface(faces[k]);
+        let (u, v) = s.project(&x, None);
+        let n = s.normal(u, v).expect("normal");
+        worst = worst.max(d);
+        assert!(
+            d <= params.tolerance,
+            "{name} feature {id}: last-layer point {x:?} lies {d:.4} mm off the top"
+        );
+        // The bead's centre, half its thickness down the axis, lies that far under the top.
+        let c = x - V3::from(p.axis) * (0.5 * p.thickness);
+        let dc = shells
+            .iter()
+            .map(|m| nearest_triangle(m, &c).0)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (dc - 0.5 * p.thickness).abs() <= params.tolerance,
+            "{name} feature {id}: last-layer bead centre {dc:.4} mm under the top, half its thickness is {:.4}",
+            0.5 * p.thickness
+        );
+        // TSN: on the top, the axis is the top's normal, a millimetre or more from its edges.
+        let ang = V3::from(p.axis)
+            .dot(&n)
+            .abs()
+            .clamp(0.0, 1.0)
+            .acos()
+            .to_degrees();
+        if side > 1.0 {
+            interior += 1;
+            worst_axis = worst_axis.max(ang);
+        }
+    }
+    assert!(
+        interior > 20,
+        "{name} feature {id}: no last-layer point on the top"
+    );
+    assert!(
+        worst_axis < 1.0,
+        "{name} feature {id}: last-layer axis {worst_axis:.2}° off the top's normal"
+    );
+    // Support: every point of layer n ≥ 1 has points of layer n − 1 within a bead's reach,
+    // and lies farther from the reference than they do.
+    let rf = f.reference.face.expect("reference face");
+    let surf = t.brep.face_surface(rf);
+    let dist = |x: &P3| {
+        let (u, v) = surf.project(x, None);
+        (x - surf.eval(u, v)).norm()
+    };
+    // Each layer's beads, sampled every 0.05 mm along its print moves.
+    let mut by_layer: HashMap<usize, Vec<P3>> = HashMap::new();
+    for w in pts.windows(2) {
+        if w[1].kind != MoveKind::Print {
+            continue;
+        }
+        let (a, b) = (P3::from(w[0].p), P3::from(w[1].p));
+        let n = ((b - a).norm() / 0.05).ceil().max(1.0) as usize;
+        let v = by_layer.entry(w[1].layer).or_default();
+        for i in 0..=n {
+            v.push(a + (b - a) * (i as f64 / n as f64));
+        }
+    }
+    let reach = params.max_layer_height + 0.5 * BEAD.width;
+    let (mut lonely, mut below, mut all) = (0usize, 0usize, 0usize);
+    for &l in by_layer.keys() {
+        if l == 0 {
+            continue;
+        }
+        let Some(under) = by_layer.get(&(l - 1)) else {
+            panic!("{name} feature {id}: layer {l} has no layer under it");
+        };
+        let grid = Grid::new(under.iter().copied(), reach);
+        for x in prints
+            .iter()
+            .filter(|p| p.layer == l)
+            .map(|p| P3::from(p.p))
+        {
+            let x = &x;
+            all += 1;
+            let near = grid.near(x);
+            if near.is_empty() {
+                lonely += 1;
+                continue;
+            }
+            let top_under = near.iter().map(&dist).fold(f64::NEG_INFINITY, f64::max);
+            if dist(x) < top_under - 1e-3 {
+                below += 1;
+            }
+        }
+    }
+    assert!(
+        (lonely as f64) < 0.01 * all as f64,
+        "{name} feature {id}: {lonely} of {all} points with nothing of the layer below within {reach} mm"
+    );
+    assert_eq!(
+        below, 0,
+        "{name} feature {id}: {below} points lie under the layer below"
+    );
+    // Volume (Eq. 1 with each point's thickness).
+    let area = std::f64::consts::PI * BEAD.filament_diameter.powi(2) / 4.0;
+    let extruded: f64 = prints.iter().map(|p| p.e).sum::<f64>() * area;
+    let err = extruded / f.volume - 1.0;
+    assert!(
+        err.abs() <= 0.02,
+        "{name} feature {id}: extruded {extruded:.1} mm³ for {:.1} mm³ ({:+.2} %)",
+        f.volume,
+        100.0 * err
+    );
+    eprintln!(
+        "{name} feature {id}: {} layers, thickness {:.3}..{:.3} mm, last layer ≤ {worst:.4} mm off the top, axis ≤ {worst_axis:.2}° off its normal, volume {:+.2} %",
+        plan.layers.len(),
+        plan.figures.thickness.0,
+        plan.figures.thickness.2,
+        100.0 * err
+    );
+}
+
+#[test]
+fn domed_pad_transition_layers_end_on_its_spherical_top() {
+    check_transition("domed_pad", 1);
+}
+
+#[test]
+fn sphere_boss_transition_layers_morph_the_sphere_into_the_flat_top() {
+    check_transition("sphere_boss", 1);
+}
+
+#[test]
+fn capsule_bosses_get_transition_layers() {
+    let t = tree("capsule");
+    for f in t
+        .features
+        .iter()
+        .filter(|f| f.kind == FeatureKind::Freeform)
+    {
+        check_transition("capsule", f.id);
+    }
+}
+
+#[test]
+fn a_top_too_close_to_the_base_somewhere_keeps_offset_layers_or_is_refused_when_forced() {
+    // Impeller blade: its tip lies 2.9 to 11 mm over the hub along the hub's normals, a ratio
+    // over max_layer_height / min_layer_height = 3, and it leans over its root.
+    let t = tree("impeller");
+    let f = t
+        .features
+        .iter()
+        .find(|f| f.kind == FeatureKind::Freeform)
+        .expect("a blade");
+    let auto = plan_freeform(&t, f, &LayerParams::default(), BEAD, None).expect("plans");
+    assert_eq!(auto.freeform.expect("figures").layers, "offset");
+    assert!(
+        auto.figures
+            .warnings
+            .iter()
+            .any(|w| w.contains("offset layers, not transition layers")),
+        "{:?}",
+        auto.figures.warnings
+    );
+    let forced = LayerParams {
+        layer_strategy: LayerStrategy::Transition,
+        ..LayerParams::default()
+    };
+    let e = plan_freeform(&t, f, &forced, BEAD, None)
+        .map(|_| ())
+        .expect_err("forced transition layers are refused");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("min_layer_height") && msg.contains("max_layer_height"),
+        "{msg}"
+    );
+}
