@@ -43,6 +43,7 @@
 use brep::math::{Aabb, P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
 use features::{extract, ExtractOptions, FeatureKind};
+use slicer::params::{LayerParamsPatch, LayerStrategy};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -64,6 +65,8 @@ const GROW: f64 = 2.0;
 const FAR: f64 = 20.0;
 /// Face-interior samples lie farther than this from every edge of their face, mm.
 const EDGE: f64 = 1.0;
+/// Top-face samples count (issue 17) farther than this from every edge of their face, mm.
+const TOP_EDGE: f64 = 0.3;
 /// Distances to a face's edges are measured up to this, mm.
 const EDGE_CAP: f64 = 2.0;
 
@@ -356,6 +359,19 @@ impl Measured {
 }
 
 impl Err {
+    /// The errors at the samples of top faces farther than [`TOP_EDGE`] from their face's edges.
+    fn top_interior(&self, s: &Surface) -> Err {
+        Err {
+            each: self
+                .each
+                .iter()
+                .zip(s.edge.iter().zip(&s.top))
+                .filter(|(_, (d, top))| **d > TOP_EDGE && **top)
+                .map(|(e, _)| *e)
+                .collect(),
+        }
+    }
+
     /// The errors at the samples farther than [`EDGE`] from their face's edges.
     fn interior(&self, s: &Surface) -> Err {
         Err {
@@ -406,6 +422,9 @@ struct Surface {
     edge: Vec<f64>,
     /// STEP id of each sample's face (the first one for a vertex on an edge).
     face: Vec<u64>,
+    /// Whether each sample's face is a top face: its samples' mean normal within 60° of the
+    /// reference surface's normal into the feature (the planner's rule for T, issue 17).
+    top: Vec<bool>,
     bbox: Aabb,
     volume: f64,
     step_faces: Vec<u64>,
@@ -502,12 +521,38 @@ fn surfaces(step: &Path) -> Result<(Vec<Surface>, f64), String> {
         normal.extend(c_normal);
         edge.extend(c_edge);
         face.extend(c_face);
+        // Top faces: the reference's normal at each sample's foot, turned into the feature.
+        let rf = f
+            .reference
+            .face
+            .ok_or(format!("feature {}: no reference face", f.id))?;
+        let rs = tree.brep.face_surface(rf);
+        let feet: Vec<(V3, V3)> = samples
+            .iter()
+            .map(|p| {
+                let (u, v) = rs.project(p, None);
+                (p - rs.eval(u, v), rs.normal(u, v).unwrap_or_else(V3::z))
+            })
+            .collect();
+        let side: f64 = feet.iter().map(|(r, n)| r.dot(n)).sum();
+        let sign = if side < 0.0 { -1.0 } else { 1.0 };
+        let mut by_face: HashMap<u64, (f64, usize)> = HashMap::new();
+        for ((fid, n), (_, rn)) in face.iter().zip(&normal).zip(&feet) {
+            let e = by_face.entry(*fid).or_default();
+            e.0 += sign * n.dot(rn);
+            e.1 += 1;
+        }
+        let top = face
+            .iter()
+            .map(|fid| by_face.get(fid).is_some_and(|(s, n)| *s >= 0.5 * *n as f64))
+            .collect();
         out.push(Surface {
             id: f.id,
             samples,
             normal,
             edge,
             face,
+            top,
             bbox: mesh.bbox(),
             volume: f.volume,
             step_faces: f.step_faces(&tree.brep),
@@ -523,11 +568,14 @@ struct Ours {
     volume: HashMap<usize, f64>,
     /// STEP face ids by feature id.
     faces: HashMap<usize, Vec<u64>>,
+    /// The layers each freeform feature got (`offset` or `transition`), by feature id.
+    layers: HashMap<usize, String>,
     seconds: f64,
 }
 
-/// Plans `step` for the built-in 5-axis printer with the planner library (no files written).
-fn run_ours(step: &Path) -> Result<Ours, String> {
+/// Plans `step` for the built-in 5-axis printer with the planner library (no files written),
+/// every feature's `layer_strategy` set to `strategy`.
+fn run_ours(step: &Path, strategy: LayerStrategy) -> Result<Ours, String> {
     let t = Instant::now();
     let part = brep::read_step(step).map_err(|e| format!("{}: {e}", step.display()))?;
     let machine = robot_post::MachineProfile::builtin(robot_post::MachineKind::Delta5);
@@ -537,7 +585,12 @@ fn run_ours(step: &Path) -> Result<Ours, String> {
         allow_collisions: true,
         ..Default::default()
     };
-    let planned = plan::plan(&part, &plan::Process::default(), &machine, &options)
+    let mut process = plan::Process::default();
+    process.defaults = Some(LayerParamsPatch {
+        layer_strategy: Some(strategy),
+        ..Default::default()
+    });
+    let planned = plan::plan(&part, &process, &machine, &options)
         .map_err(|e| format!("{}: features plan failed: {e}", step.display()))?;
     let seconds = t.elapsed().as_secs_f64();
     let mut segs = vec![];
@@ -555,7 +608,11 @@ fn run_ours(step: &Path) -> Result<Ours, String> {
     }
     let mut volume = HashMap::new();
     let mut faces = HashMap::new();
+    let mut layers = HashMap::new();
     for f in planned.features() {
+        if let Some(ff) = &f.freeform {
+            layers.insert(f.feature.id, ff.layer_strategy.clone());
+        }
         volume.insert(f.feature.id, f.extruded_volume_mm3);
         let mut fs = f.feature.faces.clone();
         fs.sort_unstable();
@@ -565,6 +622,7 @@ fn run_ours(step: &Path) -> Result<Ours, String> {
         segs,
         volume,
         faces,
+        layers,
         seconds,
     })
 }
@@ -734,6 +792,9 @@ struct Row {
     cad_volume: f64,
     ours_s: Option<f64>,
     prusa_s: Option<f64>,
+    /// Envelope errors at the top faces' interior samples, ours and PrusaSlicer's.
+    ours_top: Option<Err>,
+    prusa_top: Option<Err>,
 }
 
 fn fmt_opt(v: Option<f64>, prec: usize) -> String {
@@ -812,6 +873,45 @@ fn print_table(rows: &[Row]) {
     );
 }
 
+/// The issue-17 figure: the envelope gap on the top faces' interiors (samples of faces whose
+/// normal is within 60° of the reference's, farther than [`TOP_EDGE`] from their edges).
+fn print_top_table(rows: &[Row]) {
+    println!();
+    println!(
+        "{:<20} {:<16} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>7}",
+        "top faces, interior", "", "ours", "", "", "prusa", "", "", "samples"
+    );
+    println!(
+        "{:<20} {:<16} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>7}",
+        "part/plan", "feature layers", "max", "p95", "mean", "max", "p95", "mean", ""
+    );
+    println!("{}", "-".repeat(92));
+    for r in rows {
+        let Some(o) = r.ours_top.as_ref().filter(|o| !o.each.is_empty()) else {
+            continue;
+        };
+        let p = r.prusa_top.as_ref().filter(|p| !p.each.is_empty());
+        println!(
+            "{:<20} {:<16} | {:>6.3} {:>6.3} {:>6.3} | {:>6} {:>6} {:>6} | {:>7}",
+            r.part,
+            r.feature,
+            o.max(),
+            o.quantile(0.95),
+            o.mean(),
+            fmt_opt(p.map(Err::max), 3),
+            fmt_opt(p.map(|p| p.quantile(0.95)), 3),
+            fmt_opt(p.map(Err::mean), 3),
+            o.each.len()
+        );
+    }
+    println!(
+        "envelope gap in mm (0 inside a bead); plan `offset`: every freeform feature on offset \
+         layers; `transition`: every one on transition layers; `auto` where the planner refused \
+         those: its own choice per feature (the feature column says which); goal (issue 17): \
+         max <= 0.03, p95 <= 0.025 with transition layers"
+    );
+}
+
 fn print_envelope_table(rows: &[Row]) {
     println!();
     println!(
@@ -886,17 +986,6 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
         println!("{name}: no freeform features");
         return Ok(());
     }
-    let ours = run_ours(step)?;
-    for s in &surfs {
-        match ours.faces.get(&s.id) {
-            Some(f) if *f == s.step_faces => {}
-            _ => println!(
-                "{name}: warning: feature {} of the extraction and of plan.json differ in faces",
-                s.id
-            ),
-        }
-    }
-
     let stl = dir.join(format!("{name}.stl"));
     prusa::mesh_stl(&exe, step, &stl)?;
     let prusa = match run_prusa(&stl, &dir.join(format!("{name}.gcode"))) {
@@ -911,114 +1000,152 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
         }
     };
 
-    let mut total_ours = Err::default();
-    let mut total_prusa = Err::default();
-    let mut totals: [Err; 4] = Default::default();
-    let mut ff_volume = 0.0;
-    let mut ff_cad = 0.0;
-    // Every sample's errors, for a look at where they are.
+    // Offset layers, then transition layers on every freeform feature; where the planner refuses
+    // those (a top too close to the base somewhere for the thickness bounds), what `auto` gives.
     let mut dump = String::from(
-        "feature,x,y,z,ours,prusa,face,edge_mm,nx,ny,nz,ours_env,prusa_env,ours_axis_cos\n",
+        "plan,feature,x,y,z,ours,prusa,face,edge_mm,nx,ny,nz,ours_env,prusa_env,ours_axis_cos,top\n",
     );
-    for s in &surfs {
-        let om = Measured::new(s, &ours.segs);
-        let pm = prusa.as_ref().map(|p| Measured::new(s, &p.segs));
-        let o = om.centre.clone();
-        let p = pm.as_ref().map(|m| m.centre.clone());
-        for (i, q) in s.samples.iter().enumerate() {
-            let pe = p
-                .as_ref()
-                .map_or(String::new(), |p| format!("{:.4}", p.each[i]));
-            let pv = pm
-                .as_ref()
-                .map_or(String::new(), |p| format!("{:.4}", p.envelope.each[i]));
-            let n = s.normal[i];
-            dump.push_str(&format!(
-                "{},{:.4},{:.4},{:.4},{:.4},{pe},{},{:.4},{:.4},{:.4},{:.4},{:.4},{pv},{:.4}\n",
-                s.id,
-                q.x,
-                q.y,
-                q.z,
-                o.each[i],
-                s.face[i],
-                s.edge[i],
-                n.x,
-                n.y,
-                n.z,
-                om.envelope.each[i],
-                om.axis_cos[i]
-            ));
+    for strategy in [LayerStrategy::Offset, LayerStrategy::Transition] {
+        let (label, ours) = match (strategy, run_ours(step, strategy)) {
+            (LayerStrategy::Offset, r) => ("offset", r?),
+            (_, Ok(o)) => ("transition", o),
+            (_, Err(e)) => {
+                println!(
+                    "{name}: transition layers refused ({e}); measuring layer_strategy = auto"
+                );
+                ("auto", run_ours(step, LayerStrategy::Auto)?)
+            }
+        };
+        for s in &surfs {
+            match ours.faces.get(&s.id) {
+                Some(f) if *f == s.step_faces => {}
+                _ => println!(
+                    "{name}: warning: feature {} of the extraction and of plan.json differ in faces",
+                    s.id
+                ),
+            }
         }
-        let oi = om.envelope.interior(s);
-        let pi = pm.as_ref().map(|m| m.envelope.interior(s));
-        totals[0].merge(&om.envelope);
-        totals[2].merge(&oi);
-        if let Some(m) = &pm {
-            totals[1].merge(&m.envelope);
+
+        let mut total_ours = Err::default();
+        let mut total_prusa = Err::default();
+        let mut totals: [Err; 4] = Default::default();
+        let mut ff_volume = 0.0;
+        let mut ff_cad = 0.0;
+        let mut totals_top: [Err; 2] = Default::default();
+        let part = format!("{name}/{label}");
+        for s in &surfs {
+            let om = Measured::new(s, &ours.segs);
+            let pm = prusa.as_ref().map(|p| Measured::new(s, &p.segs));
+            let o = om.centre.clone();
+            let p = pm.as_ref().map(|m| m.centre.clone());
+            for (i, q) in s.samples.iter().enumerate() {
+                let pe = p
+                    .as_ref()
+                    .map_or(String::new(), |p| format!("{:.4}", p.each[i]));
+                let pv = pm
+                    .as_ref()
+                    .map_or(String::new(), |p| format!("{:.4}", p.envelope.each[i]));
+                let n = s.normal[i];
+                dump.push_str(&format!(
+                    "{label},{},{:.4},{:.4},{:.4},{:.4},{pe},{},{:.4},{:.4},{:.4},{:.4},{:.4},{pv},{:.4},{}\n",
+                    s.id,
+                    q.x,
+                    q.y,
+                    q.z,
+                    o.each[i],
+                    s.face[i],
+                    s.edge[i],
+                    n.x,
+                    n.y,
+                    n.z,
+                    om.envelope.each[i],
+                    om.axis_cos[i],
+                    u8::from(s.top[i])
+                ));
+            }
+            let oi = om.envelope.interior(s);
+            let pi = pm.as_ref().map(|m| m.envelope.interior(s));
+            let ot = om.envelope.top_interior(s);
+            let pt = pm.as_ref().map(|m| m.envelope.top_interior(s));
+            totals_top[0].merge(&ot);
+            if let Some(m) = &pt {
+                totals_top[1].merge(m);
+            }
+            totals[0].merge(&om.envelope);
+            totals[2].merge(&oi);
+            if let Some(m) = &pm {
+                totals[1].merge(&m.envelope);
+            }
+            if let Some(m) = &pi {
+                totals[3].merge(m);
+            }
+            total_ours.merge(&o);
+            if let Some(p) = &p {
+                total_prusa.merge(p);
+            }
+            let v = ours.volume.get(&s.id).copied().unwrap_or(0.0);
+            ff_volume += v;
+            ff_cad += s.volume;
+            let layers = ours.layers.get(&s.id).map_or("?", |l| l.as_str());
+            rows.push(Row {
+                part: part.clone(),
+                feature: format!("{} {layers}", s.id),
+                ours: Some(o),
+                prusa: p,
+                ours_env: Some(om.envelope),
+                prusa_env: pm.map(|m| m.envelope),
+                ours_int: Some(oi),
+                prusa_int: pi,
+                ours_volume: v,
+                prusa_volume: None,
+                cad_volume: s.volume,
+                ours_s: None,
+                prusa_s: None,
+                ours_top: Some(ot),
+                prusa_top: pt,
+            });
         }
-        if let Some(m) = &pi {
-            totals[3].merge(m);
-        }
-        total_ours.merge(&o);
-        if let Some(p) = &p {
-            total_prusa.merge(p);
-        }
-        let v = ours.volume.get(&s.id).copied().unwrap_or(0.0);
-        ff_volume += v;
-        ff_cad += s.volume;
         rows.push(Row {
-            part: name.clone(),
-            feature: format!("{} freeform", s.id),
-            ours: Some(o),
-            prusa: p,
-            ours_env: Some(om.envelope),
-            prusa_env: pm.map(|m| m.envelope),
-            ours_int: Some(oi),
-            prusa_int: pi,
-            ours_volume: v,
+            part: part.clone(),
+            feature: "all freeform".into(),
+            ours: Some(total_ours),
+            prusa: prusa.as_ref().map(|_| total_prusa.clone()),
+            ours_env: Some(totals[0].clone()),
+            prusa_env: prusa.as_ref().map(|_| totals[1].clone()),
+            ours_int: Some(totals[2].clone()),
+            prusa_int: prusa.as_ref().map(|_| totals[3].clone()),
+            ours_volume: ff_volume,
             prusa_volume: None,
-            cad_volume: s.volume,
+            cad_volume: ff_cad,
             ours_s: None,
             prusa_s: None,
+            ours_top: Some(totals_top[0].clone()),
+            prusa_top: prusa.as_ref().map(|_| totals_top[1].clone()),
+        });
+        rows.push(Row {
+            part,
+            feature: "whole part".into(),
+            ours: None,
+            prusa: None,
+            ours_env: None,
+            prusa_env: None,
+            ours_int: None,
+            prusa_int: None,
+            ours_volume: ours.volume.values().sum(),
+            prusa_volume: prusa.as_ref().map(|p| p.volume),
+            cad_volume: part_volume,
+            ours_s: Some(ours.seconds),
+            prusa_s: prusa.as_ref().map(|p| p.seconds),
+            ours_top: None,
+            prusa_top: None,
         });
     }
-    rows.push(Row {
-        part: name.clone(),
-        feature: "all freeform".into(),
-        ours: Some(total_ours),
-        prusa: prusa.as_ref().map(|_| total_prusa.clone()),
-        ours_env: Some(totals[0].clone()),
-        prusa_env: prusa.as_ref().map(|_| totals[1].clone()),
-        ours_int: Some(totals[2].clone()),
-        prusa_int: prusa.as_ref().map(|_| totals[3].clone()),
-        ours_volume: ff_volume,
-        prusa_volume: None,
-        cad_volume: ff_cad,
-        ours_s: None,
-        prusa_s: None,
-    });
-    rows.push(Row {
-        part: name.clone(),
-        feature: "whole part".into(),
-        ours: None,
-        prusa: None,
-        ours_env: None,
-        prusa_env: None,
-        ours_int: None,
-        prusa_int: None,
-        ours_volume: ours.volume.values().sum(),
-        prusa_volume: prusa.as_ref().map(|p| p.volume),
-        cad_volume: part_volume,
-        ours_s: Some(ours.seconds),
-        prusa_s: prusa.as_ref().map(|p| p.seconds),
-    });
     let dump_path = dir.join("errors.csv");
     std::fs::write(&dump_path, dump).map_err(|e| format!("{}: {e}", dump_path.display()))?;
     let samples: usize = surfs.iter().map(|s| s.samples.len()).sum();
     println!(
-        "{name}: {} freeform feature(s), {samples} surface samples, {} of our segments, {} of PrusaSlicer's",
+        "{name}: {} freeform feature(s), {samples} surface samples, {} of PrusaSlicer's segments",
         surfs.len(),
-        ours.segs.len(),
         fmt_opt(prusa.as_ref().map(|p| p.segs.len() as f64), 0)
     );
     Ok(())
@@ -1038,7 +1165,7 @@ fn main() {
         })
         .collect();
     if parts.is_empty() {
-        parts = ["impeller", "fan"]
+        parts = ["impeller", "fan", "domed_pad"]
             .iter()
             .map(|n| root.join("fixtures").join(format!("{n}.step")))
             .collect();
@@ -1060,6 +1187,7 @@ fn main() {
     }
     print_table(&rows);
     print_envelope_table(&rows);
+    print_top_table(&rows);
     println!("(files in {})", tmp.display());
     if failed {
         std::process::exit(1);

@@ -39,8 +39,9 @@ use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
 use crate::lift::{lift, Lifted};
-use crate::params::{LayerParams, LayerStrategy, PathMode};
+use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
+use crate::sst::{Sides, WALL_REACH};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
 use crate::transition::{levels, Levels, TopField, MIN_OVERLAP};
@@ -96,6 +97,8 @@ pub struct FreeformFill<'a> {
     tops: Vec<(f64, f64)>,
     /// Transition layers: the top's distance field and the number of layers N.
     blend: Option<(TopField, usize)>,
+    /// `wall_orientation = "sst"`: the side faces, for Eq. 3's axes on wall beads.
+    sides: Option<Sides>,
     /// Each layer's regions and fill paths in the chart.
     filled: Vec<(Vec<Region>, Vec<FillPath>)>,
     fig: FeatureFigures,
@@ -226,6 +229,9 @@ pub fn fill_freeform<'a>(
         ff.layers = "transition";
     }
     let ff = ff;
+    let sides = (params.wall_orientation == WallOrientation::Sst
+        && params.fixed_tool_axis.is_none())
+    .then(|| Sides::new(&chart, &raw, &f.heal_faces, id, 1.0));
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
@@ -301,6 +307,7 @@ pub fn fill_freeform<'a>(
         id,
         chart: base_chart,
         blend,
+        sides,
         params: params.clone(),
         bead,
         fixed,
@@ -321,6 +328,7 @@ impl FreeformFill<'_> {
             id,
             chart,
             blend,
+            sides,
             params,
             bead,
             fixed,
@@ -367,7 +375,11 @@ impl FreeformFill<'_> {
             let lifted: Vec<(Vec<Lifted>, usize)> = paths
                 .par_iter()
                 .map(|path| {
-                    let pts = lift(&chart, path, z, params.tolerance);
+                    let mut pts = lift(&chart, path, z, params.tolerance);
+                    // Wall beads: the side-surface-tangent axis (Eq. 3).
+                    if let Some(s) = &sides {
+                        crate::sst::apply(&mut pts, s, |q| thick(q, dl), WALL_REACH * bead.width);
+                    }
                     // Support: the layer below (or, under the first layer, the reference face).
                     let unheld = pts
                         .iter()

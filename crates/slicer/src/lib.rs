@@ -44,6 +44,7 @@ pub mod orient;
 pub mod params;
 pub mod planar;
 mod region_fill;
+mod sst;
 mod tolerance;
 pub mod transition;
 pub mod verify;

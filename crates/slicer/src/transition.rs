@@ -90,50 +90,13 @@ impl TopField {
             edge_points: Default::default(),
             edge_params: Default::default(),
         };
-        let mut probe = Mesh {
-            positions: vec![],
-            faces: vec![],
-            edge_points: Default::default(),
-            edge_params: Default::default(),
-        };
         for ft in &mesh.faces {
             if ft.triangles.is_empty() {
                 continue;
             }
             if heal.contains(&ft.face) {
                 base.faces.push(ft.clone());
-                continue;
-            }
-            // The face's up-share from a sample of its triangles in chart space.
-            let stride = (ft.triangles.len() / 64).max(1);
-            probe.positions.clear();
-            let mut tris: Vec<[u32; 3]> = vec![];
-            for t in ft.triangles.iter().step_by(stride) {
-                let base = probe.positions.len() as u32;
-                for &k in t {
-                    probe
-                        .positions
-                        .push(mesh.positions[ft.vertex[k as usize] as usize]);
-                }
-                tris.push([base, base + 1, base + 2]);
-            }
-            probe.faces = vec![FaceTriangulation {
-                face: ft.face,
-                uv: vec![[0.0, 0.0]; probe.positions.len()],
-                vertex: (0..probe.positions.len() as u32).collect(),
-                triangles: tris.clone(),
-            }];
-            let Ok(m) = mapped_mesh(chart, &probe, id) else {
-                continue;
-            };
-            let (mut up, mut all) = (0.0, 0.0);
-            for t in &tris {
-                let [a, b, c] = t.map(|k| m.positions[k as usize]);
-                let n = (b - a).cross(&(c - a));
-                up += n.z;
-                all += n.norm();
-            }
-            if all > 0.0 && up >= TOP_SHARE * all {
+            } else if up_share(chart, mesh, ft, id) >= TOP_SHARE {
                 top.faces.push(ft.clone());
             }
         }
@@ -304,6 +267,49 @@ fn merge(pieces: &[Mesh]) -> Mesh {
         }],
         edge_points: Default::default(),
         edge_params: Default::default(),
+    }
+}
+
+/// The `d`-share of a face's area-weighted normal in chart space (1: it faces the way the
+/// feature grows, 0: along it, −1: against it), from a sample of its triangles; 0 where they
+/// do not map.
+pub(crate) fn up_share(chart: &Chart, mesh: &Mesh, ft: &FaceTriangulation, id: usize) -> f64 {
+    let stride = (ft.triangles.len() / 64).max(1);
+    let mut positions = vec![];
+    let mut tris: Vec<[u32; 3]> = vec![];
+    for t in ft.triangles.iter().step_by(stride) {
+        let base = positions.len() as u32;
+        for &k in t {
+            positions.push(mesh.positions[ft.vertex[k as usize] as usize]);
+        }
+        tris.push([base, base + 1, base + 2]);
+    }
+    let n = positions.len();
+    let probe = Mesh {
+        positions,
+        faces: vec![FaceTriangulation {
+            face: ft.face,
+            uv: vec![[0.0, 0.0]; n],
+            vertex: (0..n as u32).collect(),
+            triangles: tris.clone(),
+        }],
+        edge_points: Default::default(),
+        edge_params: Default::default(),
+    };
+    let Ok(m) = mapped_mesh(chart, &probe, id) else {
+        return 0.0;
+    };
+    let (mut up, mut all) = (0.0, 0.0);
+    for t in &tris {
+        let [a, b, c] = t.map(|k| m.positions[k as usize]);
+        let n = (b - a).cross(&(c - a));
+        up += n.z;
+        all += n.norm();
+    }
+    if all > 0.0 {
+        up / all
+    } else {
+        0.0
     }
 }
 

@@ -317,3 +317,64 @@ fn a_top_too_close_to_the_base_somewhere_keeps_offset_layers_or_is_refused_when_
         "{msg}"
     );
 }
+
+#[test]
+fn sst_wall_axes_are_perpendicular_to_the_side_face_and_the_path() {
+    use slicer::params::WallOrientation;
+    // The domed pad's sides are four planes; its top a sphere, its base the cylinder.
+    let t = tree("domed_pad");
+    let f = &t.features[1];
+    let params = LayerParams {
+        wall_orientation: WallOrientation::Sst,
+        ..LayerParams::default()
+    };
+    let plan = plan_freeform(&t, f, &params, BEAD, None).expect("plans");
+    let sides: Vec<(Mesh, V3)> = f
+        .faces
+        .iter()
+        .filter(|x| !f.heal_faces.contains(x))
+        .filter_map(|x| match t.brep.face_surface(*x) {
+            brep::surface::Surface::Plane { .. } => {
+                let m = mesh_faces(&t.brep, &[*x], &MeshOptions::with_tolerance(0.005))
+                    .expect("meshes");
+                let tri = m.triangles()[0];
+                let [a, b, c] = tri.map(|k| m.positions[k as usize]);
+                let n = (b - a).cross(&(c - a)).normalize();
+                Some((m, n))
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(sides.len(), 4, "the pad's four planar sides");
+    let pts = &plan.points;
+    let (mut walls, mut worst_n, mut worst_t) = (0usize, 0.0f64, 0.0f64);
+    for i in 1..pts.len() - 1 {
+        let (a, p, b) = (&pts[i - 1], &pts[i], &pts[i + 1]);
+        if p.kind != MoveKind::Print || b.kind != MoveKind::Print || a.kind != MoveKind::Print {
+            continue;
+        }
+        let axis = V3::from(p.axis);
+        let centre = P3::from(p.p) - axis * (0.5 * p.thickness);
+        let mut near: Vec<(f64, V3)> = sides
+            .iter()
+            .map(|(m, n)| (nearest_triangle(m, &centre).0, *n))
+            .collect();
+        near.sort_by(|x, y| x.0.total_cmp(&y.0));
+        // A wall bead along one side, not at a corner where two meet.
+        if near[0].0 > 0.3 || near[1].0 < 0.6 {
+            continue;
+        }
+        let tangent = (P3::from(b.p) - P3::from(a.p)).normalize();
+        let off_n = axis.dot(&near[0].1).abs().asin().to_degrees();
+        let off_t = axis.dot(&tangent).abs().asin().to_degrees();
+        walls += 1;
+        worst_n = worst_n.max(off_n);
+        worst_t = worst_t.max(off_t);
+    }
+    assert!(walls > 500, "only {walls} wall beads");
+    assert!(
+        worst_n < 1.0 && worst_t < 1.0,
+        "SST axes {worst_n:.3}° off perpendicular to the side normal, {worst_t:.3}° to the path"
+    );
+    eprintln!("domed_pad SST: {walls} wall beads, axes within {worst_n:.3}° of the side plane and {worst_t:.3}° of perpendicular to the path");
+}
