@@ -204,15 +204,20 @@ impl<'a> Chart<'a> {
             blend: None,
             ..*self
         };
-        let (p, n) = plain.offset_at(q, d * top.height(q))?;
-        if d == 0.0 {
+        // Between the transition layers' start (0, or the offset layers' staircase) and the
+        // top; the normal from the staircase's smooth counterpart.
+        let level = |x: Point2, lower: f64| lower + d * (top.height(x) - lower);
+        let (p, n) = plain.offset_at(q, level(q, top.lower(q)))?;
+        if d == 0.0 && top.lower_smooth(q) == 0.0 {
             return Some((p, n));
         }
         let e = 1e-3;
         let side = |k: usize, s: f64| {
             let mut x = q;
             x[k] += s * e;
-            plain.offset_at(x, d * top.height(x)).map(|r| r.0)
+            plain
+                .offset_at(x, level(x, top.lower_smooth(x)))
+                .map(|r| r.0)
         };
         let (Some(a), Some(b), Some(c), Some(g)) =
             (side(0, 1.0), side(0, -1.0), side(1, 1.0), side(1, -1.0))
@@ -289,7 +294,10 @@ impl<'a> Chart<'a> {
         };
         // On a blended chart, the level: the distance over the top's there.
         let d = match self.blend {
-            Some(top) => d / top.height(q).max(crate::tolerance::MICROMETRE),
+            Some(top) => {
+                let lower = top.lower(q);
+                (d - lower) / (top.height(q) - lower).max(crate::tolerance::MICROMETRE)
+            }
             None => d,
         };
         (q[0].is_finite() && q[1].is_finite() && d.is_finite()).then_some((q, d))

@@ -44,7 +44,62 @@ use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INS
 use crate::sst::{Sides, WALL_REACH};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
-use crate::transition::{levels, Levels, TopField, MIN_OVERLAP};
+use crate::transition::{band, levels, Levels, TopField};
+
+/// Splits chart paths where `keep` turns false, ending each piece on the boundary (found by
+/// bisection along the segment that crosses it).
+fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPath> {
+    let cross = |a: Point2, b: Point2| {
+        // a kept, b not: the last kept point of a→b.
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..30 {
+            let m = 0.5 * (lo + hi);
+            if keep([a[0] + (b[0] - a[0]) * m, a[1] + (b[1] - a[1]) * m]) {
+                lo = m;
+            } else {
+                hi = m;
+            }
+        }
+        [a[0] + (b[0] - a[0]) * lo, a[1] + (b[1] - a[1]) * lo]
+    };
+    let mut out = vec![];
+    for p in paths {
+        let inside: Vec<bool> = p.points.iter().map(|q| keep(*q)).collect();
+        if inside.iter().all(|x| *x) {
+            out.push(p);
+            continue;
+        }
+        let mut cur = FillPath {
+            points: vec![],
+            widths: vec![],
+        };
+        for i in 0..p.points.len() {
+            if inside[i] {
+                if cur.points.is_empty() && i > 0 {
+                    cur.points.push(cross(p.points[i], p.points[i - 1]));
+                    cur.widths.push(p.widths[i]);
+                }
+                cur.points.push(p.points[i]);
+                cur.widths.push(p.widths[i]);
+            } else if !cur.points.is_empty() {
+                cur.points.push(cross(p.points[i - 1], p.points[i]));
+                cur.widths.push(p.widths[i - 1]);
+                out.push(std::mem::replace(
+                    &mut cur,
+                    FillPath {
+                        points: vec![],
+                        widths: vec![],
+                    },
+                ));
+            }
+        }
+        if cur.points.len() >= 2 {
+            out.push(cur);
+        }
+    }
+    out.retain(|p| p.points.len() >= 2);
+    out
+}
 use brep::math::{P3, V3};
 use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
@@ -95,8 +150,11 @@ pub struct FreeformFill<'a> {
     heights: Vec<f64>,
     /// Each layer's middle and top level: offsets, or morph levels with transition layers.
     tops: Vec<(f64, f64)>,
-    /// Transition layers: the top's distance field and the number of layers N.
-    blend: Option<(TopField, usize)>,
+    /// Transition layers: the top's distance field, the number N of transition layers and
+    /// the number of offset layers under them.
+    blend: Option<(TopField, usize, usize)>,
+    /// Layers `..offset_layers` are offsets of the reference; the rest transition layers.
+    offset_layers: usize,
     /// `wall_orientation = "sst"`: the side faces, for Eq. 3's axes on wall beads.
     sides: Option<Sides>,
     /// Each layer's regions and fill paths in the chart.
@@ -194,40 +252,47 @@ pub fn fill_freeform<'a>(
                     ))
                 }
                 None => None,
-                Some(field) if field.overlap < MIN_OVERLAP && !forced => {
-                    fig.warnings.push(format!(
-                        "feature {id}: offset layers, not transition layers: its top covers {:.0} % of its base along the reference's normals (it leans over), and layers morphing one into the other along them would not follow its sides",
-                        100.0 * field.overlap
-                    ));
-                    None
-                }
                 Some(field) => match levels(field.range, params) {
                     Levels::Offset => None,
-                    Levels::Transition(n) => Some((field, n)),
+                    Levels::Transition(n) => Some((field, n, 0)),
                     Levels::Infeasible(lo, hi) => {
                         let (a, _, b) = field.range;
-                        let why = format!(
-                            "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}",
-                            params.max_layer_height, params.min_layer_height
-                        );
-                        if forced {
-                            return Err(err(why));
+                        // Offset layers first, a band of transition layers for the rest.
+                        match band(field, params, bead.width) {
+                            Some(banded) => Some(banded),
+                            None => {
+                                let why = format!(
+                                    "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}, and no band of transition layers over offset layers keeps those bounds either",
+                                    params.max_layer_height, params.min_layer_height
+                                );
+                                if forced {
+                                    return Err(err(why));
+                                }
+                                fig.warnings.push(format!(
+                                    "feature {id}: offset layers, not transition layers: {why}"
+                                ));
+                                None
+                            }
                         }
-                        fig.warnings.push(format!(
-                            "feature {id}: offset layers, not transition layers: {why}"
-                        ));
-                        None
                     }
                 },
             }
         }
     };
-    if let Some((field, n)) = &blend {
-        // Nominal thicknesses for the fold check and the layers' figures; each point's is
-        // h_T(q)/N.
-        heights = vec![field.range.2 / *n as f64; *n];
-        ff.layers = "transition";
-    }
+    // Offset layers first (all of them without transition layers), then the transition layers.
+    let offset_layers = match &blend {
+        Some((field, n, k)) => {
+            // Nominal thicknesses for the fold check and the layers' figures (the thickest a
+            // point gets); each point's is its own.
+            let t = field.band_max() / *n as f64;
+            let h0 = field.band_of().map_or(0.0, |b| b.1);
+            heights = vec![h0; *k];
+            heights.extend(std::iter::repeat_n(t, *n));
+            ff.layers = "transition";
+            *k
+        }
+        None => heights.len(),
+    };
     let ff = ff;
     let sides = (params.wall_orientation == WallOrientation::Sst
         && params.fixed_tool_axis.is_none())
@@ -242,42 +307,37 @@ pub fn fill_freeform<'a>(
     // Each layer's regions and fill depend on that layer alone: computed in parallel, then
     // ordered, lifted and joined by travel one layer after the other.
     let mut tops = Vec::with_capacity(heights.len());
-    match &blend {
-        Some((_, n)) => {
-            for k in 0..*n {
-                tops.push(((k as f64 + 0.5) / *n as f64, (k + 1) as f64 / *n as f64));
-            }
-        }
-        None => {
-            for &dl in &heights {
-                tops.push((z + 0.5 * dl, z + dl));
-                z += dl;
-            }
+    for &dl in &heights[..offset_layers] {
+        tops.push((z + 0.5 * dl, z + dl));
+        z += dl;
+    }
+    if let Some((_, n, _)) = &blend {
+        for k in 0..*n {
+            tops.push(((k as f64 + 0.5) / *n as f64, (k + 1) as f64 / *n as f64));
         }
     }
-    // With transition layers the mesh is sliced at morph levels: each vertex's distance over
-    // the top's there.
-    let layer_chart = match &blend {
-        Some((field, _)) => chart.blended(field),
-        None => chart,
-    };
-    let sliced = match &blend {
-        Some((field, _)) => {
-            let mut m = mapped.clone();
-            for p in &mut m.positions {
-                p.z /= field.height([p.x, p.y]).max(MICROMETRE);
-            }
-            m
+    // Transition layers are sliced at morph levels: each vertex's place between where they
+    // start and the top over it.
+    let blended = blend.as_ref().map(|(field, _, _)| {
+        let mut m = mapped.clone();
+        for p in &mut m.positions {
+            let q = [p.x, p.y];
+            let lower = field.lower(q);
+            p.z = (p.z - lower) / (field.height(q) - lower).max(MICROMETRE);
         }
-        None => mapped,
-    };
-    let base_chart = chart;
-    let (chart, mapped) = (layer_chart, sliced);
+        (chart.blended(field), m, field)
+    });
     let filled: Vec<(Vec<Region>, Vec<FillPath>)> = tops
         .par_iter()
         .enumerate()
         .map(|(layer, &(mid, z))| {
-            let loops: Vec<Vec<Point2>> = section(&mapped, &up.offset(mid))
+            let (chart, mapped, clip) = match &blended {
+                Some((c, m, _)) if layer >= offset_layers => (c, m, None),
+                // Offset layers under a transition band: only where the band stays above.
+                Some((_, _, field)) => (&chart, &mapped, Some((*field, z))),
+                None => (&chart, &mapped, None),
+            };
+            let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
                 .iter()
                 .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
                 .collect();
@@ -289,7 +349,7 @@ pub fn fill_freeform<'a>(
             let mut paths = vec![];
             for r in &regions {
                 paths.extend(fill_region(
-                    &chart,
+                    chart,
                     r,
                     z,
                     params,
@@ -298,15 +358,20 @@ pub fn fill_freeform<'a>(
                     spacing,
                     SLIVER_INSET * bead.width,
                 ));
-                paths.extend(corner_spurs(&chart, r, z, bead.width));
+                paths.extend(corner_spurs(chart, r, z, bead.width));
+            }
+            if let Some((field, z)) = clip {
+                paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
             }
             (regions, paths)
         })
         .collect();
+    drop(blended);
     Ok(FreeformFill {
         id,
-        chart: base_chart,
+        chart,
         blend,
+        offset_layers,
         sides,
         params: params.clone(),
         bead,
@@ -328,6 +393,7 @@ impl FreeformFill<'_> {
             id,
             chart,
             blend,
+            offset_layers,
             sides,
             params,
             bead,
@@ -340,15 +406,14 @@ impl FreeformFill<'_> {
         } = self;
         let params = &params;
         // Transition layers: the chart's level is the morph level, a layer 1/N of it, and a
-        // point's thickness h_T(q)/N (crate::transition).
-        let chart = match &blend {
-            Some((field, _)) => chart.blended(field),
-            None => chart,
-        };
-        let levels = blend.as_ref().map(|(field, n)| (field, *n as f64));
-        let thick = |q: Point2, dl: f64| match levels {
-            Some((field, n)) => field.height(q) / n,
-            None => dl,
+        // point's thickness (h_T(q) − D(q))/N (crate::transition).
+        let base_chart = chart;
+        let blended_chart = blend.as_ref().map(|(field, _, _)| chart.blended(field));
+        let levels_of = |layer: usize| {
+            blend
+                .as_ref()
+                .filter(|_| layer >= offset_layers)
+                .map(|(field, n, _)| (field, *n as f64))
         };
         // Thinnest, summed and thickest thickness over the print points.
         let mut spread = (f64::INFINITY, 0.0f64, 0.0f64, 0usize);
@@ -362,6 +427,15 @@ impl FreeformFill<'_> {
         for (layer, ((&dl, &(_, z)), (regions, paths))) in
             heights.iter().zip(&tops).zip(filled).enumerate()
         {
+            let levels = levels_of(layer);
+            let chart = match (&blended_chart, levels) {
+                (Some(c), Some(_)) => *c,
+                _ => base_chart,
+            };
+            let thick = |q: Point2, dl: f64| match levels {
+                Some((field, n)) => (field.height(q) - field.lower(q)) / n,
+                None => dl,
+            };
             let below = std::mem::replace(&mut prev_regions, regions);
             let start = cursor
                 .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -471,8 +545,21 @@ impl FreeformFill<'_> {
                     let l = (w[1].p - w[0].p).norm();
                     let width = 0.5 * (w[0].w + w[1].w);
                     // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
-                    let t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
-                    let e = bead.filament_length(width, t, l);
+                    let mut t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
+                    let mut run = l;
+                    if levels.is_some() {
+                        // A transition layer leans on the reference: the bead is as thick as
+                        // the layers lie apart across it, t_N·(n_L·N), and as long as the
+                        // segment runs along it (not up its steps over the offset layers'
+                        // staircase, which the layer under it climbs too).
+                        let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
+                        if let Some((_, nr)) = base_chart.at(w[1].q, 0.0) {
+                            t *= nl.dot(&nr).abs();
+                        }
+                        let d = w[1].p - w[0].p;
+                        run = (d - nl * d.dot(&nl)).norm();
+                    }
+                    let e = bead.filament_length(width, t, run);
                     spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
                     fig.print_length += l;
                     fig.filament += e;
@@ -507,7 +594,7 @@ impl FreeformFill<'_> {
         }
         let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
         fig.finish(id, points.len(), &printed);
-        if levels.is_some() && spread.3 > 0 {
+        if blend.is_some() && spread.3 > 0 {
             fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
         }
         if against.0 > 0 {

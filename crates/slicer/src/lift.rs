@@ -15,6 +15,8 @@ pub(crate) struct Lifted {
     pub(crate) n: V3,
     /// Bead width here.
     pub(crate) w: f64,
+    /// The layer surface's unit normal here (`n` may be turned to another axis, e.g. SST's).
+    pub(crate) ln: V3,
 }
 
 /// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
@@ -38,6 +40,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
                     p,
                     n,
                     w: 0.5 * (a.w + b.w),
+                    ln: n,
                 };
                 if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
                     refine(chart, a, mid, z, tol, depth + 1, out);
@@ -53,7 +56,13 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
         let Some((p, n)) = chart.at(*q, z) else {
             continue;
         };
-        let cur = Lifted { q: *q, p, n, w: *w };
+        let cur = Lifted {
+            q: *q,
+            p,
+            n,
+            w: *w,
+            ln: n,
+        };
         match dense.last().copied() {
             Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
             None => dense.push(cur),

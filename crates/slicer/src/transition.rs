@@ -24,7 +24,17 @@
 //!   thickness lies in `[h_min/N, h_max/N]`: N must be in
 //!   `[ceil(h_max / max_layer_height), floor(h_min / min_layer_height)]`; it is the number of
 //!   that range nearest `h_mean / uniform_layer_height`. An empty range (the top comes too
-//!   close to the base somewhere for one N) is [`Levels::Infeasible`].
+//!   close to the base somewhere for one N) gets offset layers first: [`Levels::Hybrid`]; where
+//!   not even that keeps the bounds, [`Levels::Infeasible`].
+//! - **Volume, Eq. 1.** A transition layer leans on the reference by the angle α between its
+//!   normal n_L and N: its beads are `t_N·cos α` thick across it, and a segment counts by its
+//!   length along the layer (not up the steps over a hybrid's staircase); `thickness` in the
+//!   tool path is that `t_N·cos α`.
+//! - **Leaning features.** Nothing above requires the top to lie over the base: the outlines
+//!   come from the sides, so a pitched blade's layers follow its lean. Where T does not cover
+//!   q, h_T is continued from T's values, so the layers there are near-offsets that bend into T
+//!   where they reach it; their normals lean by the continuation's slope (a B/C bed tilts axes
+//!   that lean past its B limit back into it, inside the orientation cone).
 //! - **Orientation (TSN).** The layer surface's normal, from the chart by central differences.
 
 use crate::chart::{mapped_mesh, refined, Chart};
@@ -57,11 +67,11 @@ pub struct TopField {
     h: Vec<f64>,
     /// Least, mean and greatest base-to-top distance over the top, mm.
     pub range: (f64, f64, f64),
-    /// The share of the base (the feature's healing faces, seen in the chart) that the top
-    /// covers along the reference's normals: near 1 for a feature standing upright on its
-    /// base, small for one leaning over (a pitched blade, whose top lies over another part of
-    /// the reference than its root).
-    pub overlap: f64,
+    /// Offset layers first (see [`Levels::Hybrid`]): the transition band's least thickness
+    /// `c` and the offset layers' thickness `h0`; `None` for transition layers from the base.
+    band: Option<(f64, f64)>,
+    /// With a band: the offset layers' smooth top on the grid.
+    env: Vec<f64>,
 }
 
 impl TopField {
@@ -84,19 +94,11 @@ impl TopField {
             edge_points: Default::default(),
             edge_params: Default::default(),
         };
-        let mut base = Mesh {
-            positions: mesh.positions.clone(),
-            faces: vec![],
-            edge_points: Default::default(),
-            edge_params: Default::default(),
-        };
         for ft in &mesh.faces {
             if ft.triangles.is_empty() {
                 continue;
             }
-            if heal.contains(&ft.face) {
-                base.faces.push(ft.clone());
-            } else if up_share(chart, mesh, ft, id) >= TOP_SHARE {
+            if !heal.contains(&ft.face) && up_share(chart, mesh, ft, id) >= TOP_SHARE {
                 top.faces.push(ft.clone());
             }
         }
@@ -145,27 +147,6 @@ impl TopField {
             raster(&mut h, origin, cell, nx, ny, a, b, c);
         }
         let covered: Vec<bool> = h.iter().map(|v| v.is_finite()).collect();
-        // The base's cells, and how many of them the top covers.
-        let overlap = if base.faces.is_empty() {
-            1.0
-        } else {
-            let base = mapped_mesh(chart, &compact(&base), id)?;
-            let mut under = vec![f64::NEG_INFINITY; nx * ny];
-            for t in base.triangles() {
-                let [a, b, c] = t.map(|k| base.positions[k as usize]);
-                let flat = |p: P3| P3::new(p.x, p.y, 0.0);
-                raster(&mut under, origin, cell, nx, ny, flat(a), flat(b), flat(c));
-            }
-            let n = under.iter().filter(|v| v.is_finite()).count();
-            let both = (0..h.len())
-                .filter(|&i| covered[i] && under[i].is_finite())
-                .count();
-            if n == 0 {
-                1.0
-            } else {
-                both as f64 / n as f64
-            }
-        };
         let vals: Vec<f64> = h.iter().copied().filter(|v| v.is_finite()).collect();
         if vals.is_empty() {
             return Ok(None);
@@ -222,12 +203,87 @@ impl TopField {
             ny,
             h,
             range: (hmin, hmean, hmax),
-            overlap,
+            band: None,
+            env: vec![],
         }))
+    }
+
+    /// The field with offset layers `h0` thick under a transition band (see [`band`]): the
+    /// offset layers' smooth top `max(0, h_T − c)` lowered until its slope is at most `slope`
+    /// (the greatest function under it that is `slope`-Lipschitz, by chamfer passes over the
+    /// grid).
+    pub(crate) fn with_band(mut self, c: f64, h0: f64, slope: f64) -> TopField {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut env: Vec<f64> = self.h.iter().map(|h| (h - c).max(0.0)).collect();
+        // Chamfer steps are longer than the true distance by up to 8 %: keep the slope under.
+        let (s1, s2) = (
+            0.92 * slope * self.cell,
+            0.92 * slope * self.cell * 2f64.sqrt(),
+        );
+        let forward = [(-1i64, 0i64, s1), (0, -1, s1), (-1, -1, s2), (1, -1, s2)];
+        let backward = [(1i64, 0i64, s1), (0, 1, s1), (1, 1, s2), (-1, 1, s2)];
+        for _ in 0..2 {
+            for y in 0..ny {
+                for x in 0..nx {
+                    relax(&mut env, nx, ny, x, y, &forward);
+                }
+            }
+            for y in (0..ny).rev() {
+                for x in (0..nx).rev() {
+                    relax(&mut env, nx, ny, x, y, &backward);
+                }
+            }
+        }
+        self.env = env;
+        self.band = Some((c, h0));
+        self
+    }
+
+    /// The thickest the transition layers stack over a point, mm: the top's greatest distance
+    /// from the base, or from the offset layers' stack under a band.
+    pub(crate) fn band_max(&self) -> f64 {
+        match self.band {
+            Some((_, h0)) => self
+                .h
+                .iter()
+                .zip(&self.env)
+                .map(|(h, e)| h - h0 * (e / h0 + 1e-9).floor())
+                .fold(0.0, f64::max),
+            None => self.range.2,
+        }
+    }
+
+    /// The band `(c, h0)` of [`TopField::with_band`].
+    pub(crate) fn band_of(&self) -> Option<(f64, f64)> {
+        self.band
+    }
+
+    /// Where the transition layers start over `q`, mm from the reference: 0, or with offset
+    /// layers first the top of their stack there, `D(q)` (a staircase of whole layers).
+    pub fn lower(&self, q: Point2) -> f64 {
+        match self.band {
+            Some((_, h0)) => h0 * (self.lower_smooth(q) / h0 + 1e-9).floor(),
+            None => 0.0,
+        }
+    }
+
+    /// [`TopField::lower`] before it is cut to whole layers: the transition layers' normals
+    /// follow it (their positions follow the steps, so that every point's thickness stays in
+    /// bounds).
+    pub(crate) fn lower_smooth(&self, q: Point2) -> f64 {
+        match self.band {
+            Some(_) => self.bilinear(&self.env, q).max(0.0),
+            None => 0.0,
+        }
     }
 
     /// `h_T(q)`, mm: bilinear between cell centres, held at the grid's edge beyond it.
     pub fn height(&self, q: Point2) -> f64 {
+        self.bilinear(&self.h, q)
+    }
+
+    /// Grid values `v` interpolated bilinearly at `q`.
+    fn bilinear(&self, v: &[f64], q: Point2) -> f64 {
         let fx = ((q[0] - self.origin[0]) / self.cell - 0.5).clamp(0.0, (self.nx - 1) as f64);
         let fy = ((q[1] - self.origin[1]) / self.cell - 0.5).clamp(0.0, (self.ny - 1) as f64);
         if !(fx.is_finite() && fy.is_finite()) {
@@ -236,10 +292,25 @@ impl TopField {
         let (x0, y0) = (fx.floor() as usize, fy.floor() as usize);
         let (x1, y1) = ((x0 + 1).min(self.nx - 1), (y0 + 1).min(self.ny - 1));
         let (tx, ty) = (fx - x0 as f64, fy - y0 as f64);
-        let at = |x: usize, y: usize| self.h[y * self.nx + x];
+        let at = |x: usize, y: usize| v[y * self.nx + x];
         let a = at(x0, y0) * (1.0 - tx) + at(x1, y0) * tx;
         let b = at(x0, y1) * (1.0 - tx) + at(x1, y1) * tx;
         a * (1.0 - ty) + b * ty
+    }
+}
+
+/// One chamfer step at cell `(x, y)`: its value lowered to a neighbour's plus the step's cost.
+fn relax(v: &mut [f64], nx: usize, ny: usize, x: usize, y: usize, steps: &[(i64, i64, f64)]) {
+    let i = y * nx + x;
+    for &(dx, dy, cost) in steps {
+        let (a, b) = (x as i64 + dx, y as i64 + dy);
+        if a < 0 || b < 0 || a >= nx as i64 || b >= ny as i64 {
+            continue;
+        }
+        let j = b as usize * nx + a as usize;
+        if v[j] + cost < v[i] {
+            v[i] = v[j] + cost;
+        }
     }
 }
 
@@ -383,14 +454,11 @@ pub(crate) enum Levels {
     Offset,
     /// N transition layers.
     Transition(usize),
-    /// No N keeps every point's thickness within the bounds: `(lo, hi)` is the range N must
-    /// lie in (`lo > hi`).
+    /// No N keeps every point's thickness within the bounds from the base (the top comes too
+    /// close to it somewhere): `(lo, hi)` is the range N would have to lie in (`lo > hi`).
+    /// [`band`] tries offset layers first.
     Infeasible(usize, usize),
 }
-
-/// The least share of its base a top must cover for transition layers along the reference's
-/// normals to be a morph of the feature (see [`TopField::overlap`]).
-pub(crate) const MIN_OVERLAP: f64 = 0.5;
 
 /// The number of transition layers for base-to-top distances `range` (least, mean, greatest):
 /// see the module documentation.
@@ -406,6 +474,51 @@ pub(crate) fn levels(range: (f64, f64, f64), params: &LayerParams) -> Levels {
     }
     let want = (hmean / params.uniform_layer_height).round().max(1.0) as usize;
     Levels::Transition(want.clamp(lo, hi))
+}
+
+/// A band of transition layers over offset layers, for a top that comes too close to the base
+/// somewhere for one N ("offset layers first, transition layers for the rest"):
+///
+/// - offset layers `h0 = uniform_layer_height` thick stack over `q` to `D(q)`, each printed
+///   where the stack reaches its top; `D` is `max(0, h_T − c)` with `c = h_min` (the band
+///   everywhere at least as thick as the top's least height), lowered until it climbs at most
+///   one layer per half bead width (`|∇D| ≤ h0 / (w/2)`, so that no bead of a transition layer
+///   lies beside a stack more than one layer taller than its own), then cut to whole layers;
+/// - N transition layers from `D` to the top, each point `(h_T(q) − D(q))/N` thick: N must
+///   lie in `[⌈max(h_T − D)/max_layer_height⌉, ⌊min(h_T − D)/min_layer_height⌋]`, and is the
+///   one nearest the band's mean thickness over `uniform_layer_height`.
+///
+/// Returns the field with its band, N and the number of offset layers; `None` when no N keeps
+/// the bounds.
+pub(crate) fn band(
+    field: TopField,
+    params: &LayerParams,
+    bead_width: f64,
+) -> Option<(TopField, usize, usize)> {
+    let h0 = params.uniform_layer_height;
+    if !(h0 > 0.0 && bead_width > 0.0) {
+        return None;
+    }
+    let c = field.range.0;
+    let f = field.with_band(c, h0, h0 / (0.5 * bead_width));
+    let (mut lo, mut hi, mut sum, mut top) = (f64::INFINITY, 0.0f64, 0.0, 0.0f64);
+    for (h, e) in f.h.iter().zip(&f.env) {
+        let d = h0 * (e / h0 + 1e-9).floor();
+        let b = h - d;
+        lo = lo.min(b);
+        hi = hi.max(b);
+        sum += b;
+        top = top.max(d);
+    }
+    let mean = sum / f.h.len().max(1) as f64;
+    let nlo = ((hi / params.max_layer_height) - 1e-9).ceil().max(1.0) as usize;
+    let nhi = ((lo / params.min_layer_height) + 1e-9).floor().max(0.0) as usize;
+    if nlo > nhi {
+        return None;
+    }
+    let n = ((mean / params.uniform_layer_height).round().max(1.0) as usize).clamp(nlo, nhi);
+    let k = (top / h0 + 1e-9).round() as usize;
+    Some((f, n, k))
 }
 
 #[cfg(test)]
