@@ -73,8 +73,8 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
             points: vec![],
             widths: vec![],
         };
-        for i in 0..p.points.len() {
-            if inside[i] {
+        for (i, &kept) in inside.iter().enumerate() {
+            if kept {
                 if cur.points.is_empty() && i > 0 {
                     cur.points.push(cross(p.points[i], p.points[i - 1]));
                     cur.widths.push(p.widths[i]);
