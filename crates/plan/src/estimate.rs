@@ -97,6 +97,7 @@ mod tests {
             e,
             thickness: 0.2,
             width: 0.45,
+            role: slicer::toolpath::Role::Perimeter,
         }
     }
 

@@ -1,7 +1,7 @@
 //! Marlin G-code for 3-axis printers: every feature's tool axis must be +Z.
 //!
 //! The program is what slicer G-code viewers expect: `;LAYER_CHANGE`, `;Z:`, `;HEIGHT:`,
-//! `;LAYER:<n>` over the whole build order, `;FEATURE:<id>` and `;FEATURE_LAYER:<n>`, `;WIDTH:`
+//! `;LAYER:<n>` over the whole build order, `;FEATURE:<id>` and `;FEATURE_LAYER:<n>`, `;TYPE:`, `;WIDTH:`
 //! (see `gcode::LayerMarks`), relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
 //! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
 

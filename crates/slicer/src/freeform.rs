@@ -202,6 +202,7 @@ pub fn fill_freeform<'a>(
                 .max(MICROMETRE)
                 .min(spacing.max(MICROMETRE) * 1e3);
             let mut paths = vec![];
+            let layers = heights.len();
             for r in &regions {
                 paths.extend(fill_region(
                     &chart,
@@ -215,7 +216,10 @@ pub fn fill_freeform<'a>(
                 ));
                 paths.extend(corner_spurs(&chart, r, z, bead.width));
             }
-            (regions, paths)
+            (
+                regions,
+                crate::region_fill::solid_on_skins(paths, layer, layers),
+            )
         })
         .collect();
     Ok(FreeformFill {
@@ -352,6 +356,7 @@ impl FreeformFill<'_> {
                         e: 0.0,
                         thickness: dl,
                         width: bead.width,
+                        role: pts[0].role,
                     });
                     *cursor = Some(p);
                 }
@@ -371,6 +376,7 @@ impl FreeformFill<'_> {
                         e,
                         thickness: dl,
                         width,
+                        role: w[1].role,
                     });
                 }
                 *cursor = pts.last().map(|x| x.p);

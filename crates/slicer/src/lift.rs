@@ -5,6 +5,7 @@ use crate::chart::Chart;
 use crate::geodesic::segment_distance;
 use crate::geom2d::Point2;
 use crate::region_fill::FillPath;
+use crate::toolpath::Role;
 use brep::math::{P3, V3};
 
 /// A lifted path point: chart coordinates, position and unit normal.
@@ -15,6 +16,8 @@ pub(crate) struct Lifted {
     pub(crate) n: V3,
     /// Bead width here.
     pub(crate) w: f64,
+    /// What the path is for.
+    pub(crate) role: Role,
 }
 
 /// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
@@ -38,6 +41,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
                     p,
                     n,
                     w: 0.5 * (a.w + b.w),
+                    role: a.role,
                 };
                 if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
                     refine(chart, a, mid, z, tol, depth + 1, out);
@@ -53,7 +57,13 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
         let Some((p, n)) = chart.at(*q, z) else {
             continue;
         };
-        let cur = Lifted { q: *q, p, n, w: *w };
+        let cur = Lifted {
+            q: *q,
+            p,
+            n,
+            w: *w,
+            role: path.role,
+        };
         match dense.last().copied() {
             Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
             None => dense.push(cur),
