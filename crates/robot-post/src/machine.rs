@@ -46,6 +46,22 @@ pub struct MachineProfile {
     pub first_layer_speed: f64,
     /// Travel speed (mm/s).
     pub travel_speed: f64,
+    /// Fastest the tool tip moves (mm/s), the firmware's feed-rate limit: programmed speeds
+    /// above it are taken at it by the time estimate. Optional: no limit when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_speed: Option<f64>,
+    /// Acceleration of printing moves (mm/s²), for the estimate's trapezoidal speed profiles.
+    /// Optional: when left out, every move is taken at its programmed speed throughout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration: Option<f64>,
+    /// Acceleration of travel moves (mm/s²). Optional: `max_acceleration` when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub travel_acceleration: Option<f64>,
+    /// Jerk (mm/s): the largest sudden change of the tool tip's velocity vector, at a corner
+    /// or starting from and coming to a stop, that the firmware takes without slowing down
+    /// first. Optional: [`DEFAULT_JERK`] when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_jerk: Option<f64>,
     /// Nozzle temperature (°C).
     pub nozzle_temperature: f64,
     /// Bed temperature (°C); 0 for no heated bed.
@@ -74,6 +90,10 @@ pub struct MachineProfile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kuka: Option<crate::kuka::cell::KukaCell>,
 }
+
+/// The jerk (mm/s) of a profile that gives an acceleration but no `max_jerk`: Marlin's
+/// classic default for X and Y.
+pub const DEFAULT_JERK: f64 = 10.0;
 
 /// The narrowest bead a nozzle lays well, as a share of its diameter, when a profile does
 /// not say (`min_bead_width`).
@@ -153,6 +173,21 @@ impl MachineProfile {
                     "filament_density",
                     format!("must be a density in g/cm3 between 0 and 30, got {d}"),
                 ));
+            }
+        }
+        for (field, v, max) in [
+            ("max_speed", self.max_speed, 10_000.0),
+            ("max_acceleration", self.max_acceleration, 1e6),
+            ("travel_acceleration", self.travel_acceleration, 1e6),
+            ("max_jerk", self.max_jerk, 10_000.0),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0 && v <= max) {
+                    return Err(bad(
+                        field,
+                        format!("must be a positive number at most {max}, got {v}"),
+                    ));
+                }
             }
         }
         if let Some(w) = self.min_bead_width {
