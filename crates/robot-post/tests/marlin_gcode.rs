@@ -259,6 +259,10 @@ fn marlin_numbers_are_fixed_point() {
         for word in code.split_whitespace() {
             let (letter, number) = word.split_at(1);
             match letter {
+                // The motion limits (M201, M204, M205) in whole units.
+                _ if code.starts_with("M20") => {
+                    assert!(number.bytes().all(|c| c.is_ascii_digit()), "`{line}`")
+                }
                 "X" | "Y" | "Z" if !code.starts_with("G28") => {
                     assert_eq!(number.split('.').nth(1).map(str::len), Some(3), "`{line}`")
                 }
@@ -286,11 +290,14 @@ fn marlin_header_and_footer() {
         .filter(|c| !c.is_empty())
         .collect();
     assert_eq!(
-        &codes[..10],
+        &codes[..13],
         [
             "G21",
             "G90",
             "M83",
+            "M201 X1500 Y1500",
+            "M204 P1000 T1500",
+            "M205 X10 Y10",
             "M140 S60",
             "M104 S210",
             "G28",
