@@ -374,7 +374,14 @@ mod tests {
         let nan = MARLIN_TOML.replace("bead_width = 0.45", "bead_width = nan");
         let hot = MARLIN_TOML.replace("nozzle_temperature = 210.0", "nozzle_temperature = 2100.0");
         let wide = MARLIN_TOML.replace("min_bead_width = 0.24", "min_bead_width = 0.5");
+        let no_accel =
+            MARLIN_TOML.replace("max_acceleration = 1000.0", "max_acceleration = -1000.0");
+        let zero_jerk = MARLIN_TOML.replace("max_jerk = 10.0", "max_jerk = 0.0");
+        let mm_min = MARLIN_TOML.replace("max_speed = 200.0", "max_speed = 12000.0");
         for (text, needle) in [
+            (no_accel.as_str(), "max_acceleration"),
+            (zero_jerk.as_str(), "max_jerk"),
+            (mm_min.as_str(), "max_speed"),
             (wide.as_str(), "min_bead_width"),
             (unknown.as_str(), "zhop"),
             (missing.as_str(), "z_hop"),
@@ -396,6 +403,26 @@ mod tests {
             MachineProfile::from_toml(&MARLIN_TOML.replace("min_bead_width = 0.24", "")).unwrap();
         assert_eq!(old.min_bead_width, None);
         assert!((old.min_bead_width() - 0.6 * old.nozzle_diameter).abs() < 1e-12);
+        // The motion limits are optional: left out, none.
+        let mut free = MARLIN_TOML.to_string();
+        for key in [
+            "max_speed = 200.0",
+            "max_acceleration = 1000.0",
+            "travel_acceleration = 1500.0",
+            "max_jerk = 10.0",
+        ] {
+            free = free.replace(key, "");
+        }
+        let free = MachineProfile::from_toml(&free).unwrap();
+        assert_eq!(
+            (
+                free.max_speed,
+                free.max_acceleration,
+                free.travel_acceleration,
+                free.max_jerk
+            ),
+            (None, None, None, None)
+        );
     }
 
     #[test]
