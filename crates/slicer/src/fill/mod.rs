@@ -58,7 +58,7 @@ pub struct Path2 {
     /// What it is for, as slicers name it: the first ring (about the outside and about each
     /// hole) [`Role::ExternalPerimeter`], the others [`Role::Perimeter`], infill lines
     /// [`Role::SolidInfill`] or [`Role::InternalInfill`] by their spacing
-    /// ([`crate::region_fill::infill_role`]), the lines in strips rings leave
+    /// ([`infill_role`]), the lines in strips rings leave
     /// [`Role::GapFill`].
     pub role: Role,
 }
@@ -159,7 +159,7 @@ pub fn fill_layer(
     } else {
         0.0
     };
-    let infill = crate::region_fill::infill_role(width, spacing);
+    let infill = infill_role(width, spacing);
     let zigzag_angle = if layer % 2 == 1 {
         base_angle + 90.0
     } else {
@@ -246,6 +246,18 @@ pub fn fill_layer(
     FilledLayer {
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
+    }
+}
+
+/// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]
+/// where the beads touch (spacing at most the width, the default `filling_ratio` 1),
+/// [`Role::InternalInfill`] where they are laid apart (the planners make a feature's bottom
+/// and top layers solid: [`crate::region_fill::solid_on_skins`]).
+pub fn infill_role(width: f64, spacing: f64) -> Role {
+    if spacing <= width * (1.0 + 1e-6) {
+        Role::SolidInfill
+    } else {
+        Role::InternalInfill
     }
 }
 

@@ -276,7 +276,7 @@ pub(crate) fn fill_region(
         None => 0.5 * width,
     };
     let zig = params.path_mode != PathMode::Raster;
-    let infill = infill_role(width, spacing);
+    let infill = crate::fill::infill_role(width, spacing);
     let angle = if zig && layer % 2 == 1 {
         params.raster_angle_deg + 90.0
     } else {
@@ -437,18 +437,6 @@ pub(crate) fn fill_region(
         out.push(FillPath::uniform(pts, width, infill));
     }
     out
-}
-
-/// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]
-/// where the beads touch (spacing at most the width, the default `filling_ratio` 1),
-/// [`Role::InternalInfill`] where they are laid apart (the planners make a feature's bottom
-/// and top layers solid: [`solid_on_skins`]).
-pub fn infill_role(width: f64, spacing: f64) -> Role {
-    if spacing <= width * (1.0 + 1e-6) {
-        Role::SolidInfill
-    } else {
-        Role::InternalInfill
-    }
 }
 
 /// The paths of layer `layer` of `layers` with their internal infill made solid where the
