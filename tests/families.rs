@@ -414,7 +414,7 @@ fn check_part(file: &str, run: usize) -> Vec<String> {
     let mut outside: std::collections::BTreeMap<usize, (usize, f64, P)> = Default::default();
     let mut prints = 0usize;
     let mut lines = csv.lines();
-    if lines.next() != Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width") {
+    if lines.next() != Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role") {
         why.push("toolpath.csv has an unexpected header".into());
         return why;
     }

@@ -82,7 +82,7 @@ fn rows(csv: &str) -> Vec<Row> {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next(),
-        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width")
+        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role")
     );
     lines
         .map(|l| {

@@ -784,6 +784,102 @@ fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
     assert!(program.contains(&format!("; filament used [mm] = {mm:.2}")));
 }
 
+/// PrusaSlicer's G-code viewer colours moves by the `;TYPE:` above them: every print move of
+/// a Marlin plan of plate_boss_boss lies under one (written again in each layer) naming a role
+/// PrusaSlicer knows; the beads reaching farthest out in X and Y on every layer are the
+/// outermost rings, `External perimeter`; and toolpath.csv's last column, `role`, holds the
+/// same roles (as many print points of each as the program has print moves under it).
+#[test]
+fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
+    let s = Scratch::new("types");
+    let out = s.path("o");
+    let o = plan(
+        "plate_boss_boss.step",
+        &["--machine", "marlin", "-o", out.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
+    let known = [
+        "External perimeter",
+        "Perimeter",
+        "Solid infill",
+        "Internal infill",
+        "Gap fill",
+    ];
+    let mut role: Option<String> = None;
+    let mut layers = 0usize;
+    // Per layer: the print moves' (x, y, type).
+    let mut moves: Vec<Vec<(f64, f64, String)>> = vec![];
+    let mut per_type = std::collections::BTreeMap::<String, usize>::new();
+    for line in program.lines() {
+        if line == ";LAYER_CHANGE" {
+            role = None;
+            layers += 1;
+            moves.push(vec![]);
+        } else if let Some(t) = line.strip_prefix(";TYPE:") {
+            assert!(known.contains(&t), "unknown type {t}");
+            role = Some(t.to_string());
+        } else if line.starts_with("G1 X") {
+            let word = |c: char| {
+                line.split(' ')
+                    .find_map(|w| w.strip_prefix(c))
+                    .map(|v| v.parse::<f64>().unwrap())
+            };
+            if word('E').is_some_and(|e| e > 0.0) {
+                let t = role
+                    .clone()
+                    .unwrap_or_else(|| panic!("{line}: no ;TYPE: above it in its layer"));
+                *per_type.entry(t.clone()).or_default() += 1;
+                moves
+                    .last_mut()
+                    .unwrap()
+                    .push((word('X').unwrap(), word('Y').unwrap(), t));
+            }
+        }
+    }
+    assert!(layers > 0);
+    for t in ["External perimeter", "Perimeter", "Solid infill"] {
+        assert!(per_type.contains_key(t), "no {t}: {per_type:?}");
+    }
+    for (n, layer) in moves.iter().enumerate() {
+        if layer.is_empty() {
+            continue;
+        }
+        let far = |key: &dyn Fn(&(f64, f64, String)) -> f64| {
+            layer
+                .iter()
+                .max_by(|a, b| key(a).total_cmp(&key(b)))
+                .map(|m| m.2.clone())
+                .unwrap()
+        };
+        for (side, t) in [
+            ("+X", far(&|m| m.0)),
+            ("-X", far(&|m| -m.0)),
+            ("+Y", far(&|m| m.1)),
+            ("-Y", far(&|m| -m.1)),
+        ] {
+            assert_eq!(t, "External perimeter", "layer {n}, {side}");
+        }
+    }
+    let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
+    let mut csv_types = std::collections::BTreeMap::<String, usize>::new();
+    for l in csv.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        if f[2] == "print" {
+            let name = match f[12] {
+                "external_perimeter" => "External perimeter",
+                "perimeter" => "Perimeter",
+                "solid_infill" => "Solid infill",
+                "internal_infill" => "Internal infill",
+                "gap_fill" => "Gap fill",
+                other => panic!("role {other}"),
+            };
+            *csv_types.entry(name.to_string()).or_default() += 1;
+        }
+    }
+    assert_eq!(csv_types, per_type);
+}
+
 /// The built-in Marlin profile's keys.
 fn robot_post_profile() -> toml::Table {
     let o = Command::new(BIN)

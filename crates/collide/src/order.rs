@@ -65,6 +65,7 @@ mod tests {
             e: 0.0,
             thickness: 0.2,
             width: 0.45,
+            role: toolpath::Role::Perimeter,
         }
     }
 

@@ -1,7 +1,7 @@
 //! What the G-code posts (Marlin, delta5) share in writing their programs, and the comment
 //! text of every post (KUKA's KRL too).
 
-use toolpath::{push_fixed, MoveKind, PathPoint};
+use toolpath::{push_fixed, MoveKind, PathPoint, Role};
 
 /// `s` with line breaks and other control characters replaced by spaces, for comments (G-code
 /// and KRL alike: a comment never spills onto a new line).
@@ -30,7 +30,10 @@ pub(crate) fn push_line(out: &mut String, s: &str) {
 /// ;FEATURE_LAYER:<layer index within the feature, as toolpath.csv's `layer`>
 /// ```
 ///
-/// and `;WIDTH:<bead width>` before a print move whose bead width differs from the last one
+/// `;TYPE:<role>` before a print move whose path's role ([`Role::prusa_name`]: `External
+/// perimeter`, `Perimeter`, `Solid infill`, `Internal infill`, `Gap fill`) differs from the
+/// last one written in the layer (so every layer's first print move has one), and
+/// `;WIDTH:<bead width>` before a print move whose bead width differs from the last one
 /// written by more than half a micrometre.
 #[derive(Debug, Default)]
 pub(crate) struct LayerMarks {
@@ -38,6 +41,8 @@ pub(crate) struct LayerMarks {
     feature: Option<usize>,
     /// Layers begun so far over the build order.
     count: usize,
+    /// The role of the last `;TYPE:` written in this layer.
+    role: Option<Role>,
     width: Option<f64>,
 }
 
@@ -53,11 +58,18 @@ impl LayerMarks {
             push_fixed(out, q.thickness, 3);
             out.push_str(&format!("\n;LAYER:{}\n", self.count));
             self.count += 1;
+            self.role = None;
             if new_feature {
                 self.feature = Some(q.feature);
                 out.push_str(&format!(";FEATURE:{}\n", q.feature));
             }
             out.push_str(&format!(";FEATURE_LAYER:{}\n", q.layer));
+        }
+        if q.kind == MoveKind::Print && self.role != Some(q.role) {
+            self.role = Some(q.role);
+            out.push_str(";TYPE:");
+            out.push_str(q.role.prusa_name());
+            out.push('\n');
         }
         if q.kind == MoveKind::Print && self.width.is_none_or(|w| (w - q.width).abs() > 5e-4) {
             self.width = Some(q.width);

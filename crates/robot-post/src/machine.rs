@@ -46,6 +46,22 @@ pub struct MachineProfile {
     pub first_layer_speed: f64,
     /// Travel speed (mm/s).
     pub travel_speed: f64,
+    /// Fastest the tool tip moves (mm/s), the firmware's feed-rate limit: programmed speeds
+    /// above it are taken at it by the time estimate. Optional: no limit when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_speed: Option<f64>,
+    /// Acceleration of printing moves (mm/s²), for the estimate's trapezoidal speed profiles.
+    /// Optional: when left out, every move is taken at its programmed speed throughout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration: Option<f64>,
+    /// Acceleration of travel moves (mm/s²). Optional: `max_acceleration` when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub travel_acceleration: Option<f64>,
+    /// Jerk (mm/s): the largest sudden change of the tool tip's velocity vector, at a corner
+    /// or starting from and coming to a stop, that the firmware takes without slowing down
+    /// first. Optional: [`DEFAULT_JERK`] when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_jerk: Option<f64>,
     /// Nozzle temperature (°C).
     pub nozzle_temperature: f64,
     /// Bed temperature (°C); 0 for no heated bed.
@@ -74,6 +90,10 @@ pub struct MachineProfile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kuka: Option<crate::kuka::cell::KukaCell>,
 }
+
+/// The jerk (mm/s) of a profile that gives an acceleration but no `max_jerk`: Marlin's
+/// classic default for X and Y.
+pub const DEFAULT_JERK: f64 = 10.0;
 
 /// The narrowest bead a nozzle lays well, as a share of its diameter, when a profile does
 /// not say (`min_bead_width`).
@@ -153,6 +173,21 @@ impl MachineProfile {
                     "filament_density",
                     format!("must be a density in g/cm3 between 0 and 30, got {d}"),
                 ));
+            }
+        }
+        for (field, v, max) in [
+            ("max_speed", self.max_speed, 10_000.0),
+            ("max_acceleration", self.max_acceleration, 1e6),
+            ("travel_acceleration", self.travel_acceleration, 1e6),
+            ("max_jerk", self.max_jerk, 10_000.0),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0 && v <= max) {
+                    return Err(bad(
+                        field,
+                        format!("must be a positive number at most {max}, got {v}"),
+                    ));
+                }
             }
         }
         if let Some(w) = self.min_bead_width {
@@ -339,7 +374,14 @@ mod tests {
         let nan = MARLIN_TOML.replace("bead_width = 0.45", "bead_width = nan");
         let hot = MARLIN_TOML.replace("nozzle_temperature = 210.0", "nozzle_temperature = 2100.0");
         let wide = MARLIN_TOML.replace("min_bead_width = 0.24", "min_bead_width = 0.5");
+        let no_accel =
+            MARLIN_TOML.replace("max_acceleration = 1000.0", "max_acceleration = -1000.0");
+        let zero_jerk = MARLIN_TOML.replace("max_jerk = 10.0", "max_jerk = 0.0");
+        let mm_min = MARLIN_TOML.replace("max_speed = 200.0", "max_speed = 12000.0");
         for (text, needle) in [
+            (no_accel.as_str(), "max_acceleration"),
+            (zero_jerk.as_str(), "max_jerk"),
+            (mm_min.as_str(), "max_speed"),
             (wide.as_str(), "min_bead_width"),
             (unknown.as_str(), "zhop"),
             (missing.as_str(), "z_hop"),
@@ -361,6 +403,26 @@ mod tests {
             MachineProfile::from_toml(&MARLIN_TOML.replace("min_bead_width = 0.24", "")).unwrap();
         assert_eq!(old.min_bead_width, None);
         assert!((old.min_bead_width() - 0.6 * old.nozzle_diameter).abs() < 1e-12);
+        // The motion limits are optional: left out, none.
+        let mut free = MARLIN_TOML.to_string();
+        for key in [
+            "max_speed = 200.0",
+            "max_acceleration = 1000.0",
+            "travel_acceleration = 1500.0",
+            "max_jerk = 10.0",
+        ] {
+            free = free.replace(key, "");
+        }
+        let free = MachineProfile::from_toml(&free).unwrap();
+        assert_eq!(
+            (
+                free.max_speed,
+                free.max_acceleration,
+                free.travel_acceleration,
+                free.max_jerk
+            ),
+            (None, None, None, None)
+        );
     }
 
     #[test]

@@ -1,9 +1,10 @@
 //! Marlin G-code for 3-axis printers: every feature's tool axis must be +Z.
 //!
 //! The program is what slicer G-code viewers expect: `;LAYER_CHANGE`, `;Z:`, `;HEIGHT:`,
-//! `;LAYER:<n>` over the whole build order, `;FEATURE:<id>` and `;FEATURE_LAYER:<n>`, `;WIDTH:`
+//! `;LAYER:<n>` over the whole build order, `;FEATURE:<id>` and `;FEATURE_LAYER:<n>`, `;TYPE:`, `;WIDTH:`
 //! (see `gcode::LayerMarks`), relative extrusion (`M83`, each `G1`'s `E` is that segment's filament length),
-//! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels.
+//! fixed-point numbers (X/Y/Z 3 decimals, E 5, F whole mm/min), retraction around travels, and
+//! the profile's motion limits in the header (`M201`, `M204`, `M205`).
 
 use crate::gcode::{comment_text, push_line, LayerMarks};
 use crate::kind::MachineKind;
@@ -144,6 +145,7 @@ impl Writer {
         self.line("G21 ; millimetres");
         self.line("G90 ; absolute XYZ");
         self.line("M83 ; relative extrusion: E is each segment's filament length");
+        self.motion_limits(m);
         self.line(&format!("M140 S{} ; bed", t(m.bed_temperature)));
         self.line(&format!("M104 S{} ; nozzle", t(m.nozzle_temperature)));
         self.line("G28 ; home all axes");
@@ -158,6 +160,41 @@ impl Writer {
             t(m.nozzle_temperature)
         ));
         self.line("G92 E0");
+    }
+
+    /// The profile's motion limits, those it gives, as Marlin sets them (and PrusaSlicer's
+    /// G-code viewer reads them for its time estimate): `M201` X/Y acceleration caps (the
+    /// larger of the print and travel accelerations), `M204 P T` print and travel
+    /// accelerations, `M205` X/Y jerk (`max_jerk`). Not `max_speed` as `M203`: firmwares read
+    /// its units differently (mm/s in Marlin, mm/min in RepRapFirmware; PrusaSlicer's viewer
+    /// took our 200 mm/s for 200 mm/min), and the programmed speeds stay below it anyway.
+    fn motion_limits(&mut self, m: &MachineProfile) {
+        let t = |v: f64| fixed(v, 0);
+        let travel = m.travel_acceleration.or(m.max_acceleration);
+        if let Some(cap) = m
+            .max_acceleration
+            .into_iter()
+            .chain(travel)
+            .reduce(f64::max)
+        {
+            self.line(&format!(
+                "M201 X{} Y{} ; acceleration caps (mm/s^2)",
+                t(cap),
+                t(cap)
+            ));
+        }
+        if let (Some(p), Some(tr)) = (m.max_acceleration, travel) {
+            self.line(&format!(
+                "M204 P{} T{} ; print and travel acceleration (mm/s^2)",
+                t(p),
+                t(tr)
+            ));
+        } else if let Some(tr) = travel {
+            self.line(&format!("M204 T{} ; travel acceleration (mm/s^2)", t(tr)));
+        }
+        if let Some(j) = m.max_jerk {
+            self.line(&format!("M205 X{} Y{} ; jerk (mm/s)", t(j), t(j)));
+        }
     }
 
     /// The layer comments (`gcode::LayerMarks`) where the point's layer or feature changes.

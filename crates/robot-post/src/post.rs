@@ -183,6 +183,7 @@ mod tests {
             e: 0.1,
             thickness: 0.2,
             width: 0.45,
+            role: toolpath::Role::Perimeter,
         };
         let path = ToolPath {
             points: vec![q(0.0, MoveKind::Travel), q(5.0, MoveKind::Print)],

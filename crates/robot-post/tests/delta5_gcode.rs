@@ -5,6 +5,7 @@
 use gcode::{Code, Value};
 use robot_post::delta5::{forward, inverse};
 use robot_post::machine::DELTA5_TOML;
+use robot_post::toolpath::Role;
 use robot_post::{
     delta5, Delta5Program, MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath,
 };
@@ -102,6 +103,7 @@ fn add_path(
             e,
             thickness: T,
             width: W,
+            role: robot_post::toolpath::Role::Perimeter,
         });
     }
 }
@@ -973,4 +975,42 @@ fn delta5_profile_table_is_documented_and_checked() {
     high.delta5.as_mut().unwrap().z_min = 500.0;
     let msg = delta5(&synthetic(), &high, "x").unwrap_err().to_string();
     assert!(msg.contains("z_min"), "{msg}");
+}
+
+/// The delta5 program carries the same `;TYPE:` comments as Marlin's (one writer for both):
+/// two latitude circles of one layer, the outer `External perimeter` and the inner
+/// `Perimeter`, then one circle on the next layer, `Perimeter` again; every print move lies
+/// under a `;TYPE:` of its layer.
+#[test]
+fn delta5_type_comments_follow_the_roles() {
+    let m = profile();
+    let mut path = ToolPath::default();
+    for (layer, psi) in [(0, 30.0), (0, 25.0), (1, 20.0)] {
+        let from = path.points.len();
+        add_path(&mut path, &m, 1, layer, &latitude(psi, 16));
+        let role = if psi == 30.0 {
+            Role::ExternalPerimeter
+        } else {
+            Role::Perimeter
+        };
+        for q in &mut path.points[from..] {
+            q.role = role;
+        }
+    }
+    let program = delta5(&path, &m, "sphere.step").unwrap().gcode;
+    let types: Vec<&str> = program
+        .lines()
+        .filter_map(|l| l.strip_prefix(";TYPE:"))
+        .collect();
+    assert_eq!(types, ["External perimeter", "Perimeter", "Perimeter"]);
+    let mut typed = false;
+    for l in program.lines() {
+        if l == ";LAYER_CHANGE" {
+            typed = false;
+        } else if l.starts_with(";TYPE:") {
+            typed = true;
+        } else if l.starts_with("G1 ") && l.contains(" E") && !l.contains(" E-") {
+            assert!(typed, "{l}");
+        }
+    }
 }

@@ -24,6 +24,7 @@ fn pt(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], axis: [f64; 3])
         e: if kind == MoveKind::Print { 0.03 } else { 0.0 },
         thickness: T,
         width: W,
+        role: robot_post::toolpath::Role::Perimeter,
     }
 }
 

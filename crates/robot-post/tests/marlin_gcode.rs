@@ -2,6 +2,7 @@
 //! reproduce `toolpath.csv` (issue "features plan").
 
 use gcode::{Code, Value};
+use robot_post::toolpath::Role;
 use robot_post::{marlin, MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
 
 const W: f64 = 0.45;
@@ -21,6 +22,7 @@ fn point(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], e: f64) -> P
         e,
         thickness: T,
         width: W,
+        role: robot_post::toolpath::Role::Perimeter,
     }
 }
 
@@ -257,6 +259,10 @@ fn marlin_numbers_are_fixed_point() {
         for word in code.split_whitespace() {
             let (letter, number) = word.split_at(1);
             match letter {
+                // The motion limits (M201, M204, M205) in whole units.
+                _ if code.starts_with("M20") => {
+                    assert!(number.bytes().all(|c| c.is_ascii_digit()), "`{line}`")
+                }
                 "X" | "Y" | "Z" if !code.starts_with("G28") => {
                     assert_eq!(number.split('.').nth(1).map(str::len), Some(3), "`{line}`")
                 }
@@ -284,11 +290,14 @@ fn marlin_header_and_footer() {
         .filter(|c| !c.is_empty())
         .collect();
     assert_eq!(
-        &codes[..10],
+        &codes[..13],
         [
             "G21",
             "G90",
             "M83",
+            "M201 X1500 Y1500",
+            "M204 P1000 T1500",
+            "M205 X10 Y10",
             "M140 S60",
             "M104 S210",
             "G28",
@@ -486,6 +495,7 @@ fn marlin_edge_cases_do_not_panic() {
                 e: rng.v(),
                 thickness: rng.v(),
                 width: rng.v(),
+                role: robot_post::toolpath::Role::Perimeter,
             });
         }
         let path = ToolPath { points };
@@ -514,9 +524,9 @@ fn toolpath_csv_round_trip() {
     let csv = path.to_csv();
     assert_eq!(
         csv.lines().next(),
-        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width")
+        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role")
     );
-    assert_eq!(csv.lines().nth(1), Some("1,0,travel,-22.500000,30.000000,5.200000,0.000000,0.000000,1.000000,0.000000,0.2000,0.4500"));
+    assert_eq!(csv.lines().nth(1), Some("1,0,travel,-22.500000,30.000000,5.200000,0.000000,0.000000,1.000000,0.000000,0.2000,0.4500,perimeter"));
     let back = ToolPath::from_csv(&csv).unwrap();
     assert_eq!(back.points.len(), path.points.len());
     for (a, b) in path.points.iter().zip(&back.points) {
@@ -531,4 +541,77 @@ fn toolpath_csv_round_trip() {
         assert!((a.thickness - b.thickness).abs() <= 5e-5 && (a.width - b.width).abs() <= 5e-5);
     }
     assert_eq!(back.to_csv(), csv);
+}
+
+/// Four squares on layer 0 of one feature, then one on layer 1, with the roles `roles`.
+fn squares_with_roles(m: &MachineProfile, roles: &[Role]) -> ToolPath {
+    let mut path = ToolPath::default();
+    for (k, &role) in roles.iter().enumerate() {
+        let layer = usize::from(k + 1 == roles.len());
+        let from = path.points.len();
+        let side = 30.0 - 4.0 * k as f64;
+        squares(
+            &mut path,
+            m,
+            1,
+            layer,
+            [0.0, 0.0],
+            side,
+            T * (layer as f64 + 1.0),
+        );
+        for q in &mut path.points[from..] {
+            q.role = role;
+        }
+    }
+    path
+}
+
+/// `;TYPE:` is written before a print move whose role differs from the last one written in
+/// its layer, and again at the first print move of every layer, with PrusaSlicer's names;
+/// every print move (G1 with E > 0) lies under one.
+#[test]
+fn marlin_type_comments_follow_the_roles() {
+    let m = profile();
+    let roles = [
+        Role::ExternalPerimeter,
+        Role::Perimeter,
+        Role::Perimeter,
+        Role::SolidInfill,
+        Role::SolidInfill,
+    ];
+    let program = marlin(&squares_with_roles(&m, &roles), &m, "roles").unwrap();
+    let types: Vec<&str> = program
+        .lines()
+        .filter_map(|l| l.strip_prefix(";TYPE:"))
+        .collect();
+    assert_eq!(
+        types,
+        [
+            "External perimeter",
+            "Perimeter",
+            "Solid infill",
+            "Solid infill"
+        ]
+    );
+    let mut typed = false;
+    let mut prints = 0;
+    for l in program.lines() {
+        if l == ";LAYER_CHANGE" {
+            typed = false;
+        } else if l.starts_with(";TYPE:") {
+            typed = true;
+        } else if l.starts_with("G1 X") && l.contains(" E") {
+            assert!(typed, "{l}");
+            prints += 1;
+        }
+    }
+    assert_eq!(prints, 4 * roles.len());
+    // Every role's name.
+    let names: Vec<&str> = Role::ALL.iter().map(|r| r.prusa_name()).collect();
+    let program = marlin(&squares_with_roles(&m, &Role::ALL), &m, "roles").unwrap();
+    let types: Vec<&str> = program
+        .lines()
+        .filter_map(|l| l.strip_prefix(";TYPE:"))
+        .collect();
+    assert_eq!(types, names);
 }

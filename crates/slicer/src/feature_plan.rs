@@ -121,6 +121,7 @@ mod tests {
             e: 0.0,
             thickness: 0.2,
             width: 0.45,
+            role: crate::toolpath::Role::Perimeter,
         }
     }
 

@@ -72,6 +72,7 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
         let mut cur = FillPath {
             points: vec![],
             widths: vec![],
+            role: p.role,
         };
         for (i, &kept) in inside.iter().enumerate() {
             if kept {
@@ -89,6 +90,7 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
                     FillPath {
                         points: vec![],
                         widths: vec![],
+                        role: p.role,
                     },
                 ));
             }
@@ -347,6 +349,7 @@ pub fn fill_freeform<'a>(
                 .max(MICROMETRE)
                 .min(spacing.max(MICROMETRE) * 1e3);
             let mut paths = vec![];
+            let layers = heights.len();
             for r in &regions {
                 paths.extend(fill_region(
                     chart,
@@ -363,7 +366,10 @@ pub fn fill_freeform<'a>(
             if let Some((field, z)) = clip {
                 paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
             }
-            (regions, paths)
+            (
+                regions,
+                crate::region_fill::solid_on_skins(paths, layer, layers),
+            )
         })
         .collect();
     drop(blended);
@@ -537,6 +543,7 @@ impl FreeformFill<'_> {
                         e: 0.0,
                         thickness: thick(first.q, dl),
                         width: bead.width,
+                        role: pts[0].role,
                     });
                     *cursor = Some(p);
                 }
@@ -572,6 +579,7 @@ impl FreeformFill<'_> {
                         e,
                         thickness: t,
                         width,
+                        role: w[1].role,
                     });
                 }
                 *cursor = pts.last().map(|x| x.p);

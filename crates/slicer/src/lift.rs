@@ -5,6 +5,7 @@ use crate::chart::Chart;
 use crate::geodesic::segment_distance;
 use crate::geom2d::Point2;
 use crate::region_fill::FillPath;
+use crate::toolpath::Role;
 use brep::math::{P3, V3};
 
 /// A lifted path point: chart coordinates, position and unit normal.
@@ -17,6 +18,8 @@ pub(crate) struct Lifted {
     pub(crate) w: f64,
     /// The layer surface's unit normal here (`n` may be turned to another axis, e.g. SST's).
     pub(crate) ln: V3,
+    /// What the path is for.
+    pub(crate) role: Role,
 }
 
 /// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
@@ -41,6 +44,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
                     n,
                     w: 0.5 * (a.w + b.w),
                     ln: n,
+                    role: a.role,
                 };
                 if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
                     refine(chart, a, mid, z, tol, depth + 1, out);
@@ -62,6 +66,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
             n,
             w: *w,
             ln: n,
+            role: path.role,
         };
         match dense.last().copied() {
             Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),

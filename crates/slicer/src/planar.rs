@@ -9,7 +9,7 @@
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
 use crate::params::{LayerParams, PathMode};
-use crate::region_fill::{fill_flat_region, Boundary, FillPath};
+use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
@@ -113,7 +113,7 @@ pub fn fill_regions(
     let mut paths: Vec<FillPath> = filled
         .paths
         .into_iter()
-        .map(|p| FillPath::uniform(p.points, width))
+        .map(|p| FillPath::uniform(p.points, width, p.role))
         .collect();
     for r in &thin {
         paths.extend(fill_flat_region(
@@ -208,7 +208,8 @@ pub fn fill_two5d(
                 .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
                 .collect();
             let regions = regions_from_loops(&loops);
-            fill_regions(regions, params, layer, bead.width, spacing)
+            let paths = fill_regions(regions, params, layer, bead.width, spacing);
+            solid_on_skins(paths, layer, heights.len())
         })
         .collect();
     Ok(Two5dFill {
@@ -261,6 +262,7 @@ impl Two5dFill {
                     e: 0.0,
                     thickness: dl,
                     width: path.widths[0],
+                    role: path.role,
                 });
                 for (i, w) in pts.windows(2).enumerate() {
                     let l = (w[1] - w[0]).norm();
@@ -278,6 +280,7 @@ impl Two5dFill {
                         e,
                         thickness: dl,
                         width: path.widths[i + 1],
+                        role: path.role,
                     });
                 }
                 cursor = pts.last().copied();

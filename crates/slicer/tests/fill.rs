@@ -6,6 +6,7 @@ use slicer::fill::{
 use slicer::freeform::FillPath;
 use slicer::params::{LayerParams, PathMode};
 use slicer::planar::fill_regions;
+use slicer::toolpath::Role;
 use std::f64::consts::PI;
 
 /// Chord sag of offset arcs at reflex corners: 1 % of the 0.4 mm width.
@@ -694,10 +695,12 @@ fn order_paths_takes_the_nearest_end() {
     let line = |a: Point2, b: Point2| Path2 {
         points: vec![a, b],
         kind: PathKind::Infill,
+        role: Role::SolidInfill,
     };
     let ring = Path2 {
         points: vec![[5.0, 5.0], [6.0, 5.0], [6.0, 6.0], [5.0, 5.0]],
         kind: PathKind::Perimeter,
+        role: Role::ExternalPerimeter,
     };
     let paths = vec![
         line([10.0, 0.0], [20.0, 0.0]),
@@ -706,6 +709,7 @@ fn order_paths_takes_the_nearest_end() {
         Path2 {
             points: vec![],
             kind: PathKind::Infill,
+            role: Role::SolidInfill,
         },
     ];
     let out = order_paths(paths, [0.0, 0.0]);
@@ -1153,4 +1157,74 @@ fn a_web_narrower_than_two_rings_is_not_laid_twice() {
             "{mode:?}: bead area / area {ratio:.4}"
         );
     }
+}
+
+/// Roles: in a square plate with a round hole, the first ring about the outside and the one
+/// about the hole are `ExternalPerimeter` (the beads on the part's surface, each within half
+/// a bead of its boundary), the second ring `Perimeter`, the zig-zag between them
+/// `SolidInfill` where beads touch and `InternalInfill` where they are laid apart; in a strip
+/// 4.6 beads wide filled by contours, the 0.6 bead the two rings from each side leave in the
+/// middle is `GapFill`.
+#[test]
+fn paths_carry_the_roles_slicers_name() {
+    let regions = regions_from_loops(&[
+        rect(0.0, 0.0, 20.0, 20.0),
+        circle([10.0, 10.0], 3.0, 64, false),
+    ]);
+    let w = 0.4;
+    let filled = fill_layer(&regions, &params(PathMode::ContourZigzag), 0, w, w);
+    let rings: Vec<&Path2> = filled
+        .paths
+        .iter()
+        .filter(|p| p.kind == PathKind::Perimeter)
+        .collect();
+    assert_eq!(
+        rings.len(),
+        4,
+        "two rings about the outside, two about the hole"
+    );
+    for r in &rings {
+        // Distance of the ring to the region's boundary: the square's edge or the hole's.
+        let d = r
+            .points
+            .iter()
+            .map(|p| {
+                let edge = p[0].min(p[1]).min(20.0 - p[0]).min(20.0 - p[1]);
+                let hole = (p[0] - 10.0).hypot(p[1] - 10.0) - 3.0;
+                edge.min(hole)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let want = if (d - 0.5 * w).abs() < 0.02 {
+            Role::ExternalPerimeter
+        } else {
+            assert!((d - 1.5 * w).abs() < 0.02, "ring {d} mm in");
+            Role::Perimeter
+        };
+        assert_eq!(r.role, want, "ring {d} mm in");
+    }
+    let infill: Vec<&Path2> = filled
+        .paths
+        .iter()
+        .filter(|p| p.kind == PathKind::Infill)
+        .collect();
+    assert!(!infill.is_empty());
+    assert!(infill.iter().all(|p| p.role == Role::SolidInfill));
+    let sparse = LayerParams {
+        filling_ratio: 0.3,
+        ..params(PathMode::ContourZigzag)
+    };
+    let filled = fill_layer(&regions, &sparse, 0, w, w / 0.3);
+    assert!(filled
+        .paths
+        .iter()
+        .filter(|p| p.kind == PathKind::Infill)
+        .all(|p| p.role == Role::InternalInfill));
+    let strip = regions_from_loops(&[rect(0.0, 0.0, 30.0, 4.0 * w + 0.6 * w)]);
+    let paths = fill_regions(strip, &params(PathMode::Contour), 0, w, w);
+    assert!(
+        paths.iter().any(|p| p.role == Role::GapFill),
+        "{:?}",
+        paths.iter().map(|p| p.role).collect::<Vec<_>>()
+    );
+    assert!(paths.iter().any(|p| p.role == Role::ExternalPerimeter));
 }

@@ -43,6 +43,7 @@ fn point(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], axis: [f64; 
         e: if kind == MoveKind::Print { 0.01 } else { 0.0 },
         thickness: 0.2,
         width: 0.4,
+        role: slicer::toolpath::Role::Perimeter,
     }
 }
 

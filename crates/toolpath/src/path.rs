@@ -1,6 +1,7 @@
 //! The planned tool path the posts consume (the planner fills it), and its `toolpath.csv` form.
 
 use crate::fixed::push_fixed;
+use crate::role::Role;
 
 /// Why a tool path could not be read or used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -65,6 +66,8 @@ pub struct PathPoint {
     pub thickness: f64,
     /// Bead width w at this point (mm).
     pub width: f64,
+    /// What the path this point belongs to is for (a travel point: the path it leads to).
+    pub role: Role,
 }
 
 /// A planned path: points in the order the machine visits them.
@@ -75,13 +78,15 @@ pub struct ToolPath {
 }
 
 /// The header line of `toolpath.csv`.
-pub const CSV_HEADER: &str = "feature,layer,move,x,y,z,i,j,k,e,thickness,width";
+pub const CSV_HEADER: &str = "feature,layer,move,x,y,z,i,j,k,e,thickness,width,role";
 
 impl ToolPath {
     /// The path as CSV: the header exactly [`CSV_HEADER`]
-    /// (`feature,layer,move,x,y,z,i,j,k,e,thickness,width`), then one line per point; `move`
-    /// is `print` or `travel`; coordinates, axis and `e` with 6 decimals, thickness and width
-    /// with 4, fixed-point (never exponent notation, no `-0`). Lines end with `\n`.
+    /// (`feature,layer,move,x,y,z,i,j,k,e,thickness,width,role`), then one line per point;
+    /// `move` is `print` or `travel`; coordinates, axis and `e` with 6 decimals, thickness and
+    /// width with 4, fixed-point (never exponent notation, no `-0`); `role` last (appended
+    /// after the older columns, which keep their places), [`Role::as_str`]. Lines end with
+    /// `\n`.
     pub fn to_csv(&self) -> String {
         let mut out = Vec::with_capacity(64 * (self.points.len() + 1));
         // Writing to memory cannot fail, and the text is ASCII.
@@ -111,6 +116,8 @@ impl ToolPath {
                 line.push(',');
                 push_fixed(&mut line, x, decimals);
             }
+            line.push(',');
+            line.push_str(q.role.as_str());
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
@@ -142,8 +149,8 @@ impl ToolPath {
                 reason,
             };
             let f: Vec<&str> = line.split(',').map(str::trim).collect();
-            if f.len() != 12 {
-                return Err(err(format!("expected 12 fields, got {}", f.len())));
+            if f.len() != 13 {
+                return Err(err(format!("expected 13 fields, got {}", f.len())));
             }
             let int = |k: usize, name: &str| {
                 f[k].parse::<usize>()
@@ -175,6 +182,13 @@ impl ToolPath {
                 e: num(9, "e")?,
                 thickness: num(10, "thickness")?,
                 width: num(11, "width")?,
+                role: Role::parse(f[12]).ok_or_else(|| {
+                    err(format!(
+                        "role `{}` is not one of {}",
+                        clip(f[12]),
+                        role_names()
+                    ))
+                })?,
             });
         }
         Ok(ToolPath { points })
@@ -207,6 +221,11 @@ impl ToolPath {
     }
 }
 
+/// The roles' CSV names, for an error message.
+fn role_names() -> String {
+    Role::ALL.map(Role::as_str).join(", ")
+}
+
 /// `s` cut to 40 characters for an error message, with control characters replaced.
 fn clip(s: &str) -> String {
     let mut out: String = s
@@ -234,6 +253,7 @@ mod tests {
             e,
             thickness: 0.2,
             width: 0.45,
+            role: Role::Perimeter,
         };
         ToolPath {
             points: vec![
@@ -250,13 +270,16 @@ mod tests {
         let csv = p.to_csv();
         assert_eq!(
             csv.lines().next(),
-            Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width")
+            Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role")
         );
         assert!(!csv.contains("e-") && !csv.contains("e+") && !csv.contains("-0.000000,"));
         let back = ToolPath::from_csv(&csv).unwrap();
         assert_eq!(back.points.len(), p.points.len());
         for (a, b) in p.points.iter().zip(&back.points) {
-            assert_eq!((a.feature, a.layer, a.kind), (b.feature, b.layer, b.kind));
+            assert_eq!(
+                (a.feature, a.layer, a.kind, a.role),
+                (b.feature, b.layer, b.kind, b.role)
+            );
             for k in 0..3 {
                 assert!((a.p[k] - b.p[k]).abs() <= 5e-7);
                 assert!((a.axis[k] - b.axis[k]).abs() <= 5e-7);
@@ -282,7 +305,8 @@ mod tests {
             (good.replace("travel", "jump"), 2, "move"),
             (good.replacen(",0.2000,", ",NaN,", 1), 2, "thickness"),
             (good.replacen("3,1,print", "-3,1,print", 1), 3, "feature"),
-            (format!("{good}1,2,print\n"), 5, "12 fields"),
+            (format!("{good}1,2,print\n"), 5, "13 fields"),
+            (good.replacen(",perimeter\n", ",wall\n", 1), 2, "role"),
         ];
         for (text, line, needle) in cases {
             match ToolPath::from_csv(&text) {

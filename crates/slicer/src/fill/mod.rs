@@ -36,6 +36,7 @@ mod region;
 
 use crate::geom2d::{area2, dist};
 use crate::params::{LayerParams, PathMode};
+use crate::toolpath::Role;
 use i_overlay::mesh::float::style::LineJoin;
 use offset::{erode, offset, round_join};
 use pattern::{drop_short_segments, rings, scan_fill, Reach};
@@ -54,6 +55,12 @@ pub struct Path2 {
     pub points: Vec<Point2>,
     /// What the path is.
     pub kind: PathKind,
+    /// What it is for, as slicers name it: the first ring (about the outside and about each
+    /// hole) [`Role::ExternalPerimeter`], the others [`Role::Perimeter`], infill lines
+    /// [`Role::SolidInfill`] or [`Role::InternalInfill`] by their spacing
+    /// ([`infill_role`]), the lines in strips rings leave
+    /// [`Role::GapFill`].
+    pub role: Role,
 }
 
 /// What a path is for.
@@ -152,6 +159,7 @@ pub fn fill_layer(
     } else {
         0.0
     };
+    let infill = infill_role(width, spacing);
     let zigzag_angle = if layer % 2 == 1 {
         base_angle + 90.0
     } else {
@@ -183,6 +191,7 @@ pub fn fill_layer(
             join: round_join(tol.min(0.01 * width), deepest.min(0.5 * size)),
             tol: tol.min(0.0025 * width),
         };
+        let lines_from = out.len();
         match params.path_mode {
             PathMode::Raster => {
                 let area = erode(&base, 0.5 * width, &ctx.join);
@@ -218,8 +227,13 @@ pub fn fill_layer(
                 // would take in the strips left to the gaps).
                 let edge = offset(&area, 0.5 * spacing, &ctx.join, 1.0);
                 let reach = Some(Reach { base: &edge, width });
+                let from = out.len();
                 scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
+                set_role(&mut out[from..], infill);
             }
+        }
+        if matches!(params.path_mode, PathMode::Raster | PathMode::Zigzag) {
+            set_role(&mut out[lines_from..], infill);
         }
     }
     for p in &mut out {
@@ -232,6 +246,25 @@ pub fn fill_layer(
     FilledLayer {
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
+    }
+}
+
+/// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]
+/// where the beads touch (spacing at most the width, the default `filling_ratio` 1),
+/// [`Role::InternalInfill`] where they are laid apart (the planners make a feature's bottom
+/// and top layers solid: [`crate::region_fill::solid_on_skins`]).
+pub fn infill_role(width: f64, spacing: f64) -> Role {
+    if spacing <= width * (1.0 + 1e-6) {
+        Role::SolidInfill
+    } else {
+        Role::InternalInfill
+    }
+}
+
+/// Gives `paths` the role `role`.
+fn set_role(paths: &mut [Path2], role: Role) {
+    for p in paths {
+        p.role = role;
     }
 }
 

@@ -7,6 +7,7 @@ use super::{
 };
 use crate::geom2d::{area2, dist, perimeter, Point2};
 use crate::tolerance::ROUND_OFF;
+use crate::toolpath::Role;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
@@ -114,12 +115,18 @@ pub(super) fn rings(
                 line_fill(strips, ctx, out);
             }
         }
+        let role = if k == 0 {
+            Role::ExternalPerimeter
+        } else {
+            Role::Perimeter
+        };
         for c in ring.iter().flatten() {
             let mut pts = c.clone();
             pts.push(c[0]);
             out.push(Path2 {
                 points: pts,
                 kind: PathKind::Perimeter,
+                role,
             });
         }
         lost = !clean;
@@ -140,9 +147,13 @@ pub(super) fn rings(
 /// Fills strips narrower than a bead (the middle rings leave) with lines along each strip's
 /// long axis, `spacing` apart.
 fn line_fill(strips: Shapes, ctx: &Ctx, out: &mut Vec<Path2>) {
+    let from = out.len();
     for shape in strips {
         let angle = principal_angle(&shape);
         scan_fill(&vec![shape], angle, ctx.spacing, true, None, out);
+    }
+    for p in &mut out[from..] {
+        p.role = Role::GapFill;
     }
 }
 
@@ -262,7 +273,8 @@ pub(super) struct Reach<'a> {
 /// With `join`, neighbouring lines of a connected piece are chained along the boundary
 /// (zig-zag); without, each line is its own path, printed in the +angle direction. With
 /// `reach`, the ends left free (every end without `join`, a chain's first and last with it)
-/// run on past `area`'s edge towards the boundary of `reach.base`.
+/// run on past `area`'s edge towards the boundary of `reach.base`. The lines are
+/// [`Role::InternalInfill`]; the caller gives them their role.
 pub(super) fn scan_fill(
     area: &Shapes,
     angle: f64,
@@ -394,6 +406,7 @@ pub(super) fn scan_fill(
             out.push(Path2 {
                 points: vec![unrot(run_on(a)), unrot(run_on(b))],
                 kind: PathKind::Infill,
+                role: Role::InternalInfill,
             });
         }
         return;
@@ -466,6 +479,7 @@ pub(super) fn scan_fill(
             out.push(Path2 {
                 points: pts.into_iter().map(unrot).collect(),
                 kind: PathKind::Infill,
+                role: Role::InternalInfill,
             });
         }
     }

@@ -3,6 +3,7 @@
 
 use super::FillPath;
 use crate::geodesic::LayerMesh;
+use crate::toolpath::Role;
 
 /// Where a gap fill runs: from `edge` (the distance to the region's boundary where the beads
 /// outside it stop), its beads' middles `inset` further in, no narrower than `min_width`, and
@@ -63,7 +64,7 @@ pub(super) fn gap_fill(
         return out;
     }
     for line in lm.iso_lines(db, gap.edge + gap.inset, ridge) {
-        let mut cur = FillPath::default();
+        let mut cur = FillPath::empty(Role::GapFill);
         for (q, r) in line.q.iter().zip(&line.other) {
             let w = if *r < gap.below {
                 (r - gap.edge).clamp(0.0, width)
@@ -74,9 +75,9 @@ pub(super) fn gap_fill(
                 cur.points.push(*q);
                 cur.widths.push(w);
             } else if cur.points.len() >= 2 {
-                out.push(std::mem::take(&mut cur));
+                out.push(std::mem::replace(&mut cur, FillPath::empty(Role::GapFill)));
             } else {
-                cur = FillPath::default();
+                cur = FillPath::empty(Role::GapFill);
             }
         }
         if cur.points.len() >= 2 {

@@ -14,6 +14,7 @@ use crate::chart::Chart;
 use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
 use crate::geom2d::{Point2, Region};
 use crate::params::{LayerParams, PathMode};
+use crate::toolpath::Role;
 use border::Border;
 use brep::math::{P3, V3};
 use brep::surface::Surface;
@@ -22,20 +23,35 @@ use gap::{crossing_vertices, gap_fill, ridge_for, Gap};
 pub(crate) use spurs::corner_spurs;
 
 /// One path of a curved layer in chart coordinates (or of a planar layer in its plane's),
-/// with the bead width at each point.
-#[derive(Debug, Clone, Default)]
+/// with the bead width at each point and what it is for.
+#[derive(Debug, Clone)]
 pub struct FillPath {
     /// Bead centre line.
     pub points: Vec<Point2>,
     /// Bead width at each point, mm.
     pub widths: Vec<f64>,
+    /// What the path is for.
+    pub role: Role,
 }
 
 impl FillPath {
     /// A path of one bead width throughout.
-    pub fn uniform(points: Vec<Point2>, width: f64) -> Self {
+    pub fn uniform(points: Vec<Point2>, width: f64, role: Role) -> Self {
         let widths = vec![width; points.len()];
-        FillPath { points, widths }
+        FillPath {
+            points,
+            widths,
+            role,
+        }
+    }
+
+    /// A path with no points yet.
+    pub fn empty(role: Role) -> Self {
+        FillPath {
+            points: vec![],
+            widths: vec![],
+            role,
+        }
     }
 
     /// The same path run the other way.
@@ -84,6 +100,12 @@ pub fn fill_flat_region(
     );
     paths.extend(corner_spurs(&chart, region, 0.0, width));
     paths.retain(|p| p.points.len() >= 2);
+    if boundary == Boundary::Beads {
+        // A strip the rings leave: its beads, as wide as the strip, are gap fill.
+        for p in &mut paths {
+            p.role = Role::GapFill;
+        }
+    }
     paths
 }
 
@@ -195,9 +217,15 @@ pub(crate) fn fill_region(
                     }
                 })
                 .collect();
+            let role = if j == 0 {
+                Role::ExternalPerimeter
+            } else {
+                Role::Perimeter
+            };
             out.push(FillPath {
                 points: line.q,
                 widths,
+                role,
             });
         }
         last_ring = Some(c);
@@ -248,6 +276,7 @@ pub(crate) fn fill_region(
         None => 0.5 * width,
     };
     let zig = params.path_mode != PathMode::Raster;
+    let infill = crate::fill::infill_role(width, spacing);
     let angle = if zig && layer % 2 == 1 {
         params.raster_angle_deg + 90.0
     } else {
@@ -354,7 +383,7 @@ pub(crate) fn fill_region(
         out.extend(
             pieces
                 .into_iter()
-                .map(|(_, p)| FillPath::uniform(p.reaching(), width)),
+                .map(|(_, p)| FillPath::uniform(p.reaching(), width, infill)),
         );
         return out;
     }
@@ -405,9 +434,22 @@ pub(crate) fn fill_region(
             }
         }
         pts.extend(tail);
-        out.push(FillPath::uniform(pts, width));
+        out.push(FillPath::uniform(pts, width, infill));
     }
     out
+}
+
+/// The paths of layer `layer` of `layers` with their internal infill made solid where the
+/// layer is a feature's first or last (its bottom or top skin).
+pub fn solid_on_skins(mut paths: Vec<FillPath>, layer: usize, layers: usize) -> Vec<FillPath> {
+    if layer == 0 || layer + 1 >= layers {
+        for p in &mut paths {
+            if p.role == Role::InternalInfill {
+                p.role = Role::SolidInfill;
+            }
+        }
+    }
+    paths
 }
 
 /// The range of `phi` over the part of the lattice where `db` is at least `edge`, with the

@@ -5,6 +5,7 @@ use super::FillPath;
 use crate::chart::Chart;
 use crate::geom2d::{Point2, Region};
 use crate::tolerance::DEGENERATE_LENGTH;
+use crate::toolpath::Role;
 use brep::math::P3;
 
 /// A corner spur is laid only at a convex corner of the layer region sharper than this
@@ -130,7 +131,7 @@ pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -
                 continue;
             }
             let steps = ((rho_s - rho_e) / (0.25 * width)).ceil().clamp(1.0, 1e3) as usize;
-            let mut spur = FillPath::default();
+            let mut spur = FillPath::empty(Role::GapFill);
             for k in 0..=steps {
                 let rho = rho_e + (rho_s - rho_e) * k as f64 / steps as f64;
                 let f = rho / (2.0 * cs);
