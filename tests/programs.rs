@@ -269,3 +269,135 @@ fn delta5_impeller_program_has_no_empty_moves_and_feeds_within_the_limit() {
         "; F: machine-axis feed (mm/min along the XYZ path, degrees/min for a move of B and C alone) scaled so the nozzle moves over the part at print_speed"
     ));
 }
+
+#[test]
+fn krl_feed_follows_the_planned_flow_per_lin() {
+    use robot_post::krl::Target;
+    let s = Scratch::new("krl");
+    let out = s.path("imp");
+    let o = plan(
+        "impeller.step",
+        &[
+            "--machine",
+            "kuka",
+            "--allow-collisions",
+            "--allow-unreachable",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut files = vec![];
+    for entry in std::fs::read_dir(&out).expect("output folder").flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.ends_with(".src") || name.ends_with(".dat") {
+            files.push((name, read(&entry.path())));
+        }
+    }
+    let main = files
+        .iter()
+        .find(|(n, _)| n == "impeller.src")
+        .map(|(_, t)| t.clone())
+        .expect("impeller.src");
+    assert!(main.contains("; filament feed per print LIN: $ANOUT[1] = feed ratio / 0.10000"));
+    assert!(
+        !main.contains("mm per mm of bead"),
+        "no single ratio for the program"
+    );
+    let krl = robot_post::krl::read(&files).expect("the KRL reads back");
+    let full_scale = 0.1;
+    let offset = krl.offset.expect("part offset");
+    // The planned print points, in order, with their segment's start.
+    let csv = read(&out.join("toolpath.csv"));
+    let rows: Vec<(usize, bool, [f64; 3], f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let n = |i: usize| f[i].parse::<f64>().unwrap();
+            (
+                f[0].parse().unwrap(),
+                f[2] == "print",
+                [n(3), n(4), n(5)],
+                n(9),
+            )
+        })
+        .collect();
+    // Walk the extruding LINs along the planned points: each LIN reaches the next planned
+    // point it ends on (3 decimals); the planned ratio is the filament of the points since the
+    // previous LIN's over the distance between them.
+    let part = |t: &[f64; 6]| [t[0] - offset[0], t[1] - offset[1], t[2] - offset[2]];
+    let d = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let (mut j, mut checked) = (0usize, 0usize);
+    let mut from: Option<(usize, [f64; 3])> = None;
+    // Per feature: filament and length read back, as the planned ratio's average.
+    let mut by_feature = std::collections::BTreeMap::<usize, (f64, f64)>::new();
+    let mut worst = 0.0f64;
+    for mv in &krl.moves {
+        let Target::Frame(t) = mv.target else {
+            from = None;
+            continue;
+        };
+        let p = part(&t);
+        if !mv.extruder {
+            // Where a path starts: the planned travel point the approach ends on.
+            from = rows[j..]
+                .iter()
+                .position(|r| d(r.2, p) < 2e-3)
+                .map(|k| (j + k, p));
+            if let Some((k, _)) = from {
+                j = k;
+            }
+            continue;
+        }
+        let (start, a) = from.expect("a print LIN follows a path start");
+        let k = start
+            + 1
+            + rows[start + 1..]
+                .iter()
+                .position(|r| d(r.2, p) < 2e-3)
+                .expect("every print LIN ends on a planned point");
+        let e: f64 = rows[start + 1..=k]
+            .iter()
+            .filter(|r| r.1)
+            .map(|r| r.3)
+            .sum();
+        let length = d(rows[k].2, rows[start].2);
+        let ratio = mv.feed.expect("a feed before printing") * full_scale;
+        if length >= 0.05 && e > 0.0 {
+            let planned = e / length;
+            let off = (ratio - planned).abs() / planned;
+            worst = worst.max(off);
+            assert!(
+                off <= 0.01,
+                "LIN at {p:?}: ratio {ratio} read back, {planned} planned"
+            );
+            checked += 1;
+        }
+        let f = by_feature.entry(rows[k].0).or_default();
+        f.0 += ratio * d(p, a);
+        f.1 += d(p, a);
+        (j, from) = (k, Some((k, p)));
+    }
+    assert!(checked > 10_000, "{checked} LINs checked");
+    eprintln!(
+        "{checked} print LINs within {:.4} % of the planned ratio",
+        worst * 100.0
+    );
+    // The base needs about 0.0374 mm of filament per mm, the blades 0.0286.
+    let mean = |f: usize| by_feature[&f].0 / by_feature[&f].1;
+    eprintln!(
+        "feed ratios read back: {:?}",
+        (0..7).map(mean).collect::<Vec<_>>()
+    );
+    assert!((mean(0) - 0.0374).abs() < 0.001, "base {}", mean(0));
+    for blade in 1..=6 {
+        assert!(
+            (mean(blade) - 0.0286).abs() < 0.001,
+            "blade {blade}: {}",
+            mean(blade)
+        );
+    }
+}
