@@ -32,7 +32,8 @@ pub struct MachineProfile {
     pub filament_diameter: f64,
     /// Bead width w (mm).
     pub bead_width: f64,
-    /// Narrowest bead the nozzle lays well (mm); narrower beads of a plan are a warning.
+    /// Narrowest bead the nozzle lays well (mm); narrower beads of a plan are widened to it
+    /// (their filament with them) with a warning.
     /// Optional: 0.6 × `nozzle_diameter` when left out ([`MachineProfile::min_bead_width`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_bead_width: Option<f64>,
