@@ -72,17 +72,33 @@ impl LayerMarks {
 /// The part-cooling fan of a G-code program (Marlin and delta5): `M106 S<0..255>` or `M107`
 /// where the wanted speed changes, written before the print move that needs it. Beads resting
 /// on the build plate get `fan_first_layer`, the others `fan_speed`.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub(crate) struct Fan {
+    /// The `S` on the first layer and above it.
+    first_layer: u8,
+    above: u8,
     /// The `S` written last.
     at: Option<u8>,
 }
 
 impl Fan {
+    /// The fan of profile `m`, not yet set.
+    pub(crate) fn new(m: &MachineProfile) -> Fan {
+        Fan {
+            first_layer: m.fan_pwm(true),
+            above: m.fan_pwm(false),
+            at: None,
+        }
+    }
+
     /// Writes the fan command for a print move (`first_layer`: its bead rests on the plate)
     /// when the speed changes.
-    pub(crate) fn set(&mut self, m: &MachineProfile, first_layer: bool, out: &mut String) {
-        let s = m.fan_pwm(first_layer);
+    pub(crate) fn set(&mut self, first_layer: bool, out: &mut String) {
+        let s = if first_layer {
+            self.first_layer
+        } else {
+            self.above
+        };
         if self.at == Some(s) {
             return;
         }

@@ -105,8 +105,6 @@ struct Writer {
     first_layer_f: String,
     z_hop: f64,
     z_max: f64,
-    /// The fan speeds of the profile.
-    profile: MachineProfile,
 }
 
 impl Writer {
@@ -119,7 +117,7 @@ impl Writer {
             printing: false,
             hopped: false,
             marks: LayerMarks::default(),
-            fan: Fan::default(),
+            fan: Fan::new(m),
             extrusion: Extrusion::default(),
             retraction: m.retraction_length,
             retraction_f: f(m.retraction_speed),
@@ -128,7 +126,6 @@ impl Writer {
             first_layer_f: f(m.first_layer_speed),
             z_hop: m.z_hop,
             z_max: m.bed_size[2],
-            profile: m.clone(),
         }
     }
 
@@ -271,7 +268,7 @@ impl Writer {
         }
         // A bead resting on the plate (its bottom within 10 µm of Z0) goes at first-layer speed.
         let on_plate = t[2] - q.thickness.max(0.0) <= 0.01;
-        self.fan.set(&self.profile, on_plate, &mut self.out);
+        self.fan.set(on_plate, &mut self.out);
         let f = if on_plate {
             &self.first_layer_f
         } else {

@@ -93,7 +93,7 @@ impl<'a> Writer<'a> {
             travel_f: fixed(m.travel_speed * 60.0, 0),
             retraction_f: fixed(m.retraction_speed * 60.0, 0),
             extrusion: Extrusion::default(),
-            fan: Fan::default(),
+            fan: Fan::new(m),
             clamped: (0, 0.0),
             figures: BTreeMap::new(),
             plot: Vec::new(),
@@ -340,7 +340,7 @@ impl<'a> Writer<'a> {
             acc.figures.max_axis_deviation_deg = acc.figures.max_axis_deviation_deg.max(dev);
         }
         let max_feed = self.m.max_feed_mm_min();
-        self.fan.set(self.m, on_table, &mut self.out);
+        self.fan.set(on_table, &mut self.out);
         let mut lines = Vec::with_capacity(n);
         let mut written = Vec::with_capacity(n);
         for (&to, &(worst, sum, count)) in moves.iter().zip(&errors) {
