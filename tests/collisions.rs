@@ -425,7 +425,7 @@ fn check_travels(name: &str, machine: MachineKind, run: &Planned) {
                     turn += (to[3] - from[3]).abs() + (to[4] - from[4]).abs();
                 }
             }
-        } else if e.is_some_and(|e| e >= 0.0) {
+        } else if !e.is_some_and(|e| e < 0.0) {
             if turn > 0.0 {
                 travels += 1;
             }

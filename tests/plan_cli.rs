@@ -120,17 +120,25 @@ fn every_warning_of_the_plan_is_one_line_on_stderr() {
         );
     }
     // Narrow beads (the blades' thin edges): each blade's warning gives the share of its print
-    // points under min_bead_width (0.24 mm built in), counted again here from toolpath.csv.
+    // points under min_bead_width (0.24 mm built in), which are widened to it: counted again
+    // here from toolpath.csv, where no bead is narrower and they are the beads exactly 0.24
+    // wide. The filament of each feature's print points is what plan.json says it planned and
+    // added by widening.
     let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
     let mut narrow = std::collections::BTreeMap::<usize, (usize, usize)>::new();
+    let mut filament = std::collections::BTreeMap::<usize, f64>::new();
     for line in csv.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         if f[2] != "print" {
             continue;
         }
-        let e = narrow.entry(f[0].parse().unwrap()).or_default();
+        let id = f[0].parse().unwrap();
+        *filament.entry(id).or_default() += f[9].parse::<f64>().unwrap();
+        let e = narrow.entry(id).or_default();
         e.1 += 1;
-        if f[11].parse::<f64>().unwrap() < 0.24 {
+        let w = f[11].parse::<f64>().unwrap();
+        assert!(w >= 0.24, "a bead {w} mm wide is left");
+        if f[11] == "0.2400" {
             e.0 += 1;
         }
     }
@@ -147,6 +155,30 @@ fn every_warning_of_the_plan_is_one_line_on_stderr() {
         narrow.values().any(|(n, _)| *n > 0),
         "the blades have narrow beads"
     );
+    let area = std::f64::consts::PI * 1.75f64.powi(2) / 4.0;
+    for f in report["features"].as_array().unwrap() {
+        let id = f["id"].as_u64().unwrap() as usize;
+        let planned = f["extruded_volume_mm3"].as_f64().unwrap();
+        let widened = f["widened_volume_mm3"].as_f64().unwrap();
+        let laid = filament[&id] * area;
+        assert!(
+            (planned + widened - laid).abs() < 1e-3 * laid,
+            "feature {id}: {planned} + {widened} mm^3 vs {laid} laid"
+        );
+        assert_eq!(widened > 0.0, narrow[&id].0 > 0, "feature {id}");
+        if widened > 0.0 {
+            // The blades: 12.7 % more than planned, said in the warning.
+            assert!(
+                (widened / planned - 0.127).abs() < 0.005,
+                "{widened} / {planned}"
+            );
+            assert!(
+                all.iter().any(|w| w.starts_with(&format!("feature {id}: "))
+                    && w.contains(&format!("widened to 0.24 mm, {widened:.1} mm^3 more"))),
+                "feature {id}: no widening in {all:?}"
+            );
+        }
+    }
     // The summary counts them.
     let summary = String::from_utf8_lossy(&o.stdout);
     assert!(

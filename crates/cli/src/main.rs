@@ -249,7 +249,10 @@ impl Failure {
 fn progress_bar(template: &str) -> indicatif::ProgressBar {
     let bar =
         indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::stderr());
-    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+    if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        // The elapsed time keeps running through long stages.
+        bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    } else {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
     bar.set_style(

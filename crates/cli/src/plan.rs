@@ -27,11 +27,26 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     }
     // A feature's bad parameters are reported against the process file (or the part without one).
     let process_file = args.process.as_deref().unwrap_or(path);
+    // One bar over the whole run (hidden when stderr is not a terminal): reading the part, each
+    // feature, the stages after them (plan::STAGES) and writing the outputs, with the time
+    // elapsed; cleared when the run ends, however it ends.
+    let bar = Bar(crate::progress_bar(
+        "{prefix} {bar:30} {pos}/{len} {msg} [{elapsed}]",
+    ));
+    bar.0.set_length(1);
+    bar.0.set_prefix("reading");
+    bar.0.set_message(path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    ));
     let auto = args.orient.as_deref() == Some("auto");
     let (part, placement) = crate::placement::read_placed(path, args.base_face, auto)?;
+    bar.0.inc(1);
+    bar.0.set_prefix("planning");
     if let Some(p) = &placement {
         let d = p.down;
-        eprintln!(
+        bar.0.suspend(|| {
+            eprintln!(
             "features: {}: standing on face #{} (outward normal {:.4} {:.4} {:.4} turned down; {})",
             path.display(),
             p.base_face,
@@ -39,14 +54,23 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             d[1],
             d[2],
             p.rule
-        );
+        )
+        });
     }
-    let bar = crate::progress_bar("planning {bar:30} {pos}/{len} features {msg} [{elapsed}]");
+    // Reading, the features, the stages after them, writing.
     let progress = |p: Progress| match p {
-        Progress::Start { features } => bar.set_length(features),
-        Progress::Feature { id } => bar.set_message(format!("feature {id}")),
-        Progress::FeatureDone => bar.inc(1),
-        Progress::Planned => bar.set_message("posting"),
+        Progress::Start { features } => bar
+            .0
+            .set_length(1 + features + plan::STAGES.len() as u64 + 1),
+        Progress::Feature { id } => bar.0.set_message(format!("feature {id}")),
+        Progress::FeatureDone => bar.0.inc(1),
+        Progress::Planned => {}
+        Progress::Stage(name) => {
+            if name != plan::STAGES[0] {
+                bar.0.inc(1);
+            }
+            bar.0.set_message(name);
+        }
     };
     let part_stem = path
         .file_stem()
@@ -59,19 +83,21 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         progress: Some(&progress),
     };
     let result = plan::plan(&part, &process, &machine, &options);
-    bar.finish_and_clear();
+    bar.0.inc(1);
+    bar.0.set_prefix("writing");
+    bar.0.set_message("outputs");
     let mut plan = result.map_err(|e| match e {
         PlanError::Process(e) => Failure::new(process_file, e),
         PlanError::SelfCheck(problems) => {
             for p in &problems {
-                eprintln!("features: {}: {p}", path.display());
+                bar.0.suspend(|| eprintln!("features: {}: {p}", path.display()));
             }
             let n = problems.len();
             Failure::new(path, format!("the plan fails its self-check for {n} feature(s) (listed above); nothing written (--keep-going writes it anyway)"))
         }
         PlanError::Collisions(lines) => {
             for l in &lines {
-                eprintln!("features: {}: {l}", path.display());
+                bar.0.suspend(|| eprintln!("features: {}: {l}", path.display()));
             }
             let n = lines.len();
             Failure::new(path, format!("the print head collides in {n} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)"))
@@ -82,7 +108,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     // written, since --strict and unreachable points stop the plan here.
     let warnings: Vec<String> = plan.warnings().iter().map(|w| w.to_string()).collect();
     for w in &warnings {
-        eprintln!("features: {}: warning: {w}", path.display());
+        bar.0
+            .suspend(|| eprintln!("features: {}: warning: {w}", path.display()));
     }
     if args.strict && !warnings.is_empty() {
         return Err(Failure::new(
@@ -144,17 +171,39 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         write_atomic(&dir.join(&report), |w| w.write_all(json.as_bytes())),
     )?;
     let print: f64 = plan.features().iter().map(|f| f.print_length_mm).sum();
-    let vol: f64 = plan.features().iter().map(|f| f.extruded_volume_mm3).sum();
+    let widened: f64 = plan.features().iter().map(|f| f.widened_volume_mm3).sum();
+    let vol = widened
+        + plan
+            .features()
+            .iter()
+            .map(|f| f.extruded_volume_mm3)
+            .sum::<f64>();
+    let widened = if widened > 0.0 {
+        format!(" ({widened:.1} of it widening narrow beads)")
+    } else {
+        String::new()
+    };
+    bar.0.inc(1);
+    drop(bar);
     // Where it went: the folder, or the program file `-o` named.
     let to = match &args.output {
         o if o.is_dir() => dir.display().to_string(),
         o => o.display().to_string(),
     };
     emit(&format!(
-        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded, {} warning(s) -> {to}\n",
+        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {} warning(s) -> {to}\n",
         path.display(),
         plan.features().len(),
         plan.toolpath.points.len(),
         warnings.len(),
     ))
+}
+
+/// The run's progress bar, cleared when dropped (the run ended, or failed).
+struct Bar(indicatif::ProgressBar);
+
+impl Drop for Bar {
+    fn drop(&mut self) {
+        self.0.finish_and_clear();
+    }
 }

@@ -73,7 +73,18 @@ pub enum Progress {
     FeatureDone,
     /// Every feature is planned.
     Planned,
+    /// One of the [`STAGES`] after the features begins (its name, as `STAGES` has it); the
+    /// previous one, if any, is done.
+    Stage(&'static str),
 }
+
+/// The stages of a plan after its features, in order, each reported by [`Progress::Stage`]
+/// as it begins: a progress display counts them with the features.
+pub const STAGES: [&str; 3] = [
+    "smoothing tool axes",
+    "checking the print head",
+    "writing the program",
+];
 
 /// How to plan.
 #[derive(Default)]
@@ -187,7 +198,7 @@ pub fn plan(
             let id = offset + f.id;
             tell(Progress::Feature { id });
             let (params, fill) = fill?;
-            let plan = fill.lay(cursor);
+            let mut plan = fill.lay(cursor);
             cursor = plan.exit().map(P3::from).or(cursor);
             let fig = &plan.figures;
             let extruded = fig.filament * filament_area;
@@ -200,23 +211,18 @@ pub fn plan(
                 extruded,
             });
             let mut fw = fig.warnings.clone();
-            // Printability: beads narrower than the nozzle lays well (thin walls, blade tips).
-            let (narrow, prints, thinnest) = plan
-                .points
-                .iter()
-                .filter(|q| q.kind == MoveKind::Print)
-                .fold((0usize, 0usize, f64::INFINITY), |(n, all, lo), q| {
-                    let thin = q.width < min_bead;
-                    (
-                        n + thin as usize,
-                        all + 1,
-                        if thin { lo.min(q.width) } else { lo },
-                    )
-                });
-            if narrow > 0 {
+            // Printability: beads narrower than the nozzle lays well (thin walls, blade tips)
+            // are widened to min_bead_width, their filament with them.
+            let narrow = widen_narrow_beads(&mut plan.points, min_bead);
+            let widened = narrow.added_filament * filament_area;
+            if narrow.points > 0 {
                 fw.push(format!(
-                    "feature {id}: {:.1} % of its print points ({narrow} of {prints}) lay beads narrower than min_bead_width {min_bead} mm, down to {thinnest:.3} mm: the nozzle lays them poorly",
-                    100.0 * narrow as f64 / prints.max(1) as f64
+                    "feature {id}: {:.1} % of its print points ({} of {}) lay beads narrower than min_bead_width {min_bead} mm, down to {:.3} mm: widened to {min_bead} mm, {widened:.1} mm^3 more than planned ({:.1} % of the feature's {extruded:.1} mm^3)",
+                    100.0 * narrow.points as f64 / narrow.prints.max(1) as f64,
+                    narrow.points,
+                    narrow.prints,
+                    narrow.thinnest,
+                    100.0 * widened / extruded.max(1e-12)
                 ));
             }
             // Below the build plate (the base feature's reference plane): any point of the
@@ -242,6 +248,7 @@ pub fn plan(
                 print_length_mm: round(fig.print_length, 1e3),
                 travel_length_mm: round(fig.travel_length, 1e3),
                 extruded_volume_mm3: round(extruded, 1e3),
+                widened_volume_mm3: round(widened, 1e3),
                 thickness_min_mm: round(fig.thickness.0, 1e6),
                 thickness_mean_mm: round(fig.thickness.1, 1e6),
                 thickness_max_mm: round(fig.thickness.2, 1e6),
@@ -268,6 +275,7 @@ pub fn plan(
     // One tool path, features in build order with their file-wide ids.
     let mut toolpath = sequence(plans);
     // Orientation smoothing between planning and posting.
+    tell(Progress::Stage(STAGES[0]));
     let orientation = smooth(&mut toolpath, &process.orientation);
     // A B/C bed: axes that curved layers tip past the B limit are tilted back to it, inside
     // the orientation's tolerance cone (half its opening); farther, the post refuses them.
@@ -291,6 +299,7 @@ pub fn plan(
         });
     }
     // The head against what is built before each move and the table (issue 18).
+    tell(Progress::Stage(STAGES[1]));
     let collided = collisions::entries(&collisions::avoid(&mut toolpath, machine, &reports));
     let points = collisions::points(&toolpath);
     for r in &mut reports {
@@ -309,6 +318,7 @@ pub fn plan(
         format!("filament used [g] = {:.2}", est.filament_g),
     ];
     notes.extend(settings.lines());
+    tell(Progress::Stage(STAGES[2]));
     let job = Job {
         source: &options.source,
         stem: &options.stem,
@@ -357,6 +367,45 @@ pub fn plan(
         program: program.files,
         assembly,
     })
+}
+
+/// What [`widen_narrow_beads`] did to a feature's points.
+struct Widened {
+    /// Print points whose bead was narrower than the narrowest the nozzle lays well.
+    points: usize,
+    /// Print points of the feature.
+    prints: usize,
+    /// The narrowest of those beads (mm).
+    thinnest: f64,
+    /// Filament (mm) added by widening them.
+    added_filament: f64,
+}
+
+/// Printability (issue 21): every print point whose bead is narrower than `min_bead` (a thin
+/// wall's or a blade tip's, which the nozzle lays poorly) is widened to `min_bead`, its
+/// filament scaled with the width (Eq. 1 is linear in it), so the nozzle lays a bead it can
+/// and the material it takes is counted. The plan's self-check keeps comparing what was
+/// planned for the feature's volume; the plan's report gives the volume added apart
+/// (`widened_volume_mm3`), and the program and the estimate carry it.
+fn widen_narrow_beads(points: &mut [slicer::toolpath::PathPoint], min_bead: f64) -> Widened {
+    let mut w = Widened {
+        points: 0,
+        prints: 0,
+        thinnest: f64::INFINITY,
+        added_filament: 0.0,
+    };
+    for q in points.iter_mut().filter(|q| q.kind == MoveKind::Print) {
+        w.prints += 1;
+        if q.width < min_bead && q.width > 0.0 {
+            w.points += 1;
+            w.thinnest = w.thinnest.min(q.width);
+            let e = q.e * min_bead / q.width;
+            w.added_filament += e - q.e;
+            q.e = e;
+            q.width = min_bead;
+        }
+    }
+    w
 }
 
 /// The settings of a plan, every key: the process's defaults with `base`'s values, each

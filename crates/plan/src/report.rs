@@ -146,8 +146,12 @@ pub struct FeatureReport {
     pub print_length_mm: f64,
     /// Travel length, mm.
     pub travel_length_mm: f64,
-    /// Bead volume laid down (Eq. 1 filament × filament area), mm³.
+    /// Bead volume planned for the feature (Eq. 1 filament × filament area), mm³: what the
+    /// self-check compares with the feature's volume.
     pub extruded_volume_mm3: f64,
+    /// Bead volume added over that by widening beads narrower than the machine's
+    /// `min_bead_width` to it, mm³ (the program lays both).
+    pub widened_volume_mm3: f64,
     /// Thinnest layer, mm.
     pub thickness_min_mm: f64,
     /// Mean layer, mm.

@@ -1,6 +1,7 @@
 //! What the G-code posts (Marlin, delta5) share in writing their programs, and the comment
 //! text of every post (KUKA's KRL too).
 
+use crate::machine::MachineProfile;
 use toolpath::{push_fixed, MoveKind, PathPoint, Role};
 
 /// `s` with line breaks and other control characters replaced by spaces, for comments (G-code
@@ -77,5 +78,111 @@ impl LayerMarks {
             push_fixed(out, q.width, 3);
             out.push('\n');
         }
+    }
+}
+
+/// The part-cooling fan of a G-code program (Marlin and delta5): `M106 S<0..255>` or `M107`
+/// where the wanted speed changes, written before the print move that needs it. Beads resting
+/// on the build plate get `fan_first_layer`, the others `fan_speed`.
+#[derive(Debug)]
+pub(crate) struct Fan {
+    /// The `S` on the first layer and above it.
+    first_layer: u8,
+    above: u8,
+    /// The `S` written last.
+    at: Option<u8>,
+}
+
+impl Fan {
+    /// The fan of profile `m`, not yet set.
+    pub(crate) fn new(m: &MachineProfile) -> Fan {
+        Fan {
+            first_layer: m.fan_pwm(true),
+            above: m.fan_pwm(false),
+            at: None,
+        }
+    }
+
+    /// Writes the fan command for a print move (`first_layer`: its bead rests on the plate)
+    /// when the speed changes.
+    pub(crate) fn set(&mut self, first_layer: bool, out: &mut String) {
+        let s = if first_layer {
+            self.first_layer
+        } else {
+            self.above
+        };
+        if self.at == Some(s) {
+            return;
+        }
+        self.at = Some(s);
+        if s == 0 {
+            push_line(out, "M107 ; fan off");
+        } else {
+            push_line(out, &format!("M106 S{s} ; fan"));
+        }
+    }
+}
+
+/// The E of print moves with cumulative rounding (shared by the Marlin and delta5 posts): the
+/// E written adds up to the planned filament, to the 0.00001 mm of the text, however many
+/// moves it is split over or merged into.
+#[derive(Debug, Default)]
+pub(crate) struct Extrusion {
+    /// Filament written so far, in 0.00001 mm.
+    written: i64,
+    /// Filament planned so far (mm).
+    planned: f64,
+}
+
+impl Extrusion {
+    /// Adds `e` mm planned; returns what a move written now would carry (0.00001 mm), not yet
+    /// taken as written.
+    pub(crate) fn add(&mut self, e: f64) -> i64 {
+        self.planned += e;
+        (self.planned * 1e5).round() as i64 - self.written
+    }
+
+    /// The move carrying `units` is written.
+    pub(crate) fn written(&mut self, units: i64) {
+        self.written += units;
+    }
+}
+
+/// Whether a move of `xyz` mm over the part's axes and `rotary` degrees of the rotary axes is
+/// too short to stand alone as a print move that extrudes nothing (its E rounds to 0): it is
+/// merged into the next move (no G1 is written for it), at most 0.01 mm and 0.01 degrees off
+/// the path.
+pub(crate) fn mergeable(xyz: f64, rotary: f64) -> bool {
+    xyz < 0.01 && rotary < 0.01
+}
+
+/// `units` hundred-thousandths of a millimetre as fixed-point text with 5 decimals.
+pub(crate) fn e_text(units: i64) -> String {
+    let sign = if units < 0 { "-" } else { "" };
+    let a = units.unsigned_abs();
+    format!("{sign}{}.{:05}", a / 100_000, a % 100_000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn e_text_is_fixed_point() {
+        assert_eq!(e_text(0), "0.00000");
+        assert_eq!(e_text(123_456), "1.23456");
+        assert_eq!(e_text(-80_000), "-0.80000");
+        assert_eq!(e_text(7), "0.00007");
+    }
+
+    #[test]
+    fn extrusion_adds_up_over_merged_moves() {
+        let mut e = Extrusion::default();
+        // Three moves of 0.000004 mm: the first two round to nothing and are merged.
+        assert_eq!(e.add(0.000004), 0);
+        assert_eq!(e.add(0.000004), 1);
+        e.written(1);
+        assert_eq!(e.add(0.000004), 0);
+        assert_eq!(e.add(1.0), 100_000);
     }
 }

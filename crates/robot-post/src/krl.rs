@@ -11,7 +11,9 @@
 //!
 //! Semantics: `$OUT[n] = ...` switches at once; `TRIGGER WHEN DISTANCE=0 ... DO $OUT[n]=...`
 //! switches at the start of the next motion; either way a motion's `extruder` is the state
-//! during that motion.
+//! during that motion. `TRIGGER WHEN DISTANCE=0 ... DO $ANOUT[n]=v` (the filament feed, one
+//! analog output, `v` within 0..1) sets the output at the start of the next motion: a
+//! motion's `feed` is the value in force during it.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -59,6 +61,8 @@ pub struct KrlMove {
     pub extruder: bool,
     /// `$VEL.CP` in force (m/s).
     pub vel_cp: Option<f64>,
+    /// The feed's analog output `$ANOUT[n]` in force (0..1), once set.
+    pub feed: Option<f64>,
     /// The file the motion is in.
     pub file: String,
     /// Its one-based line.
@@ -83,6 +87,8 @@ pub struct KrlRead {
     pub apo_cdis: Option<f64>,
     /// The output number the extruder statements switch.
     pub extruder_output: Option<u32>,
+    /// The analog output number the feed statements set.
+    pub feed_output: Option<u32>,
     /// The modules called from the main program, in order (lower case).
     pub calls: Vec<String>,
     /// The motions, in the order the robot makes them.
@@ -194,6 +200,8 @@ pub fn read(files: &[(String, String)]) -> Result<KrlRead, KrlError> {
         initialised: false,
         extruder: false,
         pending: None,
+        pending_feed: None,
+        feed: None,
         vel: None,
         stack: Vec::new(),
     };
@@ -407,6 +415,19 @@ fn output_assignment(s: &str) -> Option<(u32, bool)> {
     Some((n.parse().ok()?, on))
 }
 
+/// `$ANOUT[n]=0.5` → `(n, 0.5)`.
+fn analog_assignment(s: &str) -> Option<(u32, Result<f64, String>)> {
+    let s: String = s.chars().filter(|c| !c.is_whitespace()).collect();
+    let rest = s.strip_prefix("$ANOUT[")?;
+    let (n, rest) = rest.split_once(']')?;
+    let value = rest.strip_prefix('=')?;
+    let v = match value.parse::<f64>() {
+        Ok(v) if (-1.0..=1.0).contains(&v) => Ok(v),
+        _ => Err(format!("`{value}` is not an analog value within -1..1")),
+    };
+    Some((n.parse().ok()?, v))
+}
+
 /// The running program.
 struct Run<'a> {
     modules: &'a BTreeMap<String, Module>,
@@ -415,6 +436,9 @@ struct Run<'a> {
     initialised: bool,
     extruder: bool,
     pending: Option<bool>,
+    /// The feed set at the start of the next motion, and the feed in force.
+    pending_feed: Option<f64>,
+    feed: Option<f64>,
     vel: Option<f64>,
     stack: Vec<String>,
 }
@@ -512,6 +536,21 @@ impl Run<'_> {
             return Ok(());
         }
         if let Some(rest) = upper.strip_prefix("TRIGGER WHEN DISTANCE=0 DELAY=0 DO ") {
+            if let Some((n, v)) = analog_assignment(rest) {
+                let v = v.map_err(|r| err(file, line, r))?;
+                match self.out.feed_output {
+                    Some(k) if k != n => {
+                        return Err(err(
+                            file,
+                            line,
+                            format!("sets $ANOUT[{n}], the feed is $ANOUT[{k}]"),
+                        ))
+                    }
+                    _ => self.out.feed_output = Some(n),
+                }
+                self.pending_feed = Some(v);
+                return Ok(());
+            }
             let Some((n, on)) = output_assignment(rest) else {
                 return Err(err(
                     file,
@@ -577,12 +616,16 @@ impl Run<'_> {
             if let Some(on) = self.pending.take() {
                 self.extruder = on;
             }
+            if let Some(v) = self.pending_feed.take() {
+                self.feed = Some(v);
+            }
             self.out.moves.push(KrlMove {
                 motion,
                 target,
                 approximated,
                 extruder: self.extruder,
                 vel_cp: self.vel,
+                feed: self.feed,
                 file: file.to_string(),
                 line,
                 note: s.note.clone(),

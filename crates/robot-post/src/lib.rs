@@ -10,11 +10,13 @@
 //! - [`delta5`](mod@delta5): 5-axis G-code for a printer with a tilting and rotating bed.
 //! - [`kuka`](mod@kuka): KRL programs for a KUKA robot cell; [`krl`] reads them back.
 //! - [`placement`]: where a post puts the part on the machine.
+//! - [`custom`]: the profile's start and end G-code and their placeholders.
 //!
 //! Every fallible function returns a [`PostError`] whose message is one line.
 
 #![warn(missing_docs)]
 
+pub mod custom;
 pub mod delta5;
 pub mod error;
 mod gcode;

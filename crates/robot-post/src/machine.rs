@@ -32,7 +32,8 @@ pub struct MachineProfile {
     pub filament_diameter: f64,
     /// Bead width w (mm).
     pub bead_width: f64,
-    /// Narrowest bead the nozzle lays well (mm); narrower beads of a plan are a warning.
+    /// Narrowest bead the nozzle lays well (mm); narrower beads of a plan are widened to it
+    /// (their filament with them) with a warning.
     /// Optional: 0.6 × `nozzle_diameter` when left out ([`MachineProfile::min_bead_width`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_bead_width: Option<f64>,
@@ -78,6 +79,28 @@ pub struct MachineProfile {
     pub retraction_speed: f64,
     /// Nozzle lift during travel moves (mm); 0 for none.
     pub z_hop: f64,
+    /// Highest F (mm/min, or degrees/min for a move of the rotary axes alone) a program may
+    /// give. Optional: 60 × `travel_speed` when left out. The speeds of the profile must fit
+    /// under it; the delta5 post clamps the feeds it scales to it (with a warning).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_feed_mm_min: Option<f64>,
+    /// Part-cooling fan (%, 0..100) while printing beads above the first layer: `M106 S..`
+    /// (0..255), `M107` at 0. Optional, 0 when left out (Marlin and delta5).
+    #[serde(default)]
+    pub fan_speed: f64,
+    /// Part-cooling fan (%, 0..100) while printing beads resting on the build plate. Optional,
+    /// 0 when left out.
+    #[serde(default)]
+    pub fan_first_layer: f64,
+    /// G-code run before the part (Marlin and delta5), with `{placeholder}`s
+    /// ([`crate::custom::PLACEHOLDERS`]). Optional: the kind's default
+    /// ([`crate::custom::MARLIN_START`], [`crate::custom::DELTA5_START`]) when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_gcode: Option<String>,
+    /// G-code run after the part, once the post has retracted and lifted the nozzle, with
+    /// placeholders as `start_gcode`. Optional: the kind's default when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub end_gcode: Option<String>,
     /// The print head's shape (`[head]` table: a nozzle cone under a body cylinder), for the
     /// collision check; the built-in profiles have [`collide::Head::default`], which a profile
     /// without the table gets too.
@@ -240,6 +263,45 @@ impl MachineProfile {
                 return Err(bad(field, format!("must be at most {max}, got {v}")));
             }
         }
+        let max_feed = self.max_feed_mm_min();
+        if !(max_feed.is_finite() && max_feed > 0.0) {
+            return Err(bad(
+                "max_feed_mm_min",
+                format!("must be a positive number, got {max_feed}"),
+            ));
+        }
+        for (field, speed) in [
+            ("print_speed", self.print_speed),
+            ("first_layer_speed", self.first_layer_speed),
+            ("travel_speed", self.travel_speed),
+            ("retraction_speed", self.retraction_speed),
+        ] {
+            if speed * 60.0 > max_feed + 1e-9 {
+                return Err(bad(
+                    field,
+                    format!(
+                        "{speed} mm/s is F{} mm/min, above max_feed_mm_min {max_feed}",
+                        speed * 60.0
+                    ),
+                ));
+            }
+        }
+        for (field, v) in [
+            ("fan_speed", self.fan_speed),
+            ("fan_first_layer", self.fan_first_layer),
+        ] {
+            if !(v.is_finite() && (0.0..=100.0).contains(&v)) {
+                return Err(bad(field, format!("must be a percentage 0..100, got {v}")));
+            }
+        }
+        for (field, text) in [
+            ("start_gcode", &self.start_gcode),
+            ("end_gcode", &self.end_gcode),
+        ] {
+            if let Some(reason) = text.as_deref().and_then(crate::custom::unknown_placeholder) {
+                return Err(bad(field, reason));
+            }
+        }
         match (self.kind, &self.delta5, &self.kuka) {
             (MachineKind::Delta5, None, _) => return Err(self.missing_table("[delta5]", "delta5")),
             (MachineKind::Kuka, _, None) => return Err(self.missing_table("[kuka]", "kuka")),
@@ -308,6 +370,77 @@ impl MachineProfile {
             .unwrap_or(MIN_BEAD_SHARE * self.nozzle_diameter)
     }
 
+    /// The highest F a program may give: `max_feed_mm_min`, or 60 × `travel_speed`.
+    pub fn max_feed_mm_min(&self) -> f64 {
+        self.max_feed_mm_min.unwrap_or(60.0 * self.travel_speed)
+    }
+
+    /// The `S` of `M106` (0..255) for the fan on beads resting on the plate (`first_layer`)
+    /// or above: `fan_first_layer` or `fan_speed` as a share of 255.
+    pub fn fan_pwm(&self, first_layer: bool) -> u8 {
+        let pct = if first_layer {
+            self.fan_first_layer
+        } else {
+            self.fan_speed
+        };
+        (pct.clamp(0.0, 100.0) * 2.55).round() as u8
+    }
+
+    /// The start G-code with its placeholders filled in: `start_gcode`, or the kind's default
+    /// (none for KUKA).
+    pub fn start_gcode_text(&self) -> String {
+        let default = match self.kind {
+            MachineKind::Marlin => crate::custom::MARLIN_START,
+            MachineKind::Delta5 => crate::custom::DELTA5_START,
+            MachineKind::Kuka => "",
+        };
+        let text = self.start_gcode.as_deref().unwrap_or(default);
+        crate::custom::expand(text, &self.placeholder_values())
+    }
+
+    /// The end G-code with its placeholders filled in: `end_gcode`, or the kind's default.
+    pub fn end_gcode_text(&self) -> String {
+        let default = match self.kind {
+            MachineKind::Marlin => crate::custom::MARLIN_END,
+            MachineKind::Delta5 => crate::custom::DELTA5_END,
+            MachineKind::Kuka => "",
+        };
+        let text = self.end_gcode.as_deref().unwrap_or(default);
+        crate::custom::expand(text, &self.placeholder_values())
+    }
+
+    /// The value of every placeholder of [`crate::custom::PLACEHOLDERS`] for this profile.
+    fn placeholder_values(&self) -> Vec<(&'static str, String)> {
+        use toolpath::fixed;
+        let (x0, y0) = if self.bed_origin_centre {
+            (-self.bed_size[0] / 2.0, -self.bed_size[1] / 2.0)
+        } else {
+            (0.0, 0.0)
+        };
+        let feed = |v: f64| fixed(v * 60.0, 0);
+        let mm = |v: f64| fixed(v, 3);
+        vec![
+            ("nozzle_temperature", fixed(self.nozzle_temperature, 0)),
+            ("bed_temperature", fixed(self.bed_temperature, 0)),
+            ("bed_x", mm(self.bed_size[0])),
+            ("bed_y", mm(self.bed_size[1])),
+            ("bed_z", mm(self.bed_size[2])),
+            ("x_min", mm(x0)),
+            ("x_max", mm(x0 + self.bed_size[0])),
+            ("y_min", mm(y0)),
+            ("y_max", mm(y0 + self.bed_size[1])),
+            ("print_feed", feed(self.print_speed)),
+            ("first_layer_feed", feed(self.first_layer_speed)),
+            ("travel_feed", feed(self.travel_speed)),
+            ("retraction_length", fixed(self.retraction_length, 5)),
+            ("retraction_feed", feed(self.retraction_speed)),
+            (
+                "purge_e",
+                fixed(self.filament_length(self.bead_width, 0.3, 100.0), 5),
+            ),
+        ]
+    }
+
     /// The profile's bead: its `bead_width` and `filament_diameter`.
     pub fn bead(&self) -> Bead {
         Bead {
@@ -357,6 +490,45 @@ mod tests {
         let m = MachineProfile::builtin(MachineKind::Marlin);
         assert_eq!(m.bed_size, [220.0, 220.0, 250.0]);
         assert!(!m.bed_origin_centre);
+    }
+
+    #[test]
+    fn builtin_start_and_end_gcode_are_the_defaults() {
+        use crate::custom::{DELTA5_END, DELTA5_START, MARLIN_END, MARLIN_START};
+        let m = MachineProfile::builtin(MachineKind::Marlin);
+        assert_eq!(m.start_gcode.as_deref(), Some(MARLIN_START));
+        assert_eq!(m.end_gcode.as_deref(), Some(MARLIN_END));
+        let d = MachineProfile::builtin(MachineKind::Delta5);
+        assert_eq!(d.start_gcode.as_deref(), Some(DELTA5_START));
+        assert_eq!(d.end_gcode.as_deref(), Some(DELTA5_END));
+        assert_eq!((m.fan_speed, m.fan_first_layer), (100.0, 0.0));
+        assert_eq!(m.fan_pwm(false), 255);
+        assert_eq!(m.fan_pwm(true), 0);
+        // Filled in: no braces left, the temperatures and the bed's edges written.
+        let start = m.start_gcode_text();
+        assert!(!start.contains('{'), "{start}");
+        assert!(
+            start.contains("M104 S210") && start.contains("M190 S60"),
+            "{start}"
+        );
+        assert!(start.contains("G0 X0.000 Y0.000 Z0.3 F7200"), "{start}");
+        // A misspelt placeholder names the key and the placeholder.
+        let bad = MARLIN_TOML.replace("M104 S{nozzle_temperature}", "M104 S{nozle_temperature}");
+        let e = MachineProfile::from_toml(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("start_gcode") && e.contains("{nozle_temperature}"),
+            "{e}"
+        );
+        // A feed above max_feed_mm_min, and a fan above 100 %.
+        let fast = MARLIN_TOML.replace("max_feed_mm_min = 12000.0", "max_feed_mm_min = 6000.0");
+        let e = MachineProfile::from_toml(&fast).unwrap_err().to_string();
+        assert!(
+            e.contains("travel_speed") && e.contains("max_feed_mm_min"),
+            "{e}"
+        );
+        let loud = MARLIN_TOML.replace("fan_speed = 100.0", "fan_speed = 255.0");
+        let e = MachineProfile::from_toml(&loud).unwrap_err().to_string();
+        assert!(e.contains("fan_speed"), "{e}");
     }
 
     #[test]

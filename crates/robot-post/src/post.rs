@@ -120,7 +120,7 @@ impl Post for Delta5Post<'_> {
                 .into_iter()
                 .map(|(id, k)| (id, PostFigures::Delta5(k)))
                 .collect(),
-            warnings: Vec::new(),
+            warnings: program.warnings,
         })
     }
 }

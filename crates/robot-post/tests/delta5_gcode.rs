@@ -234,10 +234,16 @@ fn parse(program: &str) -> Parsed {
     let mut out = Parsed::default();
     let (mut layer, mut feature) = (None, None);
     let mut pos = [f64::NAN; 5];
+    // The profile's start and end G-code (the purge line) are not the part's moves.
+    let mut custom = false;
     for block in &gc.blocks {
         for c in &block.comments {
             let text = c.value.trim();
-            if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
+            if text == "start_gcode" || text == "end_gcode" {
+                custom = true;
+            } else if text == "end of start_gcode" {
+                custom = false;
+            } else if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
                 layer = Some(n.parse().unwrap());
             } else if let Some(n) = text.strip_prefix("FEATURE:") {
                 feature = Some(n.parse().unwrap());
@@ -252,7 +258,7 @@ fn parse(program: &str) -> Parsed {
                 out.safe_z = rest.split_whitespace().next().map(|w| w.parse().unwrap());
             }
         }
-        for code in &block.codes {
+        for code in block.codes.iter().filter(|_| !custom) {
             let Code::General(g) = code else { continue };
             let major = g.number.major();
             if major != 0 && major != 1 {
@@ -299,20 +305,36 @@ fn run(path: &ToolPath, m: &MachineProfile) -> (ToolPath, Delta5Program, Parsed)
 }
 
 /// Walks the program's print moves along the planned print points: every move ends on its
-/// planned segment, each planned point is reached with its filament. Returns, per planned
-/// print point, the index of the move that reaches it.
+/// planned segment, each planned point is reached with its filament (a point merged into the
+/// next move, its filament with that move). Returns, per planned print point the program
+/// moves to, the index of the move that reaches it.
 fn match_points(planned: &ToolPath, parsed: &Parsed, m: &MachineProfile) -> Vec<(usize, usize)> {
     let g = m.delta5.as_ref().unwrap();
     let offset = parsed.offset.expect("offset comment");
     let prints: Vec<&Move> = parsed.moves.iter().filter(|mv| mv.is_print()).collect();
     let mut k = 0;
     let mut out = Vec::new();
+    let mut carry = 0.0;
     for (i, q) in planned.points.iter().enumerate() {
         if q.kind != MoveKind::Print {
             continue;
         }
         let a = if i > 0 { planned.points[i - 1].p } else { q.p };
-        let mut e_sum = 0.0;
+        // A planned move that goes nowhere on the machine is merged into the next: the
+        // machine is already at the point and the next move does not end there; its filament
+        // goes with the next move.
+        let here = match prints.get(k) {
+            Some(mv) => mv.from,
+            None => prints[k - 1].to,
+        };
+        let ends_here = |mv: &Move| norm(sub(forward(mv.to, g, offset).0, q.p)) <= 0.01;
+        if norm(sub(forward(here, g, offset).0, q.p)) <= 0.01
+            && !prints.get(k).is_some_and(|mv| ends_here(mv))
+        {
+            carry += q.e;
+            continue;
+        }
+        let mut e_sum = -std::mem::take(&mut carry);
         loop {
             assert!(k < prints.len(), "program ends before planned point {i}");
             let mv = prints[k];
@@ -634,6 +656,7 @@ fn delta5_extrusion_feed_and_travel() {
     let prints: Vec<&Move> = parsed.moves.iter().filter(|mv| mv.is_print()).collect();
     let mut first = 0;
     let mut checked = 0;
+    let mut clamped = 0;
     for &(i, last) in &matched {
         let q = &planned.points[i];
         let bottom = q.p[2] - T * unit(q.axis)[2] + offset[2];
@@ -658,6 +681,14 @@ fn delta5_extrusion_feed_and_travel() {
             let f = mv.f.unwrap();
             let speed = part * f / 60.0 / distance;
             let tol = v * (0.004 / part + 0.001 / f + 2e-3);
+            // A feed clamped to max_feed_mm_min is slower over the part, never faster.
+            let max_feed = m.max_feed_mm_min();
+            assert!(f <= max_feed, "point {i}: F{f} above {max_feed}");
+            if f == max_feed {
+                assert!(speed <= v + tol, "point {i}: {speed} mm/s vs {v}: {mv:?}");
+                clamped += 1;
+                continue;
+            }
             assert!(
                 (speed - v).abs() <= tol,
                 "point {i}: {speed} mm/s vs {v}: {mv:?}"
@@ -667,6 +698,16 @@ fn delta5_extrusion_feed_and_travel() {
         first = last + 1;
     }
     assert!(checked > 100, "{checked}");
+    // Moves slowed to max_feed_mm_min are counted in the program's warning.
+    assert_eq!(
+        clamped > 0,
+        program
+            .warnings
+            .iter()
+            .any(|w| w.contains("max_feed_mm_min")),
+        "{clamped} clamped: {:?}",
+        program.warnings
+    );
     // Every position inside the envelope; every large reorientation at the safe height.
     let safe_z = parsed.safe_z.expect("safe height comment");
     assert!((safe_z - program.safe_z).abs() < 1e-3);
@@ -701,7 +742,13 @@ fn delta5_numbers_are_fixed_point() {
     let program = delta5(&synthetic(), &profile(), "sphere.step")
         .unwrap()
         .gcode;
-    for line in program.lines() {
+    // The program's own lines: the profile's start and end G-code are the user's text.
+    let start = program.find("; end of start_gcode").unwrap();
+    let end = program.find("; end_gcode").unwrap();
+    for line in program[..program.find("; start_gcode").unwrap()]
+        .lines()
+        .chain(program[start..end].lines())
+    {
         let code = line.split(';').next().unwrap_or("");
         let lower = code.to_ascii_lowercase();
         assert!(!lower.contains("nan") && !lower.contains("inf"), "`{line}`");
@@ -870,7 +917,7 @@ fn delta5_edge_cases() {
     let m = profile();
     // Empty path: header and footer only.
     let empty = delta5(&ToolPath::default(), &m, "empty.step").unwrap();
-    assert!(empty.figures.is_empty() && !empty.gcode.contains("G1 X"));
+    assert!(empty.figures.is_empty() && !parse(&empty.gcode).moves.iter().any(|mv| mv.is_print()));
     gcode::parse(&empty.gcode).unwrap();
     assert!(empty.error_plot_svg.contains("</svg>"));
     // A path starting with a print point travels to it first.
@@ -893,7 +940,9 @@ fn delta5_edge_cases() {
     let mut bare = m.clone();
     (bare.z_hop, bare.retraction_length, bare.bed_temperature) = (0.0, 0.0, 0.0);
     let (planned, program, parsed) = run(&synthetic(), &bare);
-    assert!(!program.gcode.contains("M190") && !program.gcode.contains("G1 E"));
+    // (The heating is the profile's start_gcode: its placeholders give the bed 0 degrees.)
+    let own = &program.gcode[program.gcode.find("; end of start_gcode").unwrap()..];
+    assert!(program.gcode.contains("M140 S0 ; bed") && !own.contains("G1 E"));
     match_points(&planned, &parsed, &bare);
 }
 

@@ -109,10 +109,16 @@ fn parse(program: &str) -> Parsed {
     let (mut layer, mut feature) = (None, None);
     let mut pos = [f64::NAN; 3];
     let mut gap = 0.0;
+    // The profile's start and end G-code (the purge line) are not the part's moves.
+    let mut custom = false;
     for block in &gc.blocks {
         for c in &block.comments {
             let text = c.value.trim();
-            if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
+            if text == "start_gcode" || text == "end_gcode" {
+                custom = true;
+            } else if text == "end of start_gcode" {
+                custom = false;
+            } else if let Some(n) = text.strip_prefix("FEATURE_LAYER:") {
                 layer = Some(n.parse().unwrap());
                 out.layer_comments += 1;
             } else if let Some(n) = text.strip_prefix("FEATURE:") {
@@ -127,7 +133,7 @@ fn parse(program: &str) -> Parsed {
                 out.offset = Some([v[0], v[1], v[2]]);
             }
         }
-        for code in &block.codes {
+        for code in block.codes.iter().filter(|_| !custom) {
             let Code::General(g) = code else { continue };
             let major = g.number.major();
             if major != 0 && major != 1 {
@@ -240,7 +246,13 @@ fn marlin_program_reparsed_reproduces_toolpath_csv() {
 #[test]
 fn marlin_numbers_are_fixed_point() {
     let program = marlin(&synthetic(), &profile(), "squares.step").unwrap();
-    for line in program.lines() {
+    // The program's own lines: the profile's start and end G-code are the user's text.
+    let start = program.find("; end of start_gcode").unwrap();
+    let end = program.find("; end_gcode").unwrap();
+    for line in program[..program.find("; start_gcode").unwrap()]
+        .lines()
+        .chain(program[start..end].lines())
+    {
         let code = line.split(';').next().unwrap_or("");
         let b = code.as_bytes();
         for i in 1..b.len().saturating_sub(1) {
@@ -290,7 +302,7 @@ fn marlin_header_and_footer() {
         .filter(|c| !c.is_empty())
         .collect();
     assert_eq!(
-        &codes[..13],
+        &codes[..20],
         [
             "G21",
             "G90",
@@ -304,23 +316,43 @@ fn marlin_header_and_footer() {
             "M190 S60",
             "M109 S210",
             "G92 E0",
-            "G0 X89.250 Y100.375 Z0.400 F7200"
+            "G0 X0.000 Y0.000 Z0.3 F7200",
+            "G1 X100 E5.61265 F1200",
+            "G0 Z2 F7200",
+            "G90",
+            "M83",
+            "G0 X89.250 Y100.375 Z0.400 F7200",
+            "G0 Z0.200 F7200",
+            // The first layer without the fan (fan_first_layer 0).
+            "M107",
         ]
     );
+    // The fan at fan_speed 100 % from the second layer: M106 S255 right after its layer
+    // comments, before its first print move.
+    let second = lines.iter().position(|l| *l == ";LAYER:2").unwrap();
+    let fan = lines
+        .iter()
+        .position(|l| l.starts_with("M106 S255"))
+        .unwrap();
+    assert!(fan > second, "{fan} {second}");
+    assert!(lines[second..fan].iter().all(|l| !l.starts_with("G1 X")));
     assert!(lines.iter().any(|l| l.starts_with("; offset X")));
-    let tail = &codes[codes.len() - 6..];
+    let tail = &codes[codes.len() - 7..];
     assert_eq!(
         tail,
         [
             "G1 E-0.80000 F2100",
+            "G0 Z10.600 F7200",
+            "M107",
             "M104 S0",
             "M140 S0",
-            "G0 Z10.600 F7200",
             "G28 X0 Y0",
             "M84"
         ]
     );
     // First layer at 20 mm/s, later layers at 40 mm/s.
+    let own = codes.iter().position(|c| *c == "G0 Z2 F7200").unwrap();
+    let codes = &codes[own..];
     let f1200 = codes
         .iter()
         .filter(|c| c.starts_with("G1 X") && c.ends_with("F1200"))
@@ -422,7 +454,7 @@ fn marlin_edge_cases_do_not_panic() {
     let m = profile();
     // Empty path: header and footer only.
     let empty = marlin(&ToolPath::default(), &m, "empty.step").unwrap();
-    assert!(empty.contains("G28 X0 Y0") && !empty.contains("G1 X"));
+    assert!(empty.contains("G28 X0 Y0") && parse(&empty).prints.is_empty());
     gcode::parse(&empty).unwrap();
     // A path starting with a print point travels to it first.
     let path = ToolPath {
@@ -430,15 +462,17 @@ fn marlin_edge_cases_do_not_panic() {
     };
     let program = marlin(&path, &m, "dot.step").unwrap();
     let g0 = program.find("G0 X110.000 Y110.000").unwrap();
-    let g1 = program
-        .find("G1 X110.000 Y110.000 Z0.200 E0.01000")
-        .unwrap();
-    assert!(g0 < g1, "{program}");
+    // The dot goes nowhere once there: its filament is laid in place, not lost.
+    let g1 = program.find("G0 Z0.200").unwrap();
+    let e = program.find("G1 E0.01000 F2400").unwrap();
+    assert!(g0 < g1 && g1 < e, "{program}");
     // No hop, no retraction, no heated bed.
     let mut bare = m.clone();
     (bare.z_hop, bare.retraction_length, bare.bed_temperature) = (0.0, 0.0, 0.0);
     let program = marlin(&synthetic(), &bare, "x").unwrap();
-    assert!(!program.contains("M190") && !program.contains("G1 E"));
+    // (The heating is the profile's start_gcode: its placeholders give the bed 0 degrees.)
+    let own = &program[program.find("; end of start_gcode").unwrap()..];
+    assert!(program.contains("M140 S0 ; bed") && !own.contains("G1 E"));
     assert_eq!(parse(&program).prints.len(), 24);
     // Pseudo-random paths with extreme figures: an Ok program or an error, never a panic.
     /// xorshift64: deterministic pseudo-random figures, including extreme ones.

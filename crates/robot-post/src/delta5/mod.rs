@@ -43,7 +43,23 @@
 //! The controller (Marlin with rotary axes) takes F as the speed along the machine XYZ path of a
 //! move, or along the rotary axes (degrees) when XYZ do not move. F is scaled by that distance
 //! over the move's length along the part, so the nozzle moves over the part at the planned
-//! deposition speed (`first_layer_speed` for beads on the table, `print_speed` otherwise).
+//! deposition speed (`first_layer_speed` for beads on the table, `print_speed` otherwise), and
+//! clamped to the profile's `max_feed_mm_min`: a move asking for more is slowed to it (the
+//! program's warnings count them). The header says so in a `; F:` line.
+//!
+//! # Moves that are not written
+//!
+//! A print move that goes nowhere in machine coordinates (X, Y, Z, B and C as written: a move
+//! that only turns the bed is a real move) is not written, nor one whose E rounds to 0 over
+//! less than 0.01 mm and 0.01 degrees: the next move carries its filament (E is rounded
+//! cumulatively, so the E written adds up to the planned filament). A longer move whose E
+//! rounds to 0 is written without E. Retraction and un-retraction stay E-only moves.
+//!
+//! # Start, end, fan
+//!
+//! The profile's `start_gcode` follows the header and `end_gcode` the last retraction, lift
+//! and levelling of the bed, placeholders filled in ([`crate::custom`]); the fan follows
+//! `fan_first_layer` on beads resting on the table and `fan_speed` above (`M106`/`M107`).
 
 mod figures;
 pub(crate) mod geometry;
@@ -79,6 +95,8 @@ pub struct Delta5Program {
     /// The kinematic error along the printed path as a stand-alone SVG: one colour per
     /// feature, axes labelled, the goal as a dashed line.
     pub error_plot_svg: String,
+    /// Things to know, one line each (feeds clamped to `max_feed_mm_min`).
+    pub warnings: Vec<String>,
     /// table = part + offset (mm), as in the header.
     pub offset: [f64; 3],
     /// Machine Z of the safe height used for large reorientations.
@@ -217,10 +235,20 @@ pub fn delta5(
     let mut gcode = header(m, g, source, offset, safe_z, wanted_safe, &figures);
     gcode.push_str(&w.out);
     let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
+    let mut warnings = Vec::new();
+    if w.clamped.0 > 0 {
+        warnings.push(format!(
+            "{} print move(s) asked for a feed above max_feed_mm_min {} mm/min (up to F{}) and were slowed to it: the nozzle moves over the part slower than print_speed there",
+            w.clamped.0,
+            fixed(m.max_feed_mm_min(), 0),
+            fixed(w.clamped.1, 0)
+        ));
+    }
     Ok(Delta5Program {
         gcode,
         figures,
         error_plot_svg,
+        warnings,
         offset,
         safe_z,
     })

@@ -9,8 +9,7 @@ use super::geometry::{Delta5Geometry, FIT_TOLERANCE};
 use super::kinematics::{
     angle_deg, distance_to_segment, forward, lerp, machine_to_bed, to_machine, Pose,
 };
-use super::text::e_text;
-use crate::gcode::{push_line, LayerMarks};
+use crate::gcode::{e_text, mergeable, push_line, Extrusion, Fan, LayerMarks};
 use crate::machine::MachineProfile;
 use crate::PostError;
 use toolpath::vec3::{norm, sub, unit};
@@ -54,10 +53,11 @@ pub(super) struct Writer<'a> {
     hi: [f64; 3],
     travel_f: String,
     retraction_f: String,
-    /// Filament written so far on print moves, in 0.00001 mm.
-    e_written: i64,
-    /// Filament planned so far on print moves (mm).
-    e_planned: f64,
+    extrusion: Extrusion,
+    fan: Fan,
+    /// Print moves whose scaled feed was clamped to `max_feed_mm_min`, and the largest feed
+    /// asked for before clamping (mm/min).
+    pub(super) clamped: (usize, f64),
     pub(super) figures: BTreeMap<usize, Accumulator>,
     /// (feature, length along the printed path, largest error of the move) per print move.
     pub(super) plot: Vec<(usize, f64, f64)>,
@@ -92,8 +92,9 @@ impl<'a> Writer<'a> {
             hi: [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]],
             travel_f: fixed(m.travel_speed * 60.0, 0),
             retraction_f: fixed(m.retraction_speed * 60.0, 0),
-            e_written: 0,
-            e_planned: 0.0,
+            extrusion: Extrusion::default(),
+            fan: Fan::new(m),
+            clamped: (0, 0.0),
             figures: BTreeMap::new(),
             plot: Vec::new(),
             printed_length: 0.0,
@@ -191,6 +192,7 @@ impl<'a> Writer<'a> {
         pose: &Pose,
         lift: bool,
     ) -> Result<(), PostError> {
+        self.flush();
         if self.printing {
             self.retract();
         }
@@ -326,7 +328,6 @@ impl<'a> Writer<'a> {
         let part_step = length / n as f64;
         let mut from = start;
         let acc = self.figures.entry(q.feature).or_default();
-        acc.figures.print_moves += n;
         if n > 1 {
             acc.figures.subdivided_segments += 1;
         }
@@ -338,46 +339,65 @@ impl<'a> Writer<'a> {
             let dev = angle_deg(planned, realised);
             acc.figures.max_axis_deviation_deg = acc.figures.max_axis_deviation_deg.max(dev);
         }
+        let max_feed = self.m.max_feed_mm_min();
+        self.fan.set(on_table, &mut self.out);
         let mut lines = Vec::with_capacity(n);
+        let mut written = Vec::with_capacity(n);
         for (&to, &(worst, sum, count)) in moves.iter().zip(&errors) {
             let xyz = norm(sub([to[0], to[1], to[2]], [from[0], from[1], from[2]]));
             let rotary = (to[3] - from[3]).hypot(to[4] - from[4]);
+            let de = self.extrusion.add(q.e / n as f64);
+            acc.figures.max_mm = acc.figures.max_mm.max(worst);
+            acc.sum += sum;
+            acc.figures.samples += count;
+            self.printed_length += part_step;
+            self.plot.push((q.feature, self.printed_length, worst));
+            // Zero-length in machine coordinates (X, Y, Z, B and C as written), or extruding
+            // nothing over a few micrometres: merged into the next move, which carries its E.
+            if to == from || (de == 0 && mergeable(xyz, rotary)) {
+                continue;
+            }
             let distance = if xyz > 1e-9 { xyz } else { rotary };
             let f = if part_step > 1e-9 && distance > 0.0 {
                 60.0 * v * distance / part_step
             } else {
                 60.0 * v
             };
-            let f = f.max(0.001);
-            self.e_planned += q.e / n as f64;
-            // Cumulative rounding: the E written adds up to the planned total.
-            let target = (self.e_planned * 1e5).round() as i64;
-            let de = target - self.e_written;
-            self.e_written = target;
+            let f = if f > max_feed {
+                self.clamped.0 += 1;
+                self.clamped.1 = self.clamped.1.max(f);
+                max_feed
+            } else {
+                f.max(0.001)
+            };
+            self.extrusion.written(de);
             acc.figures.max_c_step_deg = acc.figures.max_c_step_deg.max((to[4] - from[4]).abs());
-            acc.figures.max_mm = acc.figures.max_mm.max(worst);
-            acc.sum += sum;
-            acc.figures.samples += count;
-            self.printed_length += part_step;
-            self.plot.push((q.feature, self.printed_length, worst));
+            let e = if de == 0 {
+                String::new()
+            } else {
+                format!(" E{}", e_text(de))
+            };
             lines.push(format!(
-                "G1 X{} Y{} Z{} B{} C{} E{} F{}",
+                "G1 X{} Y{} Z{} B{} C{}{e} F{}",
                 fixed(to[0], 3),
                 fixed(to[1], 3),
                 fixed(to[2], 3),
                 fixed(to[3], 4),
                 fixed(to[4], 4),
-                e_text(de),
                 fixed(f, 3)
             ));
+            written.push(to);
             from = to;
         }
-        for (to, l) in moves.iter().zip(&lines) {
+        acc.figures.print_moves += written.len();
+        for (to, l) in written.iter().zip(&lines) {
             self.check([to[0], to[1], to[2]])?;
             self.line(l);
         }
-        self.printing = true;
-        self.at = moves.last().copied();
+        if let Some(&last) = written.last() {
+            self.printing = true;
+            self.at = Some(last);
+        }
         Ok(())
     }
 
@@ -416,18 +436,36 @@ impl<'a> Writer<'a> {
         (worst, sum, steps)
     }
 
+    /// Writes the filament of print moves merged away at the end of a run (moves that went
+    /// nowhere once rounded) as an extrusion in place, so none is lost.
+    fn flush(&mut self) {
+        let de = self.extrusion.add(0.0);
+        if de != 0 {
+            let line = format!(
+                "G1 E{} F{} ; filament of moves that went nowhere",
+                e_text(de),
+                fixed(self.m.print_speed * 60.0, 0)
+            );
+            self.line(&line);
+            self.extrusion.written(de);
+            self.printing = true;
+        }
+    }
+
     pub(super) fn footer(&mut self) -> Result<(), PostError> {
+        self.flush();
         self.line("; end");
         self.retract();
-        self.line("M104 S0 ; nozzle off");
-        self.line("M140 S0 ; bed off");
         if let Some(at) = self.at {
             self.g0_z(at, self.safe_z.max(at[2]).min(self.hi[2]))?;
             let line = format!("G0 B0.0000 F{} ; level the bed", self.travel_f);
             self.line(&line);
         }
-        self.line("G28 ; home");
-        self.line("M84 ; motors off");
+        self.line("; end_gcode");
+        let end = self.m.end_gcode_text();
+        for l in end.lines() {
+            self.line(l);
+        }
         Ok(())
     }
 }

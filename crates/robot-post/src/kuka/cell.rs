@@ -107,6 +107,14 @@ pub struct KukaCell {
     pub extruder_output: u32,
     /// How the output is switched.
     pub extruder_switch: ExtruderSwitch,
+    /// Number n of the analog output `$ANOUT[n]` that carries each print LIN's feed ratio
+    /// (filament mm per mm of path). Optional: 1 when left out.
+    #[serde(default = "default_feed_output")]
+    pub feed_output: u32,
+    /// The feed ratio (filament mm per mm of path) at `$ANOUT[n] = 1.0`: the output written is
+    /// the ratio over this. Optional: 0.1 when left out.
+    #[serde(default = "default_feed_ratio_full_scale")]
+    pub feed_ratio_full_scale: f64,
     /// Most motions per `.src` file; a longer program is split into parts called from the
     /// main program.
     pub max_moves_per_file: usize,
@@ -115,6 +123,14 @@ pub struct KukaCell {
     pub wrist_singularity_deg: f64,
     /// The arm.
     pub arm: ArmModel,
+}
+
+fn default_feed_output() -> u32 {
+    1
+}
+
+fn default_feed_ratio_full_scale() -> f64 {
+    0.1
 }
 
 impl KukaCell {
@@ -157,6 +173,22 @@ impl KukaCell {
                     "must be an output number 1..4096, got {}",
                     self.extruder_output
                 ),
+            ));
+        }
+        if !(1..=4096).contains(&self.feed_output) {
+            return Err(bad(
+                "kuka.feed_output",
+                format!(
+                    "must be an analog output number 1..4096, got {}",
+                    self.feed_output
+                ),
+            ));
+        }
+        let f = self.feed_ratio_full_scale;
+        if !(f.is_finite() && f > 0.0 && f <= 10.0) {
+            return Err(bad(
+                "kuka.feed_ratio_full_scale",
+                format!("must be above 0 and at most 10 mm of filament per mm, got {f}"),
             ));
         }
         if !(1..=1_000_000).contains(&self.max_moves_per_file) {

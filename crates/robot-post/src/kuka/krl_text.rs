@@ -6,8 +6,7 @@ use super::checks::Checked;
 use super::motion::Step;
 use crate::gcode::comment_text;
 use crate::machine::MachineProfile;
-use toolpath::vec3::{norm, sub};
-use toolpath::{fixed, MoveKind, ToolPath};
+use toolpath::fixed;
 
 /// Longest KRL name (identifiers and module names).
 pub const KRL_NAME_MAX: usize = 24;
@@ -145,7 +144,6 @@ pub fn frame_text(f: &[f64; 6]) -> String {
 /// The `.src` and `.dat` files.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_files(
-    path: &ToolPath,
     m: &MachineProfile,
     cell: &KukaCell,
     steps: &[Step],
@@ -153,8 +151,12 @@ pub(super) fn write_files(
     offset: [f64; 3],
     program_name: &str,
     source: &str,
+    warnings: &mut Vec<String>,
 ) -> Vec<(String, String)> {
     let out = cell.extruder_output;
+    let feed_out = cell.feed_output;
+    // Print LINs whose feed ratio is beyond the analog output's full scale.
+    let mut beyond = (0usize, 0.0f64);
     // Lines grouped by motion: each group ends with one motion; the lines before it (comments,
     // speeds, extruder switching) go with it, so a TRIGGER stays with its motion.
     let mut groups: Vec<Vec<String>> = Vec::new();
@@ -176,6 +178,16 @@ pub(super) fn write_files(
                         format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out}]={state}")
                     }
                 });
+            }
+            Step::Feed(ratio) => {
+                let v = ratio / cell.feed_ratio_full_scale;
+                if v > 1.0 {
+                    beyond = (beyond.0 + 1, beyond.1.max(*ratio));
+                }
+                pending.push(format!(
+                    "TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[{feed_out}]={}",
+                    fixed(v.clamp(0.0, 1.0), 5)
+                ));
             }
             Step::Move { ptp, .. } => {
                 let f = &checked.frames[k];
@@ -212,23 +224,14 @@ pub(super) fn write_files(
     let part_name = |i: usize| format!("{name}_p{:0digits$}", i + 1);
 
     let src = comment_text(source);
-    let print_len: f64 = path
-        .points
-        .windows(2)
-        .filter(|w| w[1].kind == MoveKind::Print)
-        .map(|w| norm(sub(w[1].p, w[0].p)))
-        .sum();
-    let filament: f64 = path
-        .points
-        .iter()
-        .filter(|q| q.kind == MoveKind::Print)
-        .map(|q| q.e)
-        .sum();
-    let feed = if print_len > 0.0 {
-        filament / print_len
-    } else {
-        0.0
-    };
+    if beyond.0 > 0 {
+        warnings.push(format!(
+            "{} print LIN(s) need a feed ratio above kuka.feed_ratio_full_scale {} mm/mm (up to {}): $ANOUT[{feed_out}] is held at 1.0 there, under-extruding",
+            beyond.0,
+            fixed(cell.feed_ratio_full_scale, 5),
+            fixed(beyond.1, 5)
+        ));
+    }
     let switch = match cell.extruder_switch {
         ExtruderSwitch::Out => format!("$OUT[{out}] between motions (exact stop)"),
         ExtruderSwitch::Trigger => format!("$OUT[{out}] by TRIGGER at the motion's start"),
@@ -248,11 +251,15 @@ pub(super) fn write_files(
         ),
         "; tool: Z along the nozzle into the deposit (the tool path axis is -Z of $TOOL)".into(),
         format!(
-            "; extruder: {switch}; set on its controller: nozzle {} C, bed {} C, filament {} mm fed {} mm per mm of bead",
+            "; extruder: {switch}; set on its controller: nozzle {} C, bed {} C, filament {} mm",
             fixed(m.nozzle_temperature, 0),
             fixed(m.bed_temperature, 0),
-            fixed(m.filament_diameter, 2),
-            fixed(feed, 5)
+            fixed(m.filament_diameter, 2)
+        ),
+        format!(
+            "; filament feed per print LIN: $ANOUT[{feed_out}] = feed ratio / {} (feed ratio = filament mm per mm of path, the plan's for that LIN), set by TRIGGER where the LIN starts; the extruder feeds $ANOUT[{feed_out}] x {} mm of filament per mm the tool moves",
+            fixed(cell.feed_ratio_full_scale, 5),
+            fixed(cell.feed_ratio_full_scale, 5)
         ),
         format!(
             "; {moves} motions{}",

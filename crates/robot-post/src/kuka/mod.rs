@@ -36,8 +36,17 @@
 //!   "trigger"` a `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[n]=...` before the first print LIN
 //!   (on) and before the retreat (off) switches it where those motions start, without
 //!   stopping the advance run; with `"out"` a plain `$OUT[n]=...` between the motions stops
-//!   the robot there (exact stop) and switches. Temperatures and the filament feed are the
-//!   extruder controller's; the header states them.
+//!   the robot there (exact stop) and switches. Temperatures are the extruder controller's;
+//!   the header states them.
+//! - **Filament feed.** One feed ratio per print LIN, following the plan: the planned E of
+//!   the path points the LIN reaches (a print move dropped as going nowhere hands its E on)
+//!   over the LIN's length, in mm of filament per mm of path. It is written as the analog
+//!   output `$ANOUT[feed_output]` = ratio / `feed_ratio_full_scale` (5 decimals, held at 1.0
+//!   with a warning beyond full scale) by `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[n]=v`
+//!   right before the LIN, where it changes, so it switches where that LIN starts without
+//!   stopping the advance run. The extruder's controller feeds v × `feed_ratio_full_scale`
+//!   mm of filament per mm the tool moves (the impeller's blades need about 0.0286, its base
+//!   0.0374; one ratio for the whole program over-extruded the blades by 26 %).
 //! - **Files.** `<name>.src` holds header comments (source, machine, part offset, tool and
 //!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE`, `$TOOL`,
 //!   `$ADVANCE`, `$APO.CDIS`, extruder off and `PTP` home (`DECL AXIS XHOME_PRINT` in
@@ -130,7 +139,6 @@ pub fn kuka(
     let steps = plan_motion(path, &axes, offset, m, cell, &base);
     let checked = check(path, &steps, cell, &base, &mut warnings);
     let files = write_files(
-        path,
         m,
         cell,
         &steps,
@@ -138,6 +146,7 @@ pub fn kuka(
         offset,
         program_name,
         source,
+        &mut warnings,
     );
     Ok(KrlProgram {
         files,

@@ -26,6 +26,8 @@ pub(super) enum Step {
     /// `$VEL.CP` (m/s).
     Vel(f64),
     Extruder(bool),
+    /// The feed ratio (filament mm per mm of path) of the next motion, a print LIN.
+    Feed(f64),
     /// A motion to a tool pose in `$BASE`, for path point `point`.
     Move {
         ptp: bool,
@@ -85,6 +87,7 @@ pub(super) fn plan_motion(
     let mut w = Motion {
         steps: Vec::new(),
         vel: None,
+        feed: None,
         on: false,
         clearance: cell.travel_clearance,
         z_top: f64::NEG_INFINITY,
@@ -133,6 +136,7 @@ pub(super) fn plan_motion(
                 if !w.on {
                     w.extruder(true);
                 }
+                w.feed(path, &pose, i);
                 w.motion(false, pose, i);
                 pose
             }
@@ -240,6 +244,8 @@ pub(super) fn start_frame(z: V3, p: V3, base: &Pose) -> Mat3 {
 pub(super) struct Motion {
     steps: Vec<Step>,
     vel: Option<f64>,
+    /// The feed ratio in force.
+    feed: Option<f64>,
     on: bool,
     clearance: f64,
     /// Highest point of the path so far ($BASE Z, mm).
@@ -259,6 +265,33 @@ impl Motion {
     fn extruder(&mut self, on: bool) {
         self.on = on;
         self.steps.push(Step::Extruder(on));
+    }
+
+    /// The feed ratio of a print LIN to `pose` (path point `point`): the planned filament of
+    /// the print points since the previous motion's point (a print move dropped as going
+    /// nowhere hands its filament on) over the LIN's length; a step only where it changes by
+    /// more than the output's rounding.
+    fn feed(&mut self, path: &ToolPath, pose: &Pose, point: usize) {
+        let Some((last, from)) = self.steps.iter().rev().find_map(|s| match s {
+            Step::Move { pose, point, .. } => Some((*pose, *point)),
+            _ => None,
+        }) else {
+            return;
+        };
+        let length = norm(sub(pose.t, last.t));
+        if length <= 0.0 || from >= point {
+            return;
+        }
+        let e: f64 = path.points[from + 1..=point]
+            .iter()
+            .filter(|q| q.kind == MoveKind::Print)
+            .map(|q| q.e)
+            .sum();
+        let ratio = e / length;
+        if self.feed.is_none_or(|f| (f - ratio).abs() > 1e-7) {
+            self.feed = Some(ratio);
+            self.steps.push(Step::Feed(ratio));
+        }
     }
 
     /// Whether `pose` is the previous motion's (within 1e-9 mm and 1e-9°).
