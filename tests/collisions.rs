@@ -318,7 +318,8 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
 }
 
 /// A bead: its top centreline from `a` to `b`, the tool axis, thickness and width.
-type Bead = ([f64; 3], [f64; 3], [f64; 3], f64, f64);
+/// A bead: from, to, axis, thickness, width, and its (feature, layer).
+type Bead = ([f64; 3], [f64; 3], [f64; 3], f64, f64, (usize, usize));
 
 /// Beads laid so far, indexed by 1 mm cells.
 #[derive(Default)]
@@ -330,7 +331,8 @@ struct Beads {
 impl Beads {
     fn add(&mut self, a: [f64; 3], q: &Pt) {
         let k = self.all.len();
-        self.all.push((a, q.p, q.axis, q.thickness, q.width));
+        self.all
+            .push((a, q.p, q.axis, q.thickness, q.width, (q.feature, q.layer)));
         let r = q.width.max(q.thickness);
         let lo: [i64; 3] = std::array::from_fn(|i| (a[i].min(q.p[i]) - r).floor() as i64);
         let hi: [i64; 3] = std::array::from_fn(|i| (a[i].max(q.p[i]) + r).floor() as i64);
@@ -345,13 +347,21 @@ impl Beads {
 
     /// Whether `t` lies inside a bead: under its top by more than 0.02 mm and less than its
     /// thickness, and nearer its centreline across than half its width, by 0.02 mm.
-    fn inside(&self, t: [f64; 3]) -> bool {
+    /// Whether `t` lies inside a bead, but for those of the layers `own` (feature, layer): a
+    /// travel's first step up off the layer it leaves, and its last step down onto the layer
+    /// it goes to, meet that layer's beads beside it at its own height, within a bead's tilt
+    /// where the layer curves and the smoothed axis leans, or a step of a transition band
+    /// over offset layers.
+    fn inside(&self, t: [f64; 3], own: [Option<(usize, usize)>; 2]) -> bool {
         let key = t.map(|v| v.floor() as i64);
         let Some(list) = self.cells.get(&key) else {
             return false;
         };
         list.iter().any(|&k| {
-            let (a, b, axis, th, w) = self.all[k];
+            let (a, b, axis, th, w, layer) = self.all[k];
+            if own.contains(&Some(layer)) {
+                return false;
+            }
             let ab = sub(b, a);
             let len2 = dot(ab, ab);
             let s = if len2 > 0.0 {
@@ -401,7 +411,7 @@ fn check_travels(name: &str, machine: MachineKind, run: &Planned) {
         .map(|(i, q)| (i, *q))
         .collect();
     let mut beads = Beads::default();
-    let mut next = 0;
+    let mut next: usize = 0;
     let mut turn = 0.0;
     let mut from = [0.0; 5];
     let (mut travels, mut checked) = (0, 0);
@@ -415,7 +425,14 @@ fn check_travels(name: &str, machine: MachineKind, run: &Planned) {
                 let j: [f64; 5] = std::array::from_fn(|i| from[i] + (to[i] - from[i]) * f);
                 let t = to_part(j);
                 assert!(
-                    !beads.inside(t),
+                    !beads.inside(
+                        t,
+                        [
+                            next.checked_sub(1)
+                                .map(|k| (prints[k].1.feature, prints[k].1.layer)),
+                            prints.get(next).map(|(_, q)| (q.feature, q.layer))
+                        ]
+                    ),
                     "{name}: a travel to {to:?} passes through a bead at {t:?}"
                 );
                 checked += 1;

@@ -167,10 +167,20 @@ fn every_warning_of_the_plan_is_one_line_on_stderr() {
         );
         assert_eq!(widened > 0.0, narrow[&id].0 > 0, "feature {id}");
         if widened > 0.0 {
-            // The blades: 12.7 % more than planned, said in the warning.
+            // The blades' narrow beads are widened by less than the beads they widen carry:
+            // at most the filament of the beads now exactly 0.24 mm wide (each at least
+            // 0.045 mm wide before, so at most 0.24 / 0.045 - 1 of its own), said in the
+            // warning.
+            let at_min: f64 = csv
+                .lines()
+                .skip(1)
+                .map(|l| l.split(',').collect::<Vec<_>>())
+                .filter(|f| f[2] == "print" && f[0] == id.to_string() && f[11] == "0.2400")
+                .map(|f| f[9].parse::<f64>().unwrap() * area)
+                .sum();
             assert!(
-                (widened / planned - 0.127).abs() < 0.005,
-                "{widened} / {planned}"
+                widened > 0.0 && widened < at_min,
+                "feature {id}: {widened} mm^3 widened, {at_min} mm^3 in the beads at 0.24 mm"
             );
             assert!(
                 all.iter().any(|w| w.starts_with(&format!("feature {id}: "))
@@ -843,7 +853,13 @@ fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
     // Per layer: the print moves' (x, y, type).
     let mut moves: Vec<Vec<(f64, f64, String)>> = vec![];
     let mut per_type = std::collections::BTreeMap::<String, usize>::new();
-    for line in program.lines() {
+    // The planned moves: between the profile's start_gcode (its purge line prints, untyped)
+    // and its end_gcode.
+    for line in program
+        .lines()
+        .skip_while(|l| *l != "; end of start_gcode")
+        .take_while(|l| *l != "; end_gcode")
+    {
         if line == ";LAYER_CHANGE" {
             role = None;
             layers += 1;

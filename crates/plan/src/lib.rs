@@ -26,9 +26,9 @@ use robot_post::machine::MachineProfile;
 use robot_post::{Job, PostFigures, ProgramFile};
 use slicer::orient::{limit_tilt, smooth, OrientationFigures};
 
-use slicer::params::LayerParams;
+use slicer::params::{LayerParams, LayerStrategy};
 use slicer::toolpath::{MoveKind, ToolPath};
-use slicer::verify::{check_plan, PlanProblem, PlannedFeature};
+use slicer::verify::{check_plan, PlanProblem, PlannedFeature, VOLUME_TOLERANCE};
 use slicer::{fill_feature, sequence};
 
 /// Why a part could not be planned. Each message is one line.
@@ -199,6 +199,27 @@ pub fn plan(
             tell(Progress::Feature { id });
             let (params, fill) = fill?;
             let mut plan = fill.lay(cursor);
+            // Transition layers chosen by `auto` that miss the feature's volume by more than
+            // the self-check allows: the feature on offset layers instead, said in a warning.
+            let mut fallback = None;
+            if params.layer_strategy == LayerStrategy::Auto
+                && plan.freeform.is_some_and(|ff| ff.layers == "transition")
+            {
+                let expected = f.volume * params.filling_ratio;
+                let rel = plan.figures.filament * filament_area / expected.max(1e-12) - 1.0;
+                if rel.abs() > VOLUME_TOLERANCE {
+                    let offset_params = LayerParams {
+                        layer_strategy: LayerStrategy::Offset,
+                        ..params.clone()
+                    };
+                    plan = fill_feature(t, f, &offset_params, bead)?.lay(cursor);
+                    fallback = Some(format!(
+                        "feature {id}: offset layers, not transition layers: these missed its volume by {:+.2} %",
+                        100.0 * rel
+                    ));
+                }
+            }
+            plan.figures.warnings.extend(fallback);
             cursor = plan.exit().map(P3::from).or(cursor);
             let fig = &plan.figures;
             let extruded = fig.filament * filament_area;

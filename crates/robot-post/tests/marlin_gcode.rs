@@ -629,7 +629,13 @@ fn marlin_type_comments_follow_the_roles() {
     );
     let mut typed = false;
     let mut prints = 0;
-    for l in program.lines() {
+    // The planned moves: between the profile's start_gcode (its purge line prints, untyped)
+    // and its end_gcode.
+    for l in program
+        .lines()
+        .skip_while(|l| *l != "; end of start_gcode")
+        .take_while(|l| *l != "; end_gcode")
+    {
         if l == ";LAYER_CHANGE" {
             typed = false;
         } else if l.starts_with(";TYPE:") {

@@ -9,7 +9,7 @@
 use crate::error::PlanError;
 use crate::geom2d::{Point2, Region};
 use crate::tolerance::{DEGENERATE_LENGTH, SINGULAR_DET};
-use crate::transition::TopField;
+use crate::top_field::TopField;
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
 use brep::surface::Surface;

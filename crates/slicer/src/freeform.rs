@@ -44,7 +44,7 @@ use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INS
 use crate::sst::{Sides, WALL_REACH};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
-use crate::transition::{band, levels, Levels, TopField};
+use crate::transition::{band, build_top_field, levels, Levels, TopField};
 
 /// Splits chart paths where `keep` turns false, ending each piece on the boundary (found by
 /// bisection along the segment that crosses it).
@@ -247,7 +247,7 @@ pub fn fill_freeform<'a>(
         LayerStrategy::Offset => None,
         strategy => {
             let forced = strategy == LayerStrategy::Transition;
-            match TopField::build(&chart, b, &raw, &f.heal_faces, &mapped, id)? {
+            match build_top_field(&chart, b, &raw, &f.heal_faces, &mapped, id)? {
                 None if forced => {
                     return Err(err(
                         "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),

@@ -46,6 +46,7 @@ pub mod planar;
 mod region_fill;
 mod sst;
 mod tolerance;
+mod top_field;
 pub mod transition;
 pub mod verify;
 
