@@ -5,6 +5,7 @@
 #[path = "common/readback.rs"]
 mod readback;
 
+use readback::Row as Pt;
 use robot_post::machine::MachineProfile;
 use robot_post::MachineKind;
 use serde_json::Value;
@@ -29,17 +30,6 @@ impl Drop for Out {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
     }
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Pt {
-    feature: usize,
-    layer: usize,
-    print: bool,
-    p: [f64; 3],
-    axis: [f64; 3],
-    thickness: f64,
-    width: f64,
 }
 
 struct Planned {
@@ -84,23 +74,7 @@ fn plan(name: &str, machine: &str) -> Planned {
     );
     let read = |f: &str| std::fs::read_to_string(dir.0.join(f)).unwrap_or_default();
     let plan: Value = serde_json::from_str(&read("plan.json")).expect("plan.json");
-    let points = read("toolpath.csv")
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let n = |k: usize| f[k].parse::<f64>().expect("number");
-            Pt {
-                feature: f[0].parse().expect("feature"),
-                layer: f[1].parse().expect("layer"),
-                print: f[2] == "print",
-                p: [n(3), n(4), n(5)],
-                axis: [n(6), n(7), n(8)],
-                thickness: n(10),
-                width: n(11),
-            }
-        })
-        .collect();
+    let points = readback::rows(&read("toolpath.csv"));
     let program = read("program.gcode");
     Planned {
         _dir: dir,

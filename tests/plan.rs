@@ -5,6 +5,7 @@
 #[path = "common/readback.rs"]
 mod readback;
 
+use readback::{rows, Row};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -65,40 +66,6 @@ fn plan_part(part: &Path, extra: &[&str]) -> (Out, Value, String, String, String
     let gcode = std::fs::read_to_string(dir.0.join("program.gcode")).unwrap_or_default();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     (dir, plan, csv, gcode, stderr)
-}
-
-#[derive(Debug, Clone)]
-struct Row {
-    feature: usize,
-    layer: usize,
-    print: bool,
-    p: [f64; 3],
-    axis: [f64; 3],
-    e: f64,
-    thickness: f64,
-}
-
-fn rows(csv: &str) -> Vec<Row> {
-    let mut lines = csv.lines();
-    assert_eq!(
-        lines.next(),
-        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role")
-    );
-    lines
-        .map(|l| {
-            let c: Vec<&str> = l.split(',').collect();
-            let f = |k: usize| c[k].parse::<f64>().expect("number");
-            Row {
-                feature: c[0].parse().expect("feature"),
-                layer: c[1].parse().expect("layer"),
-                print: c[2] == "print",
-                p: [f(3), f(4), f(5)],
-                axis: [f(6), f(7), f(8)],
-                e: f(9),
-                thickness: f(10),
-            }
-        })
-        .collect()
 }
 
 const TWO5D_ONLY: [&str; 9] = [

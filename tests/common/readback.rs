@@ -1,5 +1,5 @@
-//! Reading a program back in the end-to-end tests (`plan`, `collisions`): its moves and the
-//! header's part offset.
+//! Reading a plan back in the end-to-end tests (`plan`, `collisions`): the program's moves and
+//! the header's part offset, and the rows of `toolpath.csv`.
 
 /// The program's `G0`/`G1` moves, as (rapid, `[X, Y, Z, B, C]` after the move, E), modal.
 pub fn moves(program: &str) -> Vec<(bool, [f64; 5], Option<f64>)> {
@@ -42,4 +42,43 @@ pub fn offset(program: &str) -> [f64; 3] {
         .map(|w| w[1..].parse().expect("offset number"))
         .collect();
     [v[0], v[1], v[2]]
+}
+
+/// One row of `toolpath.csv`. Each test reads the columns it checks.
+#[allow(dead_code)]
+#[derive(Debug, Clone, Copy)]
+pub struct Row {
+    pub feature: usize,
+    pub layer: usize,
+    pub print: bool,
+    pub p: [f64; 3],
+    pub axis: [f64; 3],
+    pub e: f64,
+    pub thickness: f64,
+    pub width: f64,
+}
+
+/// The rows of `toolpath.csv`, its header checked (other tools read these columns by place).
+pub fn rows(csv: &str) -> Vec<Row> {
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("feature,layer,move,x,y,z,i,j,k,e,thickness,width,role")
+    );
+    lines
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            let f = |k: usize| c[k].parse::<f64>().expect("number");
+            Row {
+                feature: c[0].parse().expect("feature"),
+                layer: c[1].parse().expect("layer"),
+                print: c[2] == "print",
+                p: [f(3), f(4), f(5)],
+                axis: [f(6), f(7), f(8)],
+                e: f(9),
+                thickness: f(10),
+                width: f(11),
+            }
+        })
+        .collect()
 }
