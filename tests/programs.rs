@@ -3,49 +3,12 @@
 //! no zero-length or zero-extrusion moves, feeds within the profile's limit (Marlin and
 //! delta5), and KRL extrusion following the planned flow.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+#[path = "common/cli.rs"]
+mod cli;
 
-const BIN: &str = env!("CARGO_BIN_EXE_features");
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures")
-        .join(name)
-}
-
-/// A scratch folder of one test, removed when dropped.
-struct Scratch(PathBuf);
-impl Scratch {
-    fn new(test: &str) -> Scratch {
-        let d =
-            std::env::temp_dir().join(format!("features-programs-{}-{test}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("scratch");
-        Scratch(d)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn plan(part: &str, args: &[&str]) -> Output {
-    Command::new(BIN)
-        .arg("plan")
-        .arg(fixture(part))
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use cli::{fixture, plan, stderr, Scratch, BIN};
+use std::path::Path;
+use std::process::Command;
 
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
