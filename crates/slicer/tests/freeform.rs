@@ -11,7 +11,7 @@ use slicer::params::{LayerParams, LayerStrategy, PathMode};
 use slicer::planar::{Bead, PlanError};
 use slicer::toolpath::{MoveKind, PathPoint};
 use std::collections::HashMap;
-use support::tree;
+use support::{distance_to_mesh, tree};
 
 const BEAD: Bead = Bead {
     width: 0.45,
@@ -70,38 +70,6 @@ impl Near {
         }
         best
     }
-}
-
-/// The distance from `p` to the nearest triangle of `mesh`.
-fn distance_to_mesh(mesh: &Mesh, p: &P3) -> f64 {
-    let seg = |a: &P3, b: &P3| {
-        let ab = b - a;
-        let t = ((p - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
-        (p - (a + ab * t)).norm()
-    };
-    mesh.triangles()
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            let nrm = (b - a).cross(&(c - a));
-            let edges = seg(&a, &b).min(seg(&b, &c)).min(seg(&c, &a));
-            if nrm.norm() < 1e-15 {
-                return edges;
-            }
-            let nu = nrm / nrm.norm();
-            let h = (p - a).dot(&nu);
-            let q = p - nu * h;
-            // Inside the triangle: the normal distance; else the nearest edge.
-            let inside = [(a, b), (b, c), (c, a)]
-                .iter()
-                .all(|(u, v)| (v - u).cross(&(q - u)).dot(&nrm) >= 0.0);
-            if inside {
-                h.abs()
-            } else {
-                edges
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 struct Checked {

@@ -12,44 +12,12 @@ use slicer::params::{LayerParams, LayerStrategy};
 use slicer::planar::Bead;
 use slicer::toolpath::{MoveKind, PathPoint};
 use std::collections::HashMap;
-use support::tree;
+use support::{distance_to_mesh, tree};
 
 const BEAD: Bead = Bead {
     width: 0.45,
     filament_diameter: 1.75,
 };
-
-/// The distance from `p` to the nearest triangle of `mesh`, and that triangle's unit normal.
-fn nearest_triangle(mesh: &Mesh, p: &P3) -> (f64, V3) {
-    let seg = |a: &P3, b: &P3| {
-        let ab = b - a;
-        let t = ((p - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
-        (p - (a + ab * t)).norm()
-    };
-    let mut best = (f64::INFINITY, V3::z());
-    for t in mesh.triangles() {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let nrm = (b - a).cross(&(c - a));
-        if nrm.norm() < 1e-15 {
-            continue;
-        }
-        let nu = nrm / nrm.norm();
-        let h = (p - a).dot(&nu);
-        let q = p - nu * h;
-        let inside = [(a, b), (b, c), (c, a)]
-            .iter()
-            .all(|(u, v)| (v - u).cross(&(q - u)).dot(&nrm) >= 0.0);
-        let d = if inside {
-            h.abs()
-        } else {
-            seg(&a, &b).min(seg(&b, &c)).min(seg(&c, &a))
-        };
-        if d < best.0 {
-            best = (d, nu);
-        }
-    }
-    best
-}
 
 /// Print points of one layer on a hash grid, for the nearest one to a query.
 struct Grid {
@@ -98,12 +66,11 @@ impl Grid {
 
 /// Plans freeform feature `id` of `name` with the default process (layer_strategy = auto),
 /// asserts it got transition layers, and checks the properties on every print point.
-fn check_transition(name: &str, id: usize) {
-    let t: FeatureTree = tree(name);
+fn check_transition(name: &str, t: &FeatureTree, id: usize) {
     let f = &t.features[id];
     assert_eq!(f.kind, FeatureKind::Freeform, "{name} feature {id}");
     let params = LayerParams::default();
-    let plan = plan_freeform(&t, f, &params, BEAD, None)
+    let plan = plan_freeform(t, f, &params, BEAD, None)
         .unwrap_or_else(|e| panic!("{name} feature {id}: {e}"));
     let ff = plan.freeform.expect("freeform figures");
     assert_eq!(
@@ -149,7 +116,7 @@ fn check_transition(name: &str, id: usize) {
         let mut near: Vec<(f64, usize)> = shells
             .iter()
             .enumerate()
-            .map(|(k, m)| (nearest_triangle(m, &x).0, k))
+            .map(|(k, m)| (distance_to_mesh(m, &x), k))
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
         let (d, k) = near[0];
@@ -167,7 +134,7 @@ fn check_transition(name: &str, id: usize) {
         let c = x - V3::from(p.axis) * (0.5 * p.thickness);
         let dc = shells
             .iter()
-            .map(|m| nearest_triangle(m, &c).0)
+            .map(|m| distance_to_mesh(m, &c))
             .fold(f64::INFINITY, f64::min);
         assert!(
             (dc - 0.5 * p.thickness).abs() <= params.tolerance,
@@ -308,14 +275,23 @@ fn check_transition(name: &str, id: usize) {
     );
 }
 
+/// The id of the tree's first freeform feature (a blade of the impeller or the fan).
+fn first_freeform(t: &FeatureTree) -> usize {
+    t.features
+        .iter()
+        .find(|f| f.kind == FeatureKind::Freeform)
+        .expect("a freeform feature")
+        .id
+}
+
 #[test]
 fn domed_pad_transition_layers_end_on_its_spherical_top() {
-    check_transition("domed_pad", 1);
+    check_transition("domed_pad", &tree("domed_pad"), 1);
 }
 
 #[test]
 fn sphere_boss_transition_layers_morph_the_sphere_into_the_flat_top() {
-    check_transition("sphere_boss", 1);
+    check_transition("sphere_boss", &tree("sphere_boss"), 1);
 }
 
 #[test]
@@ -326,7 +302,7 @@ fn capsule_bosses_get_transition_layers() {
         .iter()
         .filter(|f| f.kind == FeatureKind::Freeform)
     {
-        check_transition("capsule", f.id);
+        check_transition("capsule", &t, f.id);
     }
 }
 
@@ -335,25 +311,13 @@ fn impeller_blade_gets_offset_layers_then_a_transition_band_to_its_tip() {
     // Its tip lies 2.9 to 11 mm over the hub along the hub's normals: no one N keeps
     // [0.1, 0.3] mm, so offset layers first, then a transition band (crate::transition).
     let t = tree("impeller");
-    let id = t
-        .features
-        .iter()
-        .find(|f| f.kind == FeatureKind::Freeform)
-        .expect("a blade")
-        .id;
-    check_transition("impeller", id);
+    check_transition("impeller", &t, first_freeform(&t));
 }
 
 #[test]
 fn fan_blade_transition_layers_end_on_its_tip() {
     let t = tree("fan");
-    let id = t
-        .features
-        .iter()
-        .find(|f| f.kind == FeatureKind::Freeform)
-        .expect("a blade")
-        .id;
-    check_transition("fan", id);
+    check_transition("fan", &t, first_freeform(&t));
 }
 
 #[test]
@@ -362,11 +326,7 @@ fn a_top_too_close_to_the_base_for_the_bounds_keeps_offset_layers_or_is_refused_
     // the hub would need at least 37 layers and at most 9, and a band over offset layers at
     // least 11 and at most 9.
     let t = tree("impeller");
-    let f = t
-        .features
-        .iter()
-        .find(|f| f.kind == FeatureKind::Freeform)
-        .expect("a blade");
+    let f = &t.features[first_freeform(&t)];
     let tight = LayerParams {
         min_layer_height: 0.3,
         max_layer_height: 0.3,
@@ -435,7 +395,7 @@ fn sst_wall_axes_are_perpendicular_to_the_side_face_and_the_path() {
         let centre = P3::from(p.p) - axis * (0.5 * p.thickness);
         let mut near: Vec<(f64, V3)> = sides
             .iter()
-            .map(|(m, n)| (nearest_triangle(m, &centre).0, *n))
+            .map(|(m, n)| (distance_to_mesh(m, &centre), *n))
             .collect();
         near.sort_by(|x, y| x.0.total_cmp(&y.0));
         // A wall bead along one side, not at a corner where two meet.
