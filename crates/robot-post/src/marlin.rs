@@ -226,13 +226,9 @@ impl Writer {
         (z + self.z_hop).min(self.z_max).max(z)
     }
 
-    /// Writes the filament of print moves merged away at the end of a run (a run that went
-    /// nowhere once rounded, a dot) as an extrusion in place, so none is lost.
-    fn flush(&mut self) {
-        let de = self.extrusion.add(0.0);
-        if de == 0 {
-            return;
-        }
+    /// Before extruding again: down from a z-hop to where the nozzle is, and the retracted
+    /// filament fed back.
+    fn resume(&mut self) {
         if self.hopped {
             if let Some(at) = self.at {
                 let line = format!("G0 Z{} F{}", fixed(at[2], 3), self.travel_f);
@@ -245,6 +241,16 @@ impl Writer {
             self.line(&line);
             self.retracted = false;
         }
+    }
+
+    /// Writes the filament of print moves merged away at the end of a run (a run that went
+    /// nowhere once rounded, a dot) as an extrusion in place, so none is lost.
+    fn flush(&mut self) {
+        let de = self.extrusion.add(0.0);
+        if de == 0 {
+            return;
+        }
+        self.resume();
         let line = format!(
             "G1 E{} F{} ; filament of moves that went nowhere",
             e_text(de),
@@ -291,18 +297,7 @@ impl Writer {
                 return;
             }
         }
-        if self.hopped {
-            if let Some(at) = self.at {
-                let line = format!("G0 Z{} F{}", fixed(at[2], 3), self.travel_f);
-                self.line(&line);
-            }
-            self.hopped = false;
-        }
-        if self.retracted {
-            let line = format!("G1 E{} F{}", fixed(self.retraction, 5), self.retraction_f);
-            self.line(&line);
-            self.retracted = false;
-        }
+        self.resume();
         // A bead resting on the plate (its bottom within 10 µm of Z0) goes at first-layer speed.
         let on_plate = t[2] - q.thickness.max(0.0) <= 0.01;
         self.fan.set(on_plate, &mut self.out);
