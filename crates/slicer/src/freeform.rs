@@ -44,7 +44,7 @@ use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INS
 use crate::sst::{Sides, WALL_REACH};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
-use crate::transition::{band, build_top_field, levels, Levels, TopField};
+use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
 
 /// Splits chart paths where `keep` turns false, ending each piece on the boundary (found by
 /// bisection along the segment that crosses it).
@@ -242,12 +242,19 @@ pub fn fill_freeform<'a>(
         overhang_layers: None,
         layers: "offset",
     };
+    // The top faces, for transition layers and side-surface-tangent walls.
+    let sst = params.wall_orientation == WallOrientation::Sst && params.fixed_tool_axis.is_none();
+    let tops = if params.layer_strategy != LayerStrategy::Offset || sst {
+        top_faces(&chart, &raw, &f.heal_faces, id)
+    } else {
+        vec![]
+    };
     // Offset or transition layers (issue 17): see crate::transition.
     let blend = match params.layer_strategy {
         LayerStrategy::Offset => None,
         strategy => {
             let forced = strategy == LayerStrategy::Transition;
-            match build_top_field(&chart, b, &raw, &f.heal_faces, &mapped, id)? {
+            match build_top_field(&chart, b, &raw, &tops, &mapped, id)? {
                 None if forced => {
                     return Err(err(
                         "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
@@ -296,9 +303,7 @@ pub fn fill_freeform<'a>(
         None => heights.len(),
     };
     let ff = ff;
-    let sides = (params.wall_orientation == WallOrientation::Sst
-        && params.fixed_tool_axis.is_none())
-    .then(|| Sides::new(&chart, &raw, &f.heal_faces, id, 1.0));
+    let sides = sst.then(|| Sides::new(&raw, &f.heal_faces, &tops, 1.0));
     let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.

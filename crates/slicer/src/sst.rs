@@ -7,13 +7,12 @@
 //!
 //! Which beads are wall beads: those whose centre lies within [`WALL_REACH`] bead widths of a
 //! side face (the feature's faces other than its healing faces and its top, see
-//! [`crate::transition::up_share`]), so the outermost ring of each layer. The side faces are
+//! [`crate::transition::top_faces`]), so the outermost ring of each layer. The side faces are
 //! held as triangles on a uniform grid for the nearest-face query.
 
-use crate::chart::Chart;
 use crate::geom2d::Point2;
 use crate::lift::Lifted;
-use crate::transition::{up_share, TOP_SHARE};
+
 use brep::math::{P3, V3};
 use brep::mesh::Mesh;
 use brep::topology::FaceId;
@@ -30,14 +29,12 @@ pub(crate) struct Sides {
 }
 
 impl Sides {
-    /// The faces of `mesh` (a feature's) that are neither in `heal` nor top faces.
-    pub(crate) fn new(chart: &Chart, mesh: &Mesh, heal: &[FaceId], id: usize, cell: f64) -> Sides {
+    /// The faces of `mesh` (a feature's) that are neither in `heal` nor in `tops` (its top
+    /// faces, [`crate::transition::top_faces`]).
+    pub(crate) fn new(mesh: &Mesh, heal: &[FaceId], tops: &[FaceId], cell: f64) -> Sides {
         let mut tris = vec![];
         for ft in &mesh.faces {
-            if ft.triangles.is_empty()
-                || heal.contains(&ft.face)
-                || up_share(chart, mesh, ft, id) >= TOP_SHARE
-            {
+            if heal.contains(&ft.face) || tops.contains(&ft.face) {
                 continue;
             }
             for t in &ft.triangles {

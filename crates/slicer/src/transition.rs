@@ -48,7 +48,7 @@ use brep::topology::FaceId;
 
 /// A face belongs to the top when the `d`-share of its area-weighted normal in chart space is
 /// at least this (its mean normal within 60° of the growth direction).
-pub(crate) const TOP_SHARE: f64 = 0.5;
+const TOP_SHARE: f64 = 0.5;
 
 /// Longest edge of the top's triangles sampled into a [`TopField`], mm.
 const TOP_EDGE: f64 = 0.25;
@@ -56,33 +56,45 @@ const TOP_EDGE: f64 = 0.25;
 /// Most cells of a [`TopField`] grid.
 const MAX_CELLS: f64 = 400_000.0;
 
-/// `h_T` of the feature whose mesh is `mesh` (its faces' triangulations) and whose healing
-/// faces are `heal`, in `chart`; `mapped` is the refined mesh already mapped into
+/// The top faces T of the feature whose mesh is `mesh` (its faces' triangulations) and whose
+/// healing faces are `heal`, in `chart`: the others whose [`up_share`] is at least
+/// [`TOP_SHARE`].
+pub(crate) fn top_faces(chart: &Chart, mesh: &Mesh, heal: &[FaceId], id: usize) -> Vec<FaceId> {
+    mesh.faces
+        .iter()
+        .filter(|ft| {
+            !ft.triangles.is_empty()
+                && !heal.contains(&ft.face)
+                && up_share(chart, mesh, ft, id) >= TOP_SHARE
+        })
+        .map(|ft| ft.face)
+        .collect()
+}
+
+/// `h_T` of the feature whose mesh is `mesh` (its faces' triangulations) and whose top faces
+/// are `tops` ([`top_faces`]), in `chart`; `mapped` is the refined mesh already mapped into
 /// `(s, t, d)` (its bounds set the grid). `None` when the feature has no top face.
 pub(crate) fn build_top_field(
     chart: &Chart,
     brep: &brep::Brep,
     mesh: &Mesh,
-    heal: &[FaceId],
+    tops: &[FaceId],
     mapped: &Mesh,
     id: usize,
 ) -> Result<Option<TopField>, PlanError> {
     // The top faces, each as its own triangles (refined, so that d is near linear over
     // every triangle of the chart).
-    let mut top = Mesh {
+    let top = Mesh {
         positions: mesh.positions.clone(),
-        faces: vec![],
+        faces: mesh
+            .faces
+            .iter()
+            .filter(|ft| tops.contains(&ft.face))
+            .cloned()
+            .collect(),
         edge_points: Default::default(),
         edge_params: Default::default(),
     };
-    for ft in &mesh.faces {
-        if ft.triangles.is_empty() {
-            continue;
-        }
-        if !heal.contains(&ft.face) && up_share(chart, mesh, ft, id) >= TOP_SHARE {
-            top.faces.push(ft.clone());
-        }
-    }
     if top.faces.is_empty() {
         return Ok(None);
     }
@@ -161,7 +173,7 @@ fn merge(pieces: &[Mesh]) -> Mesh {
 /// The `d`-share of a face's area-weighted normal in chart space (1: it faces the way the
 /// feature grows, 0: along it, −1: against it), from a sample of its triangles; 0 where they
 /// do not map.
-pub(crate) fn up_share(chart: &Chart, mesh: &Mesh, ft: &FaceTriangulation, id: usize) -> f64 {
+fn up_share(chart: &Chart, mesh: &Mesh, ft: &FaceTriangulation, id: usize) -> f64 {
     let stride = (ft.triangles.len() / 64).max(1);
     let mut positions = vec![];
     let mut tris: Vec<[u32; 3]> = vec![];
