@@ -479,7 +479,10 @@ fn level_span(lm: &LayerMesh, phi: &[f64], db: &[f64], edge: f64) -> Option<(f64
 }
 
 /// Gap fill of the whole core a region's rings leave (or of a region too thin for a ring),
-/// its widths scaled down where they would put down more than the core holds. The ridge
+/// its widths scaled so that it puts down what the core holds: down where it would put down
+/// more, up (by at most [`MAX_CORE_WIDENING`]) where less. Up: the ridge of a strip a few
+/// lattice steps wide falls between the lattice's vertices, so its height (each flank's
+/// width) comes out short, by 12 % on a 2 mm rib's 0.2 mm core (−3.8 % of the rib). The ridge
 /// height a gap fill takes as its width is right along a strip, whose two flanks meet at the
 /// ridge, but not where the core is compact (a small boss's square core, whose flanks are
 /// all four sides): there each side took the whole half width and the loop laid the core
@@ -508,8 +511,8 @@ fn conserved(
         })
         .sum();
     let held = lm.area_above(db, edge);
-    if covered > held && covered > 0.0 {
-        let k = held / covered;
+    if covered > 0.0 && (covered - held).abs() > 1e-9 * held {
+        let k = (held / covered).min(MAX_CORE_WIDENING);
         for p in &mut paths {
             for w in &mut p.widths {
                 *w *= k;
@@ -526,6 +529,9 @@ fn surface_length(chart: &Chart, d: f64, a: Point2, b: Point2) -> f64 {
         _ => f64::NAN,
     }
 }
+
+/// Most a core's gap fill is widened to put down what the core holds ([`conserved`]).
+const MAX_CORE_WIDENING: f64 = 1.5;
 
 /// The narrowest gap fill between rings, in bead widths: a ring with less than this left
 /// beyond its bead widens to take it.
