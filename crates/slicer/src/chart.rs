@@ -8,7 +8,7 @@
 
 use crate::error::PlanError;
 use crate::geom2d::{Point2, Region};
-use crate::tolerance::{DEGENERATE_LENGTH, SINGULAR_DET};
+use crate::tolerance::{DEGENERATE_LENGTH, MICROMETRE, SINGULAR_DET};
 use crate::top_field::TopField;
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
@@ -57,6 +57,12 @@ pub struct Chart<'a> {
     /// `w = d / h_T(q)` (0 on the base, 1 on the top) instead of the distance `d`
     /// ([`crate::transition`]).
     pub(crate) blend: Option<&'a TopField>,
+    /// A translate chart (issue 17, item 5): the normal coordinate grows along this fixed unit
+    /// direction `a` instead of the reference's normal, the point `(q, d)` being `S(q) + d·a`
+    /// with `S(q)` the reference point whose projection along `a` is `q` (always with
+    /// [`ChartKind::Ortho`], `e1 × e2 = a`). Its levels are translates of the reference, which
+    /// cannot fold over a concave valley the way its offsets do (feature-based AM paper, Fig. 9).
+    pub(crate) along: Option<V3>,
 }
 
 impl<'a> Chart<'a> {
@@ -66,6 +72,7 @@ impl<'a> Chart<'a> {
             surf,
             sign: 1.0,
             blend: None,
+            along: None,
             kind: ChartKind::Native {
                 u0: 0.0,
                 v0: 0.0,
@@ -189,6 +196,7 @@ impl<'a> Chart<'a> {
             sign: self.sign,
             kind: self.kind,
             blend: Some(top),
+            along: self.along,
         }
     }
 
@@ -240,7 +248,7 @@ impl<'a> Chart<'a> {
             ChartKind::Native { .. } => self.eval_ext(u, v)?,
             ChartKind::Ortho { .. } => (self.surf.eval(u, v), self.normal_at(u, v)?),
         };
-        let p = f + n * d;
+        let p = f + self.along.unwrap_or(n) * d;
         (p.coords.iter().all(|x| x.is_finite()) && n.iter().all(|x| x.is_finite()))
             .then_some((p, n))
     }
@@ -248,6 +256,13 @@ impl<'a> Chart<'a> {
     /// Chart coordinates and distance `d` of `p` (its nearest point on the reference); on a
     /// blended chart, the morph level instead of the distance.
     pub fn inverse(&self, p: &P3) -> Option<(Point2, f64)> {
+        if let (Some(a), ChartKind::Ortho { c, e1, e2 }) = (self.along, self.kind) {
+            // A translate chart: the reference point under `p` along `a`.
+            let q = [(p - c).dot(&e1), (p - c).dot(&e2)];
+            let (u, v) = self.uv(q)?;
+            let d = (p - self.surf.eval(u, v)).dot(&a);
+            return self.level(q, d);
+        }
         let (mut u, mut v) = self.surf.project(p, None);
         let (mut f, mut n) = (self.surf.eval(u, v), self.normal_at(u, v)?);
         if let ChartKind::Native { u0, v0, .. } = self.kind {
@@ -292,15 +307,35 @@ impl<'a> Chart<'a> {
             }
             ChartKind::Ortho { c, e1, e2 } => [(f - c).dot(&e1), (f - c).dot(&e2)],
         };
-        // On a blended chart, the level: the distance over the top's there.
+        self.level(q, d)
+    }
+
+    /// Chart point `q` at distance `d`, with `d` made the morph level on a blended chart (the
+    /// distance over the top's there).
+    fn level(&self, q: Point2, d: f64) -> Option<(Point2, f64)> {
         let d = match self.blend {
             Some(top) => {
                 let lower = top.lower(q);
-                (d - lower) / (top.height(q) - lower).max(crate::tolerance::MICROMETRE)
+                (d - lower) / (top.height(q) - lower).max(MICROMETRE)
             }
             None => d,
         };
         (q[0].is_finite() && q[1].is_finite() && d.is_finite()).then_some((q, d))
+    }
+
+    /// The unit direction the chart's normal coordinate grows along at `q`: the fixed
+    /// direction of a translate chart, the reference's normal otherwise.
+    pub(crate) fn growth(&self, q: Point2) -> Option<V3> {
+        match self.along {
+            Some(a) => Some(a),
+            None => {
+                let plain = Chart {
+                    blend: None,
+                    ..*self
+                };
+                plain.offset_at(q, 0.0).map(|x| x.1)
+            }
+        }
     }
 
     /// The smallest principal curvature `λ` of the reference at `q`, with `dN = λ·dS` along
@@ -395,6 +430,7 @@ pub(crate) fn choose_chart<'a>(
             surf,
             sign,
             blend: None,
+            along: None,
             kind: ChartKind::Native {
                 u0,
                 v0,
@@ -410,6 +446,7 @@ pub(crate) fn choose_chart<'a>(
         surf,
         sign,
         blend: None,
+        along: None,
         kind: ChartKind::Ortho { c, e1, e2 },
     };
     // The projection chart needs the reference to be a height field over the tangent plane.
@@ -424,6 +461,62 @@ pub(crate) fn choose_chart<'a>(
         }
     }
     Ok(chart)
+}
+
+/// Most a translate chart's direction may lean from the reference's normal under the feature,
+/// degrees: its levels' thickness across them is `cos` of the lean times their spacing, at
+/// least half of it here.
+const TRANSLATE_LEAN_DEG: f64 = 60.0;
+
+/// The translate chart of a feature whose reference's offsets fold under it (a rib standing in
+/// a trough narrower than its height; feature-based AM paper, Fig. 9): levels grow along the
+/// reference's normal `a` at the centre of the feature's root (its mesh vertices on the
+/// reference), chart coordinates by projection along `a` onto the plane through the root's
+/// centre ([`Chart::along`]). `None` where the reference is not a height field along `a` under
+/// the feature: a point with no reference point under it, or one whose normal there leans more
+/// than [`TRANSLATE_LEAN_DEG`] from `a`, or a point of the feature under the reference.
+pub(crate) fn translate_chart<'a>(
+    surf: &'a Surface,
+    sign: f64,
+    mesh: &Mesh,
+    tol: f64,
+) -> Option<Chart<'a>> {
+    let roots: Vec<(f64, f64, P3)> = mesh
+        .positions
+        .iter()
+        .filter_map(|p| {
+            let (u, v) = surf.project(p, None);
+            let f = surf.eval(u, v);
+            ((p - f).norm() < 1e-3f64.max(2.0 * tol)).then_some((u, v, f))
+        })
+        .collect();
+    if roots.is_empty() {
+        return None;
+    }
+    let centre = roots.iter().fold(V3::zeros(), |a, r| a + r.2.coords) / roots.len() as f64;
+    let (u0, v0) = surf.project(&P3::from(centre), None);
+    let a = surf.normal(u0, v0)? * sign;
+    let c = surf.eval(u0, v0);
+    let e1 = any_perpendicular(&a).normalize();
+    let e2 = a.cross(&e1);
+    let chart = Chart {
+        surf,
+        sign,
+        blend: None,
+        along: Some(a),
+        kind: ChartKind::Ortho { c, e1, e2 },
+    };
+    let lean = TRANSLATE_LEAN_DEG.to_radians().cos();
+    let stride = (mesh.positions.len() / 2000).max(1);
+    for p in mesh.positions.iter().step_by(stride) {
+        let q = [(p - c).dot(&e1), (p - c).dot(&e2)];
+        let (u, v) = chart.uv(q)?;
+        let n = chart.normal_at(u, v)?;
+        if n.dot(&a) < lean || (p - surf.eval(u, v)).dot(&a) < -2.0 * tol.max(MICROMETRE) {
+            return None;
+        }
+    }
+    Some(chart)
 }
 
 /// The mesh with every edge longer than `max_edge` split (conforming: a triangle is cut by

@@ -51,7 +51,8 @@ impl FeatureFigures {
 /// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FreeformFigures {
-    /// `native` (the surface's parameters) or `projection` (tangent-plane chart).
+    /// `native` (the surface's parameters), `projection` (tangent-plane chart) or `translate`
+    /// (levels translated along one direction, where the reference's offsets fold).
     pub chart: &'static str,
     /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
     /// when it curves away from the feature everywhere).

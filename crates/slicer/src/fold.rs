@@ -53,6 +53,7 @@ pub(crate) fn fold_check(
         surf,
         sign,
         blend: None,
+        along: None,
         kind: ChartKind::Native { u0, v0, su, sv },
     };
     let f0 = surf.eval(u0, v0);

@@ -29,7 +29,7 @@
 //!   axis is N (or `fixed_tool_axis`); extrusion follows Isa & Lazoglu 2019, Eq. 1 with the
 //!   layer's thickness and each point's bead width.
 
-use crate::chart::{choose_chart, mapped_mesh, refined, MAX_MAPPED_EDGE};
+use crate::chart::{choose_chart, mapped_mesh, refined, translate_chart, MAX_MAPPED_EDGE};
 use crate::error::PlanError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
@@ -200,24 +200,39 @@ pub fn fill_freeform<'a>(
     // Offset deterioration first: a concave reference under the feature folds its offsets
     // before they reach the feature's top, and the feature may not even have a chart then
     // (a rib standing across a trough maps onto both of its flanks).
-    fold_check(surf, sign, &mesh, tol, params, id)?;
-    let mut chart = choose_chart(surf, sign, id, &mesh)?;
+    // Unless offset layers are asked for, a feature whose offsets fold is carried over the
+    // valley by levels that are translates of its reference along one direction, which cannot
+    // fold (issue 17, item 5: crate::chart::translate_chart); transition layers then morph
+    // them into its top.
+    let translate = match fold_check(surf, sign, &mesh, tol, params, id) {
+        Ok(()) => None,
+        Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
+        Err(e) => Some(translate_chart(surf, sign, &mesh, tol).ok_or(e)?),
+    };
+    let mut chart = match translate {
+        Some(c) => c,
+        None => choose_chart(surf, sign, id, &mesh)?,
+    };
     let mut mapped = mapped_mesh(&chart, &mesh, id)?;
     // The feature lies on the side N points to: check, and turn N round if the face said
-    // otherwise.
+    // otherwise (a translate chart has checked it).
     let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
-    if mean_d < 0.0 {
+    if mean_d < 0.0 && translate.is_none() {
         sign = -sign;
         chart = choose_chart(surf, sign, id, &mesh)?;
         mapped = mapped_mesh(&chart, &mesh, id)?;
     }
     let top = mapped.positions.iter().map(|p| p.z).fold(0.0f64, f64::max);
     let mut heights = params.layer_heights(top);
-    // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature.
+    // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature
+    // (none for translates).
     let stride = (mapped.positions.len() / 300).max(1);
     let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
     let mut lambda = 0.0f64;
     for p in mapped.positions.iter().step_by(stride) {
+        if translate.is_some() {
+            break;
+        }
         if let Some(l) = chart.min_curvature([p.x, p.y], step) {
             lambda = lambda.min(l);
         }
@@ -234,6 +249,7 @@ pub fn fill_freeform<'a>(
     };
     let mut ff = FreeformFigures {
         chart: match chart.kind {
+            _ if chart.along.is_some() => "translate",
             ChartKind::Native { .. } => "native",
             ChartKind::Ortho { .. } => "projection",
         },
@@ -559,14 +575,15 @@ impl FreeformFill<'_> {
                     // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
                     let mut t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
                     let mut run = l;
-                    if levels.is_some() {
-                        // A transition layer leans on the reference: the bead is as thick as
-                        // the layers lie apart across it, t_N·(n_L·N), and as long as the
-                        // segment runs along it (not up its steps over the offset layers'
-                        // staircase, which the layer under it climbs too).
+                    if levels.is_some() || base_chart.along.is_some() {
+                        // A transition layer (or a translate of the reference) leans on the
+                        // direction its levels grow along (N, or a translate chart's `a`): the
+                        // bead is as thick as the layers lie apart across it, t_N·(n_L·N), and
+                        // as long as the segment runs along it (not up its steps over the
+                        // offset layers' staircase, which the layer under it climbs too).
                         let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
-                        if let Some((_, nr)) = base_chart.at(w[1].q, 0.0) {
-                            t *= nl.dot(&nr).abs();
+                        if let Some(g) = base_chart.growth(w[1].q) {
+                            t *= nl.dot(&g).abs();
                         }
                         let d = w[1].p - w[0].p;
                         run = (d - nl * d.dot(&nl)).norm();

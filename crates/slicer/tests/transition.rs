@@ -67,6 +67,13 @@ impl Grid {
 /// Plans freeform feature `id` of `name` with the default process (layer_strategy = auto),
 /// asserts it got transition layers, and checks the issue's properties on every print point.
 fn check_transition(name: &str, t: &FeatureTree, id: usize) {
+    check_transition_along(name, t, id, None);
+}
+
+/// [`check_transition`], the layers compared by their feet on the reference, or, with
+/// `along`, by their projection along that direction (a feature whose reference's offsets
+/// fold, whose layers are translates of it) and their height along it.
+fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<V3>) {
     let f = &t.features[id];
     assert_eq!(f.kind, FeatureKind::Freeform, "{name} feature {id}");
     let params = LayerParams::default();
@@ -172,6 +179,10 @@ fn check_transition(name: &str, t: &FeatureTree, id: usize) {
     // A point whose nearest point on the reference is on its face's boundary (off its normal:
     // a blade overhanging the hub's eye) has no foot to compare by, and is left out.
     let foot = |x: &P3| {
+        if let Some(a) = along {
+            let h = x.coords.dot(&a);
+            return Some((x - a * h, h));
+        }
         let (u, v) = surf.project(x, None);
         let f = surf.eval(u, v);
         let r = x - f;
@@ -312,6 +323,30 @@ fn impeller_blade_gets_offset_layers_then_a_transition_band_to_its_tip() {
     // [0.1, 0.3] mm, so offset layers first, then a transition band (crate::transition).
     let t = tree("impeller");
     check_transition("impeller", &t, first_freeform(&t));
+}
+
+/// Offset deterioration (feature-based AM paper, Fig. 9; issue 17, item 5): the rib stands
+/// 9 mm tall in a trough of radius 4 mm, so its reference's offsets fold 4 mm up. Its layers
+/// are translates of the trough along the trough bottom's normal, +Z
+/// (fixtures/make_fixtures.py, `make_trough_rib`), morphed into its flat top.
+#[test]
+fn trough_rib_is_carried_over_its_valley_by_transition_layers() {
+    let t = tree("trough_rib");
+    let id = first_freeform(&t);
+    check_transition_along("trough_rib", &t, id, Some(V3::z()));
+    let plan = plan_freeform(&t, &t.features[id], &LayerParams::default(), BEAD, None)
+        .expect("the rib plans");
+    assert_eq!(plan.freeform.expect("freeform").chart, "translate");
+    // Every print point within the rib: |y| ≤ 1, z ≤ 19, above the trough's surface.
+    for p in plan.points.iter().filter(|p| p.kind == MoveKind::Print) {
+        let [x, y, z] = p.p;
+        let floor = 14.0 - (16.0 - y * y).max(0.0).sqrt();
+        assert!(
+            x.abs() <= 10.0 + 1e-6 && y.abs() <= 1.0 + 1e-6 && z <= 19.0 + 1e-6 && z > floor,
+            "print point {:?} outside the rib",
+            p.p
+        );
+    }
 }
 
 #[test]

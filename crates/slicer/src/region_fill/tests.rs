@@ -211,6 +211,7 @@ fn stretched_chart(surf: &Surface) -> Chart<'_> {
         surf,
         sign: 1.0,
         blend: None,
+        along: None,
         kind: ChartKind::Native {
             u0: 0.0,
             v0: 0.0,
