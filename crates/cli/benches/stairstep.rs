@@ -67,6 +67,8 @@ const FAR: f64 = 20.0;
 const EDGE: f64 = 1.0;
 /// Top-face samples count (issue 17) farther than this from every edge of their face, mm.
 const TOP_EDGE: f64 = 0.3;
+/// The top faces' largest envelope gap issue 17 asks for, mm.
+const TOP_GOAL_MAX: f64 = 0.03;
 /// Distances to a face's edges are measured up to this, mm.
 const EDGE_CAP: f64 = 2.0;
 
@@ -383,6 +385,11 @@ impl Err {
                 .map(|(e, _)| *e)
                 .collect(),
         }
+    }
+
+    /// The share of the samples over `x`, %.
+    fn share_over(&self, x: f64) -> f64 {
+        100.0 * self.each.iter().filter(|e| **e > x).count() as f64 / self.each.len().max(1) as f64
     }
 
     /// Max, p95 and mean, or `None` without samples.
@@ -878,37 +885,53 @@ fn print_table(rows: &[Row]) {
 fn print_top_table(rows: &[Row]) {
     println!();
     println!(
-        "{:<20} {:<16} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>7}",
-        "top faces, interior", "", "ours", "", "", "prusa", "", "", "samples"
+        "{:<20} {:<16} | {:>6} {:>6} {:>6} {:>7} | {:>6} {:>6} {:>6} {:>7} | {:>7}",
+        "top faces, interior", "", "ours", "", "", "", "prusa", "", "", "", "samples"
     );
     println!(
-        "{:<20} {:<16} | {:>6} {:>6} {:>6} | {:>6} {:>6} {:>6} | {:>7}",
-        "part/plan", "feature layers", "max", "p95", "mean", "max", "p95", "mean", ""
+        "{:<20} {:<16} | {:>6} {:>6} {:>6} {:>7} | {:>6} {:>6} {:>6} {:>7} | {:>7}",
+        "part/plan",
+        "feature layers",
+        "max",
+        "p95",
+        "mean",
+        ">0.03",
+        "max",
+        "p95",
+        "mean",
+        ">0.03",
+        ""
     );
-    println!("{}", "-".repeat(92));
+    println!("{}", "-".repeat(108));
     for r in rows {
         let Some(o) = r.ours_top.as_ref().filter(|o| !o.each.is_empty()) else {
             continue;
         };
         let p = r.prusa_top.as_ref().filter(|p| !p.each.is_empty());
         println!(
-            "{:<20} {:<16} | {:>6.3} {:>6.3} {:>6.3} | {:>6} {:>6} {:>6} | {:>7}",
+            "{:<20} {:<16} | {:>6.3} {:>6.3} {:>6.3} {:>6.2}% | {:>6} {:>6} {:>6} {:>7} | {:>7}",
             r.part,
             r.feature,
             o.max(),
             o.quantile(0.95),
             o.mean(),
+            o.share_over(TOP_GOAL_MAX),
             fmt_opt(p.map(Err::max), 3),
             fmt_opt(p.map(|p| p.quantile(0.95)), 3),
             fmt_opt(p.map(Err::mean), 3),
+            p.map_or("-".into(), |p| format!(
+                "{:.2}%",
+                p.share_over(TOP_GOAL_MAX)
+            )),
             o.each.len()
         );
     }
     println!(
         "envelope gap in mm (0 inside a bead); plan `offset`: every freeform feature on offset \
          layers; `transition`: every one on transition layers; `auto` where the planner refused \
-         those: its own choice per feature (the feature column says which); goal (issue 17): \
-         max <= 0.03, p95 <= 0.025 with transition layers"
+         those: its own choice per feature (the feature column says which); >0.03: the share \
+         of samples over the goal's maximum; goal (issue 17): max <= 0.03, p95 <= 0.025 with \
+         transition layers"
     );
 }
 
@@ -1007,7 +1030,12 @@ fn bench_part(step: &Path, tmp: &Path, rows: &mut Vec<Row>) -> Result<(), String
     );
     for strategy in [LayerStrategy::Offset, LayerStrategy::Transition] {
         let (label, ours) = match (strategy, run_ours(step, strategy)) {
-            (LayerStrategy::Offset, r) => ("offset", r?),
+            (LayerStrategy::Offset, Ok(o)) => ("offset", o),
+            (LayerStrategy::Offset, Err(e)) => {
+                // A rib in a trough narrower than its height: its offsets fold.
+                println!("{name}: offset layers refused ({e})");
+                continue;
+            }
             (_, Ok(o)) => ("transition", o),
             (_, Err(e)) => {
                 println!(
