@@ -1,10 +1,13 @@
 //! The collision stage, between smoothing and the post (issue 18): the head of the machine
 //! profile checked along every move against what was deposited before it and the table
-//! (`collide`), colliding travels lifted over the material, and sibling features (the same
-//! parents) printed layer by layer in turn where that leaves fewer collisions.
+//! (`collide`), colliding travels lifted over the material, sibling features (the same
+//! parents) printed layer by layer in turn where that leaves fewer collisions, and colliding
+//! print moves cleared by tilting the tool axis inside the orientation's tolerance cone.
 
 use crate::report::{round, CollisionEntry, FeatureReport, HitEntry};
-use collide::{check_and_route, interleave, Collision, Obstacle, Table, Travels};
+use collide::{interleave, tilt_and_route, Collision, Obstacle, Table, TiltLimits, Travels};
+use slicer::orient::SmoothParams;
+use slicer::vec3::V3;
 use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
 use robot_post::MachineKind;
@@ -42,15 +45,43 @@ pub fn sibling_groups(features: &[FeatureReport]) -> Vec<Vec<usize>> {
     groups
 }
 
-/// Checks `path` with the machine's head and table, lifting colliding travels (left to the
-/// post on a KUKA cell, whose post makes its own); where print
-/// moves hit siblings, tries the siblings interleaved and keeps that order when it leaves fewer
-/// colliding moves. Returns the collisions left, in path order.
+/// What [`avoid`] leaves.
+#[derive(Debug, Clone, Default)]
+pub struct Avoided {
+    /// The colliding moves left, in path order.
+    pub left: Vec<Collision>,
+    /// Per feature id, its print moves cleared by tilting the tool axis.
+    pub cleared: BTreeMap<usize, usize>,
+}
+
+/// How far [`avoid`] may tilt tool axes: inside the smoothing's tolerance cone, blended over its
+/// window, within a B/C bed's B limit; `None` when smoothing is off (the planned axes are
+/// kept) or its options are wrong.
+pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Option<TiltLimits> {
+    (orientation.enabled && orientation.validate().is_ok()).then(|| TiltLimits {
+        cone_half_deg: 0.5 * orientation.cone_angle_deg,
+        max_from_z_deg: machine
+            .delta5_table()
+            .ok()
+            .map(|g| g.b_limits_deg[0].abs().max(g.b_limits_deg[1].abs())),
+        window_mm: orientation.window_mm,
+    })
+}
+
+/// Checks `path` with the machine's head and table in one walk along it: colliding print
+/// moves tilted inside the cone about their `planned` axes (one per point of `path`, before
+/// smoothing) by `limits` ([`collide::tilt`]; `None`: no tilt), then colliding travels lifted
+/// (left to the post on a KUKA cell, whose post makes its own). Where print moves still hit
+/// siblings, the siblings interleaved (their planned axes along) are walked alike, and that
+/// order kept when it leaves fewer colliding moves. Returns the collisions left, in path order,
+/// and the moves tilt cleared.
 pub fn avoid(
     path: &mut ToolPath,
+    planned: &[V3],
     machine: &MachineProfile,
     features: &[FeatureReport],
-) -> Vec<Collision> {
+    limits: Option<TiltLimits>,
+) -> Avoided {
     let head = machine.head;
     let table = table(path, machine);
     // The KUKA post makes its own travels (retreat, rise, cross, approach).
@@ -58,36 +89,55 @@ pub fn avoid(
         MachineKind::Kuka => Travels::Skip,
         _ => Travels::Route,
     };
+    let walk = |path: &mut ToolPath, planned: &[V3]| {
+        let r = tilt_and_route(path, planned, &head, Some(table), travels, limits.as_ref());
+        Avoided {
+            left: r.left,
+            cleared: r.cleared,
+        }
+    };
     let groups = sibling_groups(features);
-    let left = check_and_route(path, &head, Some(table), travels);
+    let unrouted = path.clone();
+    let first = walk(path, planned);
     // Groups one of whose members hits another.
     let crowded: Vec<&Vec<usize>> = groups
         .iter()
         .filter(|g| {
-            left.iter().any(|c| {
+            first.left.iter().any(|c| {
                 g.contains(&c.feature)
                     && matches!(c.hits, Obstacle::Feature(f) if f != c.feature && g.contains(&f))
             })
         })
         .collect();
     if crowded.is_empty() {
-        return left;
+        return first;
     }
-    // The travels lifted for the first order go along with their layers: still travels, checked
-    // again in the new order.
-    let mut mixed = path.clone();
+    // The planned axes go along with their points: a path of them interleaved alike.
+    let mut mixed = unrouted.clone();
+    let mut mixed_planned = with_axes(&unrouted, planned);
     for g in crowded {
-        if let Some(m) = interleave(&mixed, g) {
+        if let (Some(m), Some(p)) = (interleave(&mixed, g), interleave(&mixed_planned, g)) {
             mixed = m;
+            mixed_planned = p;
         }
     }
-    let mixed_left = check_and_route(&mut mixed, &head, Some(table), travels);
-    if mixed_left.len() < left.len() {
+    let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
+    let second = walk(&mut mixed, &planned);
+    if second.left.len() < first.left.len() {
         *path = mixed;
-        mixed_left
+        second
     } else {
-        left
+        first
     }
+}
+
+/// `path` with the tool axes `axes` (one per point).
+fn with_axes(path: &ToolPath, axes: &[V3]) -> ToolPath {
+    let mut out = path.clone();
+    for (q, &a) in out.points.iter_mut().zip(axes) {
+        q.axis = a;
+    }
+    out
 }
 
 /// Per feature id, its points in the tool path (travels lifted over material add some).
@@ -99,10 +149,14 @@ pub fn points(path: &ToolPath) -> BTreeMap<usize, usize> {
     out
 }
 
-/// Per feature id, its colliding moves and the first one, as `plan.json` reports them.
-pub fn entries(collisions: &[Collision]) -> BTreeMap<usize, CollisionEntry> {
+/// Per feature id, its colliding moves, the first one and the moves tilt cleared, as
+/// `plan.json` reports them.
+pub fn entries(avoided: &Avoided) -> BTreeMap<usize, CollisionEntry> {
     let mut out: BTreeMap<usize, CollisionEntry> = BTreeMap::new();
-    for c in collisions {
+    for (&id, &n) in &avoided.cleared {
+        out.entry(id).or_default().collisions_cleared_by_tilt = n;
+    }
+    for c in &avoided.left {
         let e = out.entry(c.feature).or_default();
         e.collisions += 1;
         e.first_collision

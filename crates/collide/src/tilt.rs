@@ -1,0 +1,402 @@
+//! Avoidance by tilt (issue 18, item 3, its first step): the tool axis of a colliding print move
+//! turned, inside the orientation's tolerance cone about the point's planned axis (the cone
+//! smoothing keeps, `slicer::orient`), to an axis whose head clears what lies before the move
+//! and the table, and the turn blended into the path's neighbouring points so the axes stay
+//! continuous.
+//!
+//! Each continuous path (a bead's start point and the print points after it, one feature and
+//! layer) is tilted on its own, against the material deposited before its group (feature,
+//! layer), which a tilt does not change:
+//!
+//! 1. **keys**: for each colliding print move, the smallest turn ω (a rotation vector: axis ×
+//!    angle) of the point's axis that clears the move: first the turn of the nearest key, then
+//!    rings of [`RING_STEP_DEG`] about the axis, [`AZIMUTHS`] directions each, starting towards
+//!    +Z (away from the table). A turn is allowed when it keeps the axis within the cone (and a
+//!    B/C bed's B limit) and differs from the keys beside it by at most the blend's slope;
+//! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
+//!    two windows, falling to nothing over one window (the smoothing's `window_mm`) beyond the
+//!    outer keys ([`blend`]); each point's axis turned by it, scaled back where it would leave
+//!    the cone or the B limit;
+//! 3. **check again**, with new keys where moves still collide, a few passes; the path keeps
+//!    its tilt only when every move that collides after it collided before it and fewer do.
+
+use crate::check::{move_hit, walk, Collision, Obstacle, Routed, Scene};
+use crate::head::Head;
+use crate::table::Table;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use toolpath::vec3::{add, cross, dot, norm, scale, sub, unit, V3};
+use toolpath::{PathPoint, ToolPath};
+
+/// Angle between rings of axes tried about a colliding point's axis, degrees.
+pub const RING_STEP_DEG: f64 = 5.0;
+
+/// Directions tried on each ring.
+pub const AZIMUTHS: usize = 8;
+
+/// Passes of key search, blend and check per continuous path.
+const PASSES: usize = 3;
+
+/// Angle (radians) an axis may exceed a limit by, for rounding.
+const SLACK: f64 = 1e-9;
+
+/// What a tilt may do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TiltLimits {
+    /// Half the opening of the tolerance cone about each point's planned axis, degrees: γ/2 of
+    /// the orientation smoothing (`cone_angle_deg / 2`).
+    pub cone_half_deg: f64,
+    /// Largest angle of an axis from +Z, degrees (a B/C bed's B limit); `None`: no limit. An
+    /// axis already beyond it is not tilted.
+    pub max_from_z_deg: Option<f64>,
+    /// Length of path, mm, over which a tilt is blended into its neighbours: the smoothing's
+    /// window, so the turn per mm stays within `2 · cone_half_deg / window_mm`.
+    pub window_mm: f64,
+}
+
+impl TiltLimits {
+    /// The largest change of the turn field per mm of path, radians: two cone half-angles (the
+    /// most a turn inside the cone can be) over one window.
+    pub fn slope(&self) -> f64 {
+        2.0 * self.cone_half_deg.to_radians() / self.window_mm.max(1e-9)
+    }
+}
+
+/// A path after [`tilt`].
+#[derive(Debug, Clone)]
+pub struct Tilted {
+    /// The path, its tool axes tilted where that clears moves (positions and all else as
+    /// given).
+    pub path: ToolPath,
+    /// Per feature id, its print moves that collided as given and are clear tilted.
+    pub cleared: BTreeMap<usize, usize>,
+    /// The colliding moves left, in path order, as [`crate::check`] finds them on `path`.
+    pub left: Vec<Collision>,
+}
+
+/// Tilts the tool axes of `path` inside the cone about `planned` (each point's planned axis,
+/// before smoothing: one per point) to clear its colliding print moves, with `head` over
+/// `table`; see the module's comment. Points whose planned or given axis has no direction are
+/// not tilted. A pure stage: `path` is not changed, and its travels are checked, not routed
+/// ([`crate::tilt_and_route`] does both in one walk).
+pub fn tilt(
+    path: &ToolPath,
+    planned: &[V3],
+    head: &Head,
+    table: Option<Table>,
+    limits: &TiltLimits,
+) -> Tilted {
+    let mut out = path.clone();
+    let Routed { left, cleared } = walk(&mut out, head, table, None, Some((planned, limits)));
+    Tilted {
+        path: out,
+        cleared,
+        left,
+    }
+}
+
+/// `v` turned by the rotation vector `w` (Rodrigues).
+fn rotate(v: V3, w: V3) -> V3 {
+    let t = norm(w);
+    if t < 1e-15 {
+        return v;
+    }
+    let k = scale(w, 1.0 / t);
+    let (s, c) = t.sin_cos();
+    add(
+        add(scale(v, c), scale(cross(k, v), s)),
+        scale(k, dot(k, v) * (1.0 - c)),
+    )
+}
+
+/// Angle between unit vectors, radians.
+fn angle(a: V3, b: V3) -> f64 {
+    norm(cross(a, b)).atan2(dot(a, b))
+}
+
+/// The allowed axes at one point: within the cone about its planned axis, and within the B
+/// limit (or no farther from +Z than the given axis already is).
+struct Allowed {
+    planned: V3,
+    half: f64,
+    from_z: f64,
+}
+
+impl Allowed {
+    fn new(planned: V3, given: V3, limits: &TiltLimits) -> Allowed {
+        let from_z = limits.max_from_z_deg.map_or(f64::INFINITY, |b| {
+            b.to_radians().max(angle(given, [0.0, 0.0, 1.0]))
+        });
+        Allowed {
+            planned,
+            half: limits.cone_half_deg.to_radians(),
+            from_z,
+        }
+    }
+
+    fn holds(&self, a: V3) -> bool {
+        angle(a, self.planned) <= self.half + SLACK
+            && (self.from_z.is_infinite() || angle(a, [0.0, 0.0, 1.0]) <= self.from_z + SLACK)
+    }
+
+    /// The allowed axis nearest +Z: the most a tilt can lift the head off the table.
+    fn highest(&self) -> V3 {
+        let z = [0.0, 0.0, 1.0];
+        let off = angle(self.planned, z);
+        if off <= self.half {
+            return z;
+        }
+        let towards = cross(self.planned, z);
+        match unit(towards) {
+            Some(k) => rotate(self.planned, scale(k, self.half)),
+            None => self.planned,
+        }
+    }
+}
+
+/// One continuous path's tilted axes and its moves' collisions after them, or `None` when no
+/// tilt leaves fewer colliding moves without a new one. The run `r` holds `lead` travel
+/// points before the point its bead starts from (`r.start + lead`); `before[k]` is the
+/// collision of the move ending at `r.start + k` as given; `planned` is the run's planned
+/// axes; the travel moves into the run's lead and bead start are checked when `travels`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn tilt_run(
+    scene: &Scene,
+    pts: &[PathPoint],
+    r: Range<usize>,
+    lead: usize,
+    planned: &[V3],
+    limits: &TiltLimits,
+    before: &[Option<Collision>],
+    travels: bool,
+) -> Option<(Vec<V3>, Vec<Option<Collision>>)> {
+    let run = &pts[r.clone()];
+    let given: Vec<V3> = run.iter().map(|q| unit(q.axis)).collect::<Option<_>>()?;
+    let planned: Vec<V3> = planned.iter().map(|&a| unit(a)).collect::<Option<_>>()?;
+    let allowed: Vec<Allowed> = planned
+        .iter()
+        .zip(&given)
+        .map(|(&p, &g)| Allowed::new(p, g, limits))
+        .collect();
+    // Arc length along the bead, its start and the travel points before it at 0.
+    let mut s = vec![0.0; run.len()];
+    for k in lead + 1..run.len() {
+        s[k] = s[k - 1] + norm(sub(run[k].p, run[k - 1].p));
+    }
+    let mut keys: BTreeMap<usize, V3> = BTreeMap::new();
+    let mut tried = vec![false; run.len()];
+    let mut axes = given.clone();
+    let mut now: Vec<Option<Collision>> = before.to_vec();
+    for _ in 0..PASSES {
+        let mut added = false;
+        for k in 0..run.len() {
+            let Some(c) = now[k] else { continue };
+            // Print moves; and travels into the lead or the bead start where the head
+            // collides at the point itself (no lift clears that).
+            let point = k <= lead && scene.at(run[k].p, axes[k]).is_some();
+            if k <= lead && !point {
+                continue;
+            }
+            // A key on the bead that still collides (its move starts from a blended axis):
+            // the point before it takes the same turn.
+            let (k, w) = match keys.get(&k) {
+                Some(&w)
+                    if k > lead
+                        && !keys.contains_key(&(k - 1))
+                        && allowed[k - 1].holds(rotate(given[k - 1], w)) =>
+                {
+                    (k - 1, Some(w))
+                }
+                Some(_) => continue,
+                None if tried[k] => continue,
+                None => (k, None),
+            };
+            tried[k] = true;
+            let w = w.or_else(|| {
+                let at = Candidate {
+                    k,
+                    lead,
+                    hits: c.hits,
+                };
+                search(scene, run, &given, &allowed, &keys, &s, at, limits)
+            });
+            if let Some(w) = w {
+                keys.insert(k, w);
+                added = true;
+            }
+        }
+        if !added {
+            break;
+        }
+        let field = blend(&keys, &s, limits.window_mm);
+        for k in 0..run.len() {
+            axes[k] = apply(given[k], field[k], &allowed[k]);
+        }
+        let mut moved: Vec<PathPoint> = run.to_vec();
+        for (q, &a) in moved.iter_mut().zip(&axes) {
+            q.axis = a;
+        }
+        now = (0..run.len())
+            .map(|k| {
+                let from = match k {
+                    _ if k <= lead && !travels => return None,
+                    0 => r.start.checked_sub(1).map(|j| &pts[j]),
+                    _ => Some(&moved[k - 1]),
+                };
+                move_hit(scene, from, &moved[k], r.start + k)
+            })
+            .collect();
+    }
+    let new = now
+        .iter()
+        .zip(before)
+        .any(|(a, b)| a.is_some() && b.is_none());
+    let fewer = now.iter().flatten().count() < before.iter().flatten().count();
+    (fewer && !new).then_some((axes, now))
+}
+
+/// The point of a run a turn is searched for: its index `k`, the run's lead (travel points
+/// before the bead start) and what the head hits there.
+struct Candidate {
+    k: usize,
+    lead: usize,
+    hits: Obstacle,
+}
+
+/// The smallest turn of the axis at `run[at.k]` that clears the print move ending there (its
+/// start point turned alike, and clear itself when it starts the bead), or on the lead and the
+/// bead start the head at the point; allowed there and within the blend's slope of the keys
+/// beside it. `None` when no turn tried clears it, or the axis given is not allowed. Against
+/// the table, the allowed axis nearest +Z is tried first: the head's lowest point rises with
+/// the axis's height, so if that one meets the table plane, every allowed axis does.
+#[allow(clippy::too_many_arguments)]
+fn search(
+    scene: &Scene,
+    run: &[PathPoint],
+    given: &[V3],
+    allowed: &[Allowed],
+    keys: &BTreeMap<usize, V3>,
+    s: &[f64],
+    at: Candidate,
+    limits: &TiltLimits,
+) -> Option<V3> {
+    let Candidate { k, lead, hits } = at;
+    let a = given[k];
+    if !allowed[k].holds(a)
+        || (hits == Obstacle::Table && scene.hits_table(run[k].p, allowed[k].highest()))
+    {
+        return None;
+    }
+    let (slope, window) = (limits.slope(), limits.window_mm);
+    let prev = keys.range(..k).next_back();
+    let next = keys.range(k + 1..).next();
+    let near = |w: V3| {
+        [prev, next].into_iter().flatten().all(|(&j, &wj)| {
+            let gap = (s[j] - s[k]).abs();
+            gap > 2.0 * window || norm(sub(w, wj)) <= slope * gap + SLACK
+        })
+    };
+    let clears = |w: V3| {
+        let b = rotate(a, w);
+        if !allowed[k].holds(b) || !near(w) {
+            return false;
+        }
+        if k <= lead {
+            return scene.at(run[k].p, b).is_none();
+        }
+        // The bead's start ends a travel; the sweep leaves it out.
+        let from = (run[k - 1].p, rotate(given[k - 1], w));
+        (k > lead + 1 || scene.at(from.0, from.1).is_none())
+            && scene.sweep(from.0, from.1, run[k].p, b).is_none()
+    };
+    // The nearest key's turn first: neighbours tilted alike keep the axes continuous.
+    let nearest = [prev, next]
+        .into_iter()
+        .flatten()
+        .min_by(|x, y| (s[*x.0] - s[k]).abs().total_cmp(&(s[*y.0] - s[k]).abs()));
+    if let Some((_, &w)) = nearest {
+        if clears(w) {
+            return Some(w);
+        }
+    }
+    // Directions across the axis, the first towards +Z.
+    let up = sub([0.0, 0.0, 1.0], scale(a, a[2]));
+    let e1 = unit(up)
+        .or_else(|| unit(cross(a, [1.0, 0.0, 0.0])))
+        .or_else(|| unit(cross(a, [0.0, 1.0, 0.0])))?;
+    let e2 = cross(a, e1);
+    let most = 2.0 * allowed[k].half;
+    let rings = (most.to_degrees() / RING_STEP_DEG).ceil() as usize;
+    for ring in 1..=rings {
+        let t = (ring as f64 * RING_STEP_DEG).to_radians().min(most);
+        for j in 0..AZIMUTHS {
+            let phi = std::f64::consts::TAU * j as f64 / AZIMUTHS as f64;
+            let d = add(scale(e1, phi.cos()), scale(e2, phi.sin()));
+            let w = scale(cross(a, d), t);
+            if clears(w) {
+                return Some(w);
+            }
+        }
+    }
+    None
+}
+
+/// The turn field along a run with arc lengths `s`, from its keys (index → turn): between two
+/// keys at most two windows apart, linear in arc length from one to the other; from the run's
+/// start to a first key at most two windows along, that key's turn; elsewhere each key's turn
+/// falling linearly to nothing over one window. Continuous, and its change per mm
+/// is at most the keys' largest turn over `window`, or the change between two keys over their
+/// distance.
+pub fn blend(keys: &BTreeMap<usize, V3>, s: &[f64], window: f64) -> Vec<V3> {
+    let w = window.max(1e-9);
+    (0..s.len())
+        .map(|j| {
+            let prev = keys.range(..=j).next_back();
+            let next = keys.range(j..).next();
+            match (prev, next) {
+                // From the run's first point (where its bead starts, after a travel) to a key
+                // within two windows, that key's turn is held.
+                (None, Some((&i1, &w1))) if s[i1] - s[0] <= 2.0 * w => w1,
+                (Some((&i0, &w0)), Some((&i1, &w1))) if s[i1] - s[i0] <= 2.0 * w => {
+                    let gap = s[i1] - s[i0];
+                    if gap <= 0.0 {
+                        return w0;
+                    }
+                    let t = (s[j] - s[i0]) / gap;
+                    add(scale(w0, 1.0 - t), scale(w1, t))
+                }
+                _ => {
+                    let ramp = |key: Option<(&usize, &V3)>| {
+                        key.map_or([0.0; 3], |(&i, &wi)| {
+                            scale(wi, (1.0 - (s[j] - s[i]).abs() / w).max(0.0))
+                        })
+                    };
+                    add(ramp(prev), ramp(next))
+                }
+            }
+        })
+        .collect()
+}
+
+/// `a` turned by `w`, or by the largest share of `w` (halved down to a 256th) that stays
+/// allowed; `a` itself when it is not allowed.
+fn apply(a: V3, w: V3, allowed: &Allowed) -> V3 {
+    if norm(w) < 1e-15 || !allowed.holds(a) {
+        return a;
+    }
+    let b = rotate(a, w);
+    if allowed.holds(b) {
+        return b;
+    }
+    // Bisect the share.
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..8 {
+        let mid = 0.5 * (lo + hi);
+        if allowed.holds(rotate(a, scale(w, mid))) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    rotate(a, scale(w, lo))
+}
