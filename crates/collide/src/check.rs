@@ -261,7 +261,10 @@ pub(crate) fn walk(
             if let Some((axes, after)) = (prints && planned.len() == pts.len())
                 .then(|| {
                     let planned = &planned[r.clone()];
-                    tilt_run(&scene, pts, r.clone(), lead, planned, limits, &found, checked)
+                    let t0 = std::time::Instant::now(); // TIMING-TMP
+                    let x = tilt_run(&scene, pts, r.clone(), lead, planned, limits, &found, checked);
+                    crate::tilt::DBG_RUN_NS.fetch_add(t0.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
+                    x
                 })
                 .flatten()
             {
@@ -294,6 +297,7 @@ pub(crate) fn walk(
             }
         }
     }
+    if std::env::var_os("TIMING_TMP").is_some() { eprintln!("TIMING walk: tilt_run {:.3} s, searches {}, clears {}, rechecks {}", crate::tilt::DBG_RUN_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9, crate::tilt::DBG_SEARCH.load(std::sync::atomic::Ordering::Relaxed), crate::tilt::DBG_CLEARS.load(std::sync::atomic::Ordering::Relaxed), crate::tilt::DBG_RECHECK.load(std::sync::atomic::Ordering::Relaxed)); } // TIMING-TMP
     if !detours.is_empty() {
         let old = std::mem::take(&mut path.points);
         let mut points = Vec::with_capacity(old.len() + 2 * detours.len());

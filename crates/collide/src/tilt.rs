@@ -10,8 +10,9 @@
 //!
 //! 1. **keys**: for each colliding print move, the smallest turn ω (a rotation vector: axis ×
 //!    angle) of the point's axis that clears the move: first the turn of the nearest key, then
-//!    rings of [`RING_STEP_DEG`] about the axis, [`AZIMUTHS`] directions each, starting towards
-//!    +Z (away from the table). A turn is allowed when it keeps the axis within the cone (and a
+//!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
+//!    first that clears), [`AZIMUTHS`] directions each, starting towards +Z (away from the
+//!    table). A turn is allowed when it keeps the axis within the cone (and a
 //!    B/C bed's B limit) and differs from the keys beside it by at most the blend's slope;
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
 //!    two windows, falling to nothing over one window (the smoothing's `window_mm`) beyond the
@@ -34,8 +35,18 @@ pub const RING_STEP_DEG: f64 = 5.0;
 /// Directions tried on each ring.
 pub const AZIMUTHS: usize = 8;
 
+pub static DBG_CLEARS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
+pub static DBG_SEARCH: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
+pub static DBG_RUN_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
+pub static DBG_RECHECK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
+/// Length of path, mm, after a point no turn clears before the search is tried again.
+pub const RETRY_MM: f64 = 1.0;
+
+/// Least length of path, mm, between keys found in one pass.
+pub const KEY_SPACING_MM: f64 = 1.0;
+
 /// Passes of key search, blend and check per continuous path.
-const PASSES: usize = 3;
+const PASSES: usize = 4;
 
 /// Angle (radians) an axis may exceed a limit by, for rounding.
 const SLACK: f64 = 1e-9;
@@ -185,10 +196,16 @@ pub(crate) fn tilt_run(
     }
     let mut keys: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
+    // Where the last search along the bead found no turn: the moves just after it mostly meet
+    // the same obstacle, so the search waits [`RETRY_MM`] of path.
+    let mut failed: Option<f64> = None;
     let mut axes = given.clone();
     let mut now: Vec<Option<Collision>> = before.to_vec();
     for _ in 0..PASSES {
         let mut added = false;
+        // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
+        // for the blend, and are searched in the next pass if it leaves them colliding.
+        let mut found: Option<f64> = None;
         for k in 0..run.len() {
             let Some(c) = now[k] else { continue };
             // Print moves; and travels into the lead or the bead start where the head
@@ -209,6 +226,8 @@ pub(crate) fn tilt_run(
                 }
                 Some(_) => continue,
                 None if tried[k] => continue,
+                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => continue,
+                None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
                 None => (k, None),
             };
             tried[k] = true;
@@ -220,15 +239,21 @@ pub(crate) fn tilt_run(
                 };
                 search(scene, run, &given, &allowed, &keys, &s, at, limits)
             });
-            if let Some(w) = w {
-                keys.insert(k, w);
-                added = true;
+            match w {
+                Some(w) => {
+                    keys.insert(k, w);
+                    found = Some(s[k]);
+                    added = true;
+                }
+                None => failed = Some(s[k]),
             }
         }
         if !added {
             break;
         }
+        failed = None;
         let field = blend(&keys, &s, limits.window_mm);
+        let last = axes.clone();
         for k in 0..run.len() {
             axes[k] = apply(given[k], field[k], &allowed[k]);
         }
@@ -236,8 +261,14 @@ pub(crate) fn tilt_run(
         for (q, &a) in moved.iter_mut().zip(&axes) {
             q.axis = a;
         }
+        // Only the moves whose ends turned are checked again.
+        let turned = |k: usize| axes[k] != last[k];
         now = (0..run.len())
             .map(|k| {
+                if !(turned(k) || k > 0 && turned(k - 1)) {
+                    return now[k];
+                }
+                DBG_RECHECK.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
                 let from = match k {
                     _ if k <= lead && !travels => return None,
                     0 => r.start.checked_sub(1).map(|j| &pts[j]),
@@ -281,6 +312,7 @@ fn search(
     limits: &TiltLimits,
 ) -> Option<V3> {
     let Candidate { k, lead, hits } = at;
+    DBG_SEARCH.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
     let a = given[k];
     if !allowed[k].holds(a)
         || (hits == Obstacle::Table && scene.hits_table(run[k].p, allowed[k].highest()))
@@ -297,6 +329,7 @@ fn search(
         })
     };
     let clears = |w: V3| {
+        DBG_CLEARS.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
         let b = rotate(a, w);
         if !allowed[k].holds(b) || !near(w) {
             return false;
@@ -326,19 +359,23 @@ fn search(
         .or_else(|| unit(cross(a, [0.0, 1.0, 0.0])))?;
     let e2 = cross(a, e1);
     let most = 2.0 * allowed[k].half;
-    let rings = (most.to_degrees() / RING_STEP_DEG).ceil() as usize;
-    for ring in 1..=rings {
-        let t = (ring as f64 * RING_STEP_DEG).to_radians().min(most);
-        for j in 0..AZIMUTHS {
+    let ring = |t: f64| {
+        (0..AZIMUTHS).find_map(|j| {
             let phi = std::f64::consts::TAU * j as f64 / AZIMUTHS as f64;
             let d = add(scale(e1, phi.cos()), scale(e2, phi.sin()));
             let w = scale(cross(a, d), t);
-            if clears(w) {
-                return Some(w);
-            }
-        }
-    }
-    None
+            clears(w).then_some(w)
+        })
+    };
+    // Every other ring first (a move no turn clears costs half the rings), then the ring
+    // inside the first that clears.
+    let step = RING_STEP_DEG.to_radians();
+    let rings = (most / step).ceil() as usize;
+    (2..=rings + 1).step_by(2).find_map(|n| {
+        let t = (n as f64 * step).min(most);
+        let w = ring(t)?;
+        Some(ring((n - 1) as f64 * step).unwrap_or(w))
+    })
 }
 
 /// The turn field along a run with arc lengths `s`, from its keys (index → turn): between two
