@@ -270,7 +270,10 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
             // The impeller's blades: tilting the axis inside the cone clears most of the
             // moves whose body meets the hub.
             if name == "impeller" && id > 0 {
-                assert!(cleared > n, "{name}: feature {id}: {cleared} cleared, {n} left");
+                assert!(
+                    cleared > n,
+                    "{name}: feature {id}: {cleared} cleared, {n} left"
+                );
             }
             if f["parents"].as_array().expect("parents").is_empty() {
                 assert_eq!(n, 0, "{name}: base feature {id} collides");

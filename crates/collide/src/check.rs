@@ -225,7 +225,13 @@ pub fn tilt_and_route(
     travels: Travels,
     limits: Option<&TiltLimits>,
 ) -> Routed {
-    walk(path, head, table, Some(travels), limits.map(|l| (planned, l)))
+    walk(
+        path,
+        head,
+        table,
+        Some(travels),
+        limits.map(|l| (planned, l)),
+    )
 }
 
 /// The walk along `path` behind [`check_and_route`], [`tilt_and_route`] and [`crate::tilt`]:
@@ -261,10 +267,16 @@ pub(crate) fn walk(
             if let Some((axes, after)) = (prints && planned.len() == pts.len())
                 .then(|| {
                     let planned = &planned[r.clone()];
-                    let t0 = std::time::Instant::now(); // TIMING-TMP
-                    let x = tilt_run(&scene, pts, r.clone(), lead, planned, limits, &found, checked);
-                    crate::tilt::DBG_RUN_NS.fetch_add(t0.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
-                    x
+                    tilt_run(
+                        &scene,
+                        pts,
+                        r.clone(),
+                        lead,
+                        planned,
+                        limits,
+                        &found,
+                        checked,
+                    )
                 })
                 .flatten()
             {
@@ -297,7 +309,6 @@ pub(crate) fn walk(
             }
         }
     }
-    if std::env::var_os("TIMING_TMP").is_some() { eprintln!("TIMING walk: tilt_run {:.3} s, searches {}, clears {}, rechecks {}", crate::tilt::DBG_RUN_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9, crate::tilt::DBG_SEARCH.load(std::sync::atomic::Ordering::Relaxed), crate::tilt::DBG_CLEARS.load(std::sync::atomic::Ordering::Relaxed), crate::tilt::DBG_RECHECK.load(std::sync::atomic::Ordering::Relaxed)); } // TIMING-TMP
     if !detours.is_empty() {
         let old = std::mem::take(&mut path.points);
         let mut points = Vec::with_capacity(old.len() + 2 * detours.len());
@@ -322,9 +333,7 @@ pub(crate) fn runs(points: &[PathPoint]) -> Vec<(std::ops::Range<usize>, usize)>
     let mut out = vec![];
     let mut start = 0;
     let next = |end: usize, kind: MoveKind| {
-        end < points.len()
-            && points[end].kind == kind
-            && same_group(&points[end - 1], &points[end])
+        end < points.len() && points[end].kind == kind && same_group(&points[end - 1], &points[end])
     };
     while start < points.len() {
         let mut end = start + 1;

@@ -35,10 +35,6 @@ pub const RING_STEP_DEG: f64 = 5.0;
 /// Directions tried on each ring.
 pub const AZIMUTHS: usize = 8;
 
-pub static DBG_CLEARS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
-pub static DBG_SEARCH: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
-pub static DBG_RUN_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
-pub static DBG_RECHECK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0); // TIMING-TMP
 /// Length of path, mm, after a point no turn clears before the search is tried again.
 pub const RETRY_MM: f64 = 1.0;
 
@@ -269,7 +265,6 @@ pub(crate) fn tilt_run(
                 if !(turned(k) || k > 0 && turned(k - 1)) {
                     return now[k];
                 }
-                DBG_RECHECK.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
                 let from = match k {
                     _ if k <= lead && !travels => return None,
                     0 => r.start.checked_sub(1).map(|j| &pts[j]),
@@ -325,7 +320,6 @@ fn search(
     limits: &TiltLimits,
 ) -> Option<V3> {
     let Candidate { k, lead, hits } = at;
-    DBG_SEARCH.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
     let a = given[k];
     if !allowed[k].holds(a)
         || (hits == Obstacle::Table && scene.hits_table(run[k].p, allowed[k].highest()))
@@ -336,7 +330,6 @@ fn search(
     let next = keys.range(k + 1..).next();
     let near = |w: V3| near(keys, s, k, w, limits);
     let clears = |w: V3| {
-        DBG_CLEARS.fetch_add(1, std::sync::atomic::Ordering::Relaxed); // TIMING-TMP
         let b = rotate(a, w);
         if !allowed[k].holds(b) || !near(w) {
             return false;
@@ -526,18 +519,23 @@ mod tests {
         // The plate: the head's rims.
         let e1 = unit(cross(a, [0.0, 1.0, 0.0])).unwrap();
         let e2 = cross(a, e1);
-        [(0.0, tip_r), (nozzle, tip_r + nozzle * tan), (nozzle, body_r), (body, body_r)]
-            .iter()
-            .any(|&(h, r)| {
-                (0..64).any(|k| {
-                    let f = std::f64::consts::TAU * k as f64 / 64.0;
-                    let p = add(
-                        add(q.p, scale(a, h)),
-                        add(scale(e1, r * f.cos()), scale(e2, r * f.sin())),
-                    );
-                    p[2] < -DEPTH
-                })
+        [
+            (0.0, tip_r),
+            (nozzle, tip_r + nozzle * tan),
+            (nozzle, body_r),
+            (body, body_r),
+        ]
+        .iter()
+        .any(|&(h, r)| {
+            (0..64).any(|k| {
+                let f = std::f64::consts::TAU * k as f64 / 64.0;
+                let p = add(
+                    add(q.p, scale(a, h)),
+                    add(scale(e1, r * f.cos()), scale(e2, r * f.sin())),
+                );
+                p[2] < -DEPTH
             })
+        })
     }
 
     #[test]
@@ -552,17 +550,29 @@ mod tests {
         };
         let given = check(&path, &head, table);
         let prints = |c: &[Collision]| c.iter().filter(|c| c.kind == MoveKind::Print).count();
-        assert!(prints(&given) > 100, "the wall is in the way: {}", given.len());
+        assert!(
+            prints(&given) > 100,
+            "the wall is in the way: {}",
+            given.len()
+        );
         let t = tilt(&path, &planned, &head, table, &limits);
         // Only axes change.
         assert_eq!(t.path.points.len(), path.points.len());
         for (a, b) in t.path.points.iter().zip(&path.points) {
-            assert_eq!((a.p, a.kind, a.feature, a.layer, a.e), (b.p, b.kind, b.feature, b.layer, b.e));
+            assert_eq!(
+                (a.p, a.kind, a.feature, a.layer, a.e),
+                (b.p, b.kind, b.feature, b.layer, b.e)
+            );
         }
         // (c) Fewer colliding moves, as the check finds them again, and what tilt counts.
         let after = check(&t.path, &head, table);
         assert_eq!(after, t.left);
-        assert!(prints(&after) < prints(&given), "{} → {}", prints(&given), prints(&after));
+        assert!(
+            prints(&after) < prints(&given),
+            "{} → {}",
+            prints(&given),
+            prints(&after)
+        );
         let cleared: usize = t.cleared.values().sum();
         assert_eq!(cleared, prints(&given) - prints(&after));
         // The moves cleared are clear by the brute-force check, which finds them colliding
@@ -574,7 +584,10 @@ mod tests {
                 seen += usize::from(brute_hits(&path.points, c.index));
             }
         }
-        assert!(seen > 0, "the brute-force check sees the given moves collide");
+        assert!(
+            seen > 0,
+            "the brute-force check sees the given moves collide"
+        );
         // (a) Every axis unit, within the cone about its planned axis and the B limit.
         for (q, &b) in t.path.points.iter().zip(&planned) {
             assert!((norm(q.axis) - 1.0).abs() < 1e-9);
@@ -595,7 +608,10 @@ mod tests {
             let len = norm(sub(p1.p, p0.p));
             let before = angle(p0.axis, p1.axis);
             let step = angle(t0.axis, t1.axis);
-            assert!(step <= before + limits.slope() * len + 1e-9, "{j}: {step} vs {before}");
+            assert!(
+                step <= before + limits.slope() * len + 1e-9,
+                "{j}: {step} vs {before}"
+            );
             tilted += usize::from(angle(t1.axis, p1.axis) > 1e-6);
         }
         assert!(tilted > 0);

@@ -6,13 +6,13 @@
 
 use crate::report::{round, CollisionEntry, FeatureReport, HitEntry};
 use collide::{interleave, tilt_and_route, Collision, Obstacle, Table, TiltLimits, Travels};
-use slicer::orient::SmoothParams;
-use slicer::toolpath::MoveKind;
-use slicer::vec3::V3;
 use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
 use robot_post::MachineKind;
+use slicer::orient::SmoothParams;
+use slicer::toolpath::MoveKind;
 use slicer::toolpath::ToolPath;
+use slicer::vec3::V3;
 use std::collections::BTreeMap;
 
 /// The machine's table in part coordinates, placed as the post will place the part: the lowest

@@ -323,10 +323,8 @@ pub fn plan(
     }
     // The head against what is built before each move and the table (issue 18).
     tell(Progress::Stage(STAGES[1]));
-    let limits = collisions::tilt_limits(machine, &process.orientation).filter(|_| std::env::var_os("TILT_OFF").is_none()); // TIMING-TMP
-    let t0 = std::time::Instant::now(); // TIMING-TMP
+    let limits = collisions::tilt_limits(machine, &process.orientation);
     let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &reports, limits);
-    if std::env::var_os("TIMING_TMP").is_some() { eprintln!("TIMING avoid {:.3} s", t0.elapsed().as_secs_f64()); } // TIMING-TMP
     let collided = collisions::entries(&avoided);
     let points = collisions::points(&toolpath);
     for r in &mut reports {
