@@ -4,21 +4,27 @@
 //! and the table, and the turn blended into the path's neighbouring points so the axes stay
 //! continuous.
 //!
-//! Each continuous path (a bead's start point and the print points after it, one feature and
-//! layer) is tilted on its own, against the material deposited before its group (feature,
-//! layer), which a tilt does not change:
+//! Each run (a continuous path: the point a bead starts from and the print points after it,
+//! one feature and layer, with the travel points of that feature and layer leading to it) is
+//! tilted on its own, against the material deposited before its group (feature, layer), which
+//! a tilt does not change:
 //!
 //! 1. **keys**: for each colliding print move, the smallest turn ω (a rotation vector: axis ×
 //!    angle) of the point's axis that clears the move: first the turn of the nearest key, then
 //!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
 //!    first that clears), [`AZIMUTHS`] directions each, starting towards +Z (away from the
-//!    table). A turn is allowed when it keeps the axis within the cone (and a
-//!    B/C bed's B limit) and differs from the keys beside it by at most the blend's slope;
+//!    table). A turn is allowed when it keeps the axis within the cone (and a B/C bed's B
+//!    limit) and differs from the keys beside it by at most the blend's slope
+//!    ([`TiltLimits::slope`]). The travel points leading to the bead and its start, which a
+//!    lift cannot clear when the head collides there, get keys of their own. Keys found in one
+//!    pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after a
+//!    move no turn clears;
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
-//!    two windows, falling to nothing over one window (the smoothing's `window_mm`) beyond the
-//!    outer keys ([`blend`]); each point's axis turned by it, scaled back where it would leave
-//!    the cone or the B limit;
-//! 3. **check again**, with new keys where moves still collide, a few passes; the path keeps
+//!    two windows, held from the bead's start (and its lead) to a first key that close,
+//!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
+//!    ([`blend`]); each point's axis turned by it, scaled back where it would leave the cone or
+//!    the B limit;
+//! 3. **check again**, with new keys where moves still collide, a few passes; the run keeps
 //!    its tilt only when every move that collides after it collided before it and fewer do.
 
 use crate::check::{move_hit, walk, Collision, Obstacle, Routed, Scene};
@@ -54,7 +60,7 @@ pub struct TiltLimits {
     /// the orientation smoothing (`cone_angle_deg / 2`).
     pub cone_half_deg: f64,
     /// Largest angle of an axis from +Z, degrees (a B/C bed's B limit); `None`: no limit. An
-    /// axis already beyond it is not tilted.
+    /// axis already beyond it may be tilted, but not farther from +Z.
     pub max_from_z_deg: Option<f64>,
     /// Length of path, mm, over which a tilt is blended into its neighbours: the smoothing's
     /// window, so the turn per mm stays within `2 · cone_half_deg / window_mm`.
