@@ -227,6 +227,10 @@ pub(crate) fn tilt_run(
                 {
                     (k - 1, Some(w))
                 }
+                // Or a turn of its own, if none was searched there yet.
+                Some(_) if k > lead && !keys.contains_key(&(k - 1)) && !tried[k - 1] => {
+                    (k - 1, None)
+                }
                 Some(_) => continue,
                 None if tried[k] => continue,
                 None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => continue,

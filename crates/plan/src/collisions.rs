@@ -10,7 +10,6 @@ use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
 use robot_post::MachineKind;
 use slicer::orient::SmoothParams;
-use slicer::toolpath::MoveKind;
 use slicer::toolpath::ToolPath;
 use slicer::vec3::V3;
 use std::collections::BTreeMap;
@@ -73,9 +72,8 @@ pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Opti
 /// moves tilted inside the cone about their `planned` axes (one per point of `path`, before
 /// smoothing) by `limits` ([`collide::tilt`]; `None`: no tilt), then colliding travels lifted
 /// (left to the post on a KUKA cell, whose post makes its own). Where print moves still hit
-/// siblings, the siblings interleaved are walked without tilt, and that order kept when it
-/// leaves fewer colliding moves, tilted then (the planned axes interleaved along) if print
-/// moves in it still collide. Returns the collisions left, in path order,
+/// siblings, the siblings interleaved (their planned axes along) are walked alike, and that
+/// order kept when it leaves fewer colliding moves. Returns the collisions left, in path order,
 /// and the moves tilt cleared.
 pub fn avoid(
     path: &mut ToolPath,
@@ -123,21 +121,14 @@ pub fn avoid(
             mixed_planned = p;
         }
     }
-    // Interleaved and not tilted first (cheaper); tilted too only when that order is kept
-    // and print moves still collide.
-    let mut routed = mixed.clone();
-    let second = walk(&mut routed, &[], None);
-    if second.left.len() >= first.left.len() {
-        return first;
-    }
-    if limits.is_none() || second.left.iter().all(|c| c.kind != MoveKind::Print) {
-        *path = routed;
-        return second;
-    }
     let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
-    let third = walk(&mut mixed, &planned, limits.as_ref());
-    *path = mixed;
-    third
+    let second = walk(&mut mixed, &planned, limits.as_ref());
+    if second.left.len() < first.left.len() {
+        *path = mixed;
+        second
+    } else {
+        first
+    }
 }
 
 /// `path` with the tool axes `axes` (one per point).
