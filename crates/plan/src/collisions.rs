@@ -73,7 +73,8 @@ pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Opti
 /// smoothing) by `limits` ([`collide::tilt`]; `None`: no tilt), then colliding travels lifted
 /// (left to the post on a KUKA cell, whose post makes its own). Where print moves still hit
 /// siblings, the siblings interleaved (their planned axes along) are walked alike, and that
-/// order kept when it leaves fewer colliding moves. Returns the collisions left, in path order,
+/// order kept when it leaves fewer colliding moves; where every sibling group is crowded, that
+/// walk is the one made beside the first, on the other thread. Returns the collisions left, in path order,
 /// and the moves tilt cleared.
 pub fn avoid(
     path: &mut ToolPath,
@@ -97,8 +98,34 @@ pub fn avoid(
         }
     };
     let groups = sibling_groups(features);
-    let unrouted = path.clone();
-    let first = walk(path, planned, limits.as_ref());
+    // The siblings interleaved: the path and its planned axes (a path of them interleaved
+    // alike), `None` where no group interleaves.
+    let mixed = |groups: &[&Vec<usize>]| {
+        let mut mixed = path.clone();
+        let mut mixed_planned = with_axes(path, planned);
+        let mut any = false;
+        for g in groups {
+            if let (Some(m), Some(p)) = (interleave(&mixed, g), interleave(&mixed_planned, g)) {
+                mixed = m;
+                mixed_planned = p;
+                any = true;
+            }
+        }
+        let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
+        any.then_some((mixed, planned))
+    };
+    // Where the part has siblings, every group interleaved is walked beside the first walk
+    // (the machine's other thread), in case the first leaves them all crowded.
+    let all: Vec<&Vec<usize>> = groups.iter().collect();
+    let mut first_path = path.clone();
+    let (first, every) = rayon::join(
+        || walk(&mut first_path, planned, limits.as_ref()),
+        || {
+            let (mut m, p) = mixed(&all)?;
+            let w = walk(&mut m, &p, limits.as_ref());
+            Some((m, w))
+        },
+    );
     // Groups one of whose members hits another.
     let crowded: Vec<&Vec<usize>> = groups
         .iter()
@@ -109,25 +136,23 @@ pub fn avoid(
             })
         })
         .collect();
-    if crowded.is_empty() {
-        return first;
-    }
-    // The planned axes go along with their points: a path of them interleaved alike.
-    let mut mixed = unrouted.clone();
-    let mut mixed_planned = with_axes(&unrouted, planned);
-    for g in crowded {
-        if let (Some(m), Some(p)) = (interleave(&mixed, g), interleave(&mixed_planned, g)) {
-            mixed = m;
-            mixed_planned = p;
+    let second = match every {
+        _ if crowded.is_empty() => None,
+        Some(done) if crowded.len() == all.len() => Some(done),
+        _ => mixed(&crowded).map(|(mut m, p)| {
+            let w = walk(&mut m, &p, limits.as_ref());
+            (m, w)
+        }),
+    };
+    match second {
+        Some((m, second)) if second.left.len() < first.left.len() => {
+            *path = m;
+            second
         }
-    }
-    let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
-    let second = walk(&mut mixed, &planned, limits.as_ref());
-    if second.left.len() < first.left.len() {
-        *path = mixed;
-        second
-    } else {
-        first
+        _ => {
+            *path = first_path;
+            first
+        }
     }
 }
 
