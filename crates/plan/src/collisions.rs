@@ -55,10 +55,11 @@ pub struct Avoided {
 }
 
 /// How far [`avoid`] may tilt tool axes: inside the smoothing's tolerance cone, blended over its
-/// window, within a B/C bed's B limit; `None` when smoothing is off (the planned axes are
-/// kept) or its options are wrong.
+/// window, within a B/C bed's B limit; `None` on a 3-axis printer (its tool axis is +Z only),
+/// when smoothing is off (the planned axes are kept) or when its options are wrong.
 pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Option<TiltLimits> {
-    (orientation.enabled && orientation.validate().is_ok()).then(|| TiltLimits {
+    let turns = machine.kind != MachineKind::Marlin;
+    (turns && orientation.enabled && orientation.validate().is_ok()).then(|| TiltLimits {
         cone_half_deg: 0.5 * orientation.cone_angle_deg,
         max_from_z_deg: machine
             .delta5_table()
