@@ -264,8 +264,20 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
         for f in run.plan["features"].as_array().expect("features") {
             let id = f["id"].as_u64().expect("id");
             let n = f["collisions"].as_u64().expect("collisions");
+            let cleared = f["collisions_cleared_by_tilt"]
+                .as_u64()
+                .expect("collisions_cleared_by_tilt");
+            // The impeller's blades: tilting the axis inside the cone clears most of the
+            // moves whose body meets the hub.
+            if name == "impeller" && id > 0 {
+                assert!(
+                    cleared > n,
+                    "{name}: feature {id}: {cleared} cleared, {n} left"
+                );
+            }
             if f["parents"].as_array().expect("parents").is_empty() {
                 assert_eq!(n, 0, "{name}: base feature {id} collides");
+                assert_eq!(cleared, 0, "{name}: base feature {id} tilted");
                 continue;
             }
             if n == 0 {
@@ -288,6 +300,45 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
                 .fold(0.0, f64::max);
             assert!(lean > 30.0, "{name}: feature {id} leans only {lean}°");
         }
+        tilt_is_continuous(name, &run);
+    }
+}
+
+/// The default orientation smoothing: window (mm) and the cone's half-angle (degrees).
+const SMOOTHING: (f64, f64) = (5.0, 30.0);
+
+/// The axes along every bead after the head's avoidance turn, from one print point to the
+/// next, by at most the feature's largest step after smoothing (`plan.json`) plus the tilt
+/// blend's slope (two cone half-angles per window, the most a turn inside the cone can change
+/// over one) times the step's length: the tilt keeps the smoothed axes continuous.
+fn tilt_is_continuous(name: &str, run: &Planned) {
+    let (window, half) = SMOOTHING;
+    let slope = 2.0 * half / window;
+    let smoothed: BTreeMap<usize, f64> = run.plan["features"]
+        .as_array()
+        .expect("features")
+        .iter()
+        .map(|f| {
+            let step = f["orientation_step_max_deg_after"].as_f64().unwrap_or(0.0);
+            (f["id"].as_u64().expect("id") as usize, step)
+        })
+        .collect();
+    for w in run.points.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if !(b.print && a.feature == b.feature && a.layer == b.layer) {
+            continue;
+        }
+        let step = norm(cross(a.axis, b.axis))
+            .atan2(dot(a.axis, b.axis))
+            .to_degrees();
+        let len = dot(sub(b.p, a.p), sub(b.p, a.p)).sqrt();
+        let bound = smoothed[&b.feature] + slope * len + 1e-3;
+        assert!(
+            step <= bound,
+            "{name}: feature {} turns {step}° over {len} mm (bound {bound}°)",
+            b.feature
+        );
+        assert!((norm(b.axis) - 1.0).abs() < 1e-4, "{name}: axis not unit");
     }
 }
 
@@ -358,6 +409,18 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
 }
 
 /// Every travel (`G0`) of the program, followed in steps of at most 0.1 mm of the tip in part

@@ -8,6 +8,8 @@
 use crate::deposit::{Deposit, GRAIN_SPACING};
 use crate::head::{Head, HeadShape};
 use crate::table::Table;
+use crate::tilt::{tilt_run, TiltLimits};
+use std::collections::BTreeMap;
 use toolpath::vec3::{add, norm, scale, sub, unit, V3};
 use toolpath::{MoveKind, PathPoint, ToolPath};
 
@@ -76,6 +78,13 @@ impl Scene {
             .map(Obstacle::Feature)
     }
 
+    /// Whether the head with its tip at `tip` and unit tool axis `axis` meets the table.
+    pub(crate) fn hits_table(&self, tip: V3, axis: V3) -> bool {
+        self.table
+            .as_ref()
+            .is_some_and(|t| t.hits(&self.shape, tip, axis, TOLERANCE))
+    }
+
     /// The first obstacle the head meets swept from (`a`, axis `aa`) to (`b`, axis `ab`), with
     /// the tip position there; `a` itself is not checked (the move before ended there).
     pub fn sweep(&self, a: V3, aa: V3, b: V3, ab: V3) -> Option<(V3, Obstacle)> {
@@ -95,7 +104,7 @@ impl Scene {
     /// along each run of beads, grains at most [`GRAIN_SPACING`] apart and, where the planned
     /// points lie closer, at least half that apart (every point of a bead is then within a
     /// quarter of the spacing of a grain), the run's ends always.
-    fn deposit(&mut self, points: &[PathPoint], range: std::ops::Range<usize>) {
+    pub(crate) fn deposit(&mut self, points: &[PathPoint], range: std::ops::Range<usize>) {
         let mut last: Option<V3> = None;
         for j in range {
             let q = &points[j];
@@ -119,7 +128,7 @@ impl Scene {
 }
 
 /// Whether `a` and `b` belong to one group of points (same feature and layer).
-fn same_group(a: &PathPoint, b: &PathPoint) -> bool {
+pub(crate) fn same_group(a: &PathPoint, b: &PathPoint) -> bool {
     a.feature == b.feature && a.layer == b.layer
 }
 
@@ -142,14 +151,24 @@ pub fn check(path: &ToolPath, head: &Head, table: Option<Table>) -> Vec<Collisio
 }
 
 /// The collision of the move ending at `pts[i]`, if any.
-fn move_collision(scene: &Scene, pts: &[PathPoint], i: usize) -> Option<Collision> {
-    let q = &pts[i];
-    let hit = match i.checked_sub(1).map(|j| &pts[j]) {
+pub(crate) fn move_collision(scene: &Scene, pts: &[PathPoint], i: usize) -> Option<Collision> {
+    move_hit(scene, i.checked_sub(1).map(|j| &pts[j]), &pts[i], i)
+}
+
+/// The collision of the move from `from` (none: the path's first point) to `q`, the point of
+/// index `index` in its path, if any.
+pub(crate) fn move_hit(
+    scene: &Scene,
+    from: Option<&PathPoint>,
+    q: &PathPoint,
+    index: usize,
+) -> Option<Collision> {
+    let hit = match from {
         Some(a) => scene.sweep(a.p, a.axis, q.p, q.axis),
         None => scene.at(q.p, q.axis).map(|o| (q.p, o)),
     }?;
     Some(Collision {
-        index: i,
+        index,
         feature: q.feature,
         kind: q.kind,
         at: hit.0,
@@ -182,31 +201,112 @@ pub fn check_and_route(
     table: Option<Table>,
     travels: Travels,
 ) -> Vec<Collision> {
+    walk(path, head, table, Some(travels), None).left
+}
+
+/// What [`tilt_and_route`] leaves.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Routed {
+    /// The colliding moves left, in path order (indices in the path as re-routed).
+    pub left: Vec<Collision>,
+    /// Per feature id, its print moves that collided with the axes given and are clear tilted.
+    pub cleared: BTreeMap<usize, usize>,
+}
+
+/// [`check_and_route`], each continuous path first tilted inside the cone about its `planned`
+/// axes (one per point of `path`) where that clears print moves ([`crate::tilt`]; no tilt
+/// when `limits` is `None`), its travels then routed with the axes tilted: the whole
+/// avoidance in one walk along the path, each move checked once against what lies before it.
+pub fn tilt_and_route(
+    path: &mut ToolPath,
+    planned: &[V3],
+    head: &Head,
+    table: Option<Table>,
+    travels: Travels,
+    limits: Option<&TiltLimits>,
+) -> Routed {
+    walk(
+        path,
+        head,
+        table,
+        Some(travels),
+        limits.map(|l| (planned, l)),
+    )
+}
+
+/// The walk along `path` behind [`check_and_route`], [`tilt_and_route`] and [`crate::tilt`]:
+/// run by run (continuous paths), the material before each run's group deposited, its moves
+/// checked, tilted by `tilt` (planned axes and limits) where that clears print moves, and its
+/// colliding travels routed by `travels` (`None`: checked and reported, not routed).
+pub(crate) fn walk(
+    path: &mut ToolPath,
+    head: &Head,
+    table: Option<Table>,
+    travels: Option<Travels>,
+    tilt: Option<(&[V3], &TiltLimits)>,
+) -> Routed {
     let mut scene = Scene::new(head, table);
-    let pts = &path.points;
     // Detours by the index of the point they go before; the path is rebuilt once, if at all.
     let mut detours: Vec<(usize, [PathPoint; 2])> = vec![];
-    let mut left = vec![];
+    let mut out = Routed::default();
     let mut group = 0;
-    for i in 0..pts.len() {
-        if i > 0 && !same_group(&pts[i - 1], &pts[i]) {
-            scene.deposit(pts, group..i);
-            group = i;
+    let skip = |q: &PathPoint| travels == Some(Travels::Skip) && q.kind == MoveKind::Travel;
+    for (r, lead) in runs(&path.points) {
+        let pts = &mut path.points;
+        if r.start > 0 && !same_group(&pts[r.start - 1], &pts[r.start]) {
+            scene.deposit(pts, group..r.start);
+            group = r.start;
         }
-        let skip = travels == Travels::Skip && pts[i].kind == MoveKind::Travel;
-        let Some(c) = (!skip).then(|| move_collision(&scene, pts, i)).flatten() else {
-            continue;
-        };
-        let via = match (c.kind, i.checked_sub(1)) {
-            (MoveKind::Travel, Some(j)) => detour(&scene, &pts[j], &pts[i], head),
-            _ => None,
-        };
-        match via {
-            Some(via) => detours.push((i, via)),
-            None => left.push(Collision {
-                index: i + 2 * detours.len(),
-                ..c
-            }),
+        let mut found: Vec<Option<Collision>> = r
+            .clone()
+            .map(|i| (!skip(&pts[i])).then(|| move_collision(&scene, pts, i))?)
+            .collect();
+        if let Some((planned, limits)) = tilt {
+            let prints = found[lead + 1..].iter().any(Option::is_some);
+            let checked = travels != Some(Travels::Skip);
+            if let Some((axes, after)) = (prints && planned.len() == pts.len())
+                .then(|| {
+                    let planned = &planned[r.clone()];
+                    tilt_run(
+                        &scene,
+                        pts,
+                        r.clone(),
+                        lead,
+                        planned,
+                        limits,
+                        &found,
+                        checked,
+                    )
+                })
+                .flatten()
+            {
+                for (q, a) in pts[r.clone()].iter_mut().zip(axes) {
+                    q.axis = a;
+                }
+                let n = found[lead + 1..]
+                    .iter()
+                    .zip(&after[lead + 1..])
+                    .filter(|(b, a)| b.is_some() && a.is_none())
+                    .count();
+                *out.cleared.entry(pts[r.start].feature).or_default() += n;
+                found = after;
+            }
+        }
+        for c in found.into_iter().flatten() {
+            let i = c.index;
+            let via = match (c.kind, travels, i.checked_sub(1)) {
+                (MoveKind::Travel, Some(Travels::Route), Some(j)) => {
+                    detour(&scene, &pts[j], &pts[i], head)
+                }
+                _ => None,
+            };
+            match via {
+                Some(via) => detours.push((i, via)),
+                None => out.left.push(Collision {
+                    index: i + 2 * detours.len(),
+                    ..c
+                }),
+            }
         }
     }
     if !detours.is_empty() {
@@ -221,7 +321,35 @@ pub fn check_and_route(
         points.extend_from_slice(&old[from..]);
         path.points = points;
     }
-    left
+    out
+}
+
+/// The runs of `points` the walk tilts on their own, as index ranges covering every point once,
+/// in order, each with its lead: the travel points of one feature and layer before the point
+/// its bead starts from (the lead's count), that point, and the print points of that feature
+/// and layer after it (the continuous path of `slicer::orient::continuous_paths`, with the
+/// travel points that lead to it). Travel points followed by no bead are a run of their own.
+pub(crate) fn runs(points: &[PathPoint]) -> Vec<(std::ops::Range<usize>, usize)> {
+    let mut out = vec![];
+    let mut start = 0;
+    let next = |end: usize, kind: MoveKind| {
+        end < points.len() && points[end].kind == kind && same_group(&points[end - 1], &points[end])
+    };
+    while start < points.len() {
+        let mut end = start + 1;
+        if points[start].kind == MoveKind::Travel {
+            while next(end, MoveKind::Travel) {
+                end += 1;
+            }
+        }
+        let lead = end - 1 - start;
+        while next(end, MoveKind::Print) {
+            end += 1;
+        }
+        out.push((start..end, lead));
+        start = end;
+    }
+    out
 }
 
 /// Two travel points lifting the head from `a` over the material and down onto `b`, clear of

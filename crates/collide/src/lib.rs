@@ -7,7 +7,10 @@
 //!   hierarchy of occupied cells, asked whether any grain lies inside the head;
 //! - [`check`]: every move of a [`toolpath::ToolPath`], the head swept along it, against what
 //!   was deposited before it (earlier features, the feature's earlier layers) and the table;
-//!   [`check_and_route`] also lifts colliding travels over the material;
+//!   [`check_and_route`] also lifts colliding travels over the material, and
+//!   [`tilt_and_route`] first tilts colliding print moves clear ([`tilt`]);
+//! - [`tilt`]: colliding print moves cleared by turning the tool axis inside the orientation's
+//!   tolerance cone, the turn blended along the path;
 //! - [`interleave`]: sibling features printed layer by layer in turn, when that clears the head.
 //!
 //! It reads only the tool path: the beads a feature lays are the material it leaves.
@@ -19,11 +22,14 @@ mod deposit;
 mod head;
 mod order;
 mod table;
+mod tilt;
 
 pub use check::{
-    check, check_and_route, Collision, Obstacle, Scene, Travels, SWEEP_STEP, TOLERANCE,
+    check, check_and_route, tilt_and_route, Collision, Obstacle, Routed, Scene, Travels,
+    SWEEP_STEP, TOLERANCE,
 };
 pub use deposit::{Deposit, GRAIN_SPACING};
 pub use head::{Head, HeadShape};
 pub use order::interleave;
 pub use table::Table;
+pub use tilt::{blend, tilt, TiltLimits, Tilted, AZIMUTHS, RING_STEP_DEG};

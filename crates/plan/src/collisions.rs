@@ -1,14 +1,17 @@
 //! The collision stage, between smoothing and the post (issue 18): the head of the machine
 //! profile checked along every move against what was deposited before it and the table
-//! (`collide`), colliding travels lifted over the material, and sibling features (the same
-//! parents) printed layer by layer in turn where that leaves fewer collisions.
+//! (`collide`), colliding travels lifted over the material, sibling features (the same
+//! parents) printed layer by layer in turn where that leaves fewer collisions, and colliding
+//! print moves cleared by tilting the tool axis inside the orientation's tolerance cone.
 
 use crate::report::{round, CollisionEntry, FeatureReport, HitEntry};
-use collide::{check_and_route, interleave, Collision, Obstacle, Table, Travels};
+use collide::{interleave, tilt_and_route, Collision, Obstacle, Table, TiltLimits, Travels};
 use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
 use robot_post::MachineKind;
+use slicer::orient::SmoothParams;
 use slicer::toolpath::ToolPath;
+use slicer::vec3::V3;
 use std::collections::BTreeMap;
 
 /// The machine's table in part coordinates, placed as the post will place the part: the lowest
@@ -42,15 +45,45 @@ pub fn sibling_groups(features: &[FeatureReport]) -> Vec<Vec<usize>> {
     groups
 }
 
-/// Checks `path` with the machine's head and table, lifting colliding travels (left to the
-/// post on a KUKA cell, whose post makes its own); where print
-/// moves hit siblings, tries the siblings interleaved and keeps that order when it leaves fewer
-/// colliding moves. Returns the collisions left, in path order.
+/// What [`avoid`] leaves.
+#[derive(Debug, Clone, Default)]
+pub struct Avoided {
+    /// The colliding moves left, in path order.
+    pub left: Vec<Collision>,
+    /// Per feature id, its print moves cleared by tilting the tool axis.
+    pub cleared: BTreeMap<usize, usize>,
+}
+
+/// How far [`avoid`] may tilt tool axes: inside the smoothing's tolerance cone, blended over its
+/// window, within a B/C bed's B limit; `None` on a 3-axis printer (its tool axis is +Z only),
+/// when smoothing is off (the planned axes are kept) or when its options are wrong.
+pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Option<TiltLimits> {
+    let turns = machine.kind != MachineKind::Marlin;
+    (turns && orientation.enabled && orientation.validate().is_ok()).then(|| TiltLimits {
+        cone_half_deg: 0.5 * orientation.cone_angle_deg,
+        max_from_z_deg: machine
+            .delta5_table()
+            .ok()
+            .map(|g| g.b_limits_deg[0].abs().max(g.b_limits_deg[1].abs())),
+        window_mm: orientation.window_mm,
+    })
+}
+
+/// Checks `path` with the machine's head and table in one walk along it: colliding print
+/// moves tilted inside the cone about their `planned` axes (one per point of `path`, before
+/// smoothing) by `limits` ([`collide::tilt`]; `None`: no tilt), then colliding travels lifted
+/// (left to the post on a KUKA cell, whose post makes its own). Where print moves still hit
+/// siblings, the siblings interleaved (their planned axes along) are walked alike, and that
+/// order kept when it leaves fewer colliding moves; where every sibling group is crowded, that
+/// walk is the one made beside the first, on the other thread. Returns the collisions left, in path order,
+/// and the moves tilt cleared.
 pub fn avoid(
     path: &mut ToolPath,
+    planned: &[V3],
     machine: &MachineProfile,
     features: &[FeatureReport],
-) -> Vec<Collision> {
+    limits: Option<TiltLimits>,
+) -> Avoided {
     let head = machine.head;
     let table = table(path, machine);
     // The KUKA post makes its own travels (retreat, rise, cross, approach).
@@ -58,36 +91,79 @@ pub fn avoid(
         MachineKind::Kuka => Travels::Skip,
         _ => Travels::Route,
     };
+    let walk = |path: &mut ToolPath, planned: &[V3], limits: Option<&TiltLimits>| {
+        let r = tilt_and_route(path, planned, &head, Some(table), travels, limits);
+        Avoided {
+            left: r.left,
+            cleared: r.cleared,
+        }
+    };
     let groups = sibling_groups(features);
-    let left = check_and_route(path, &head, Some(table), travels);
+    // The siblings interleaved: the path and its planned axes (a path of them interleaved
+    // alike), `None` where no group interleaves.
+    let mixed = |groups: &[&Vec<usize>]| {
+        let mut mixed = path.clone();
+        let mut mixed_planned = with_axes(path, planned);
+        let mut any = false;
+        for g in groups {
+            if let (Some(m), Some(p)) = (interleave(&mixed, g), interleave(&mixed_planned, g)) {
+                mixed = m;
+                mixed_planned = p;
+                any = true;
+            }
+        }
+        let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
+        any.then_some((mixed, planned))
+    };
+    // Where the part has siblings, every group interleaved is walked beside the first walk
+    // (the machine's other thread), in case the first leaves them all crowded.
+    let all: Vec<&Vec<usize>> = groups.iter().collect();
+    let mut first_path = path.clone();
+    let (first, every) = rayon::join(
+        || walk(&mut first_path, planned, limits.as_ref()),
+        || {
+            let (mut m, p) = mixed(&all)?;
+            let w = walk(&mut m, &p, limits.as_ref());
+            Some((m, w))
+        },
+    );
     // Groups one of whose members hits another.
     let crowded: Vec<&Vec<usize>> = groups
         .iter()
         .filter(|g| {
-            left.iter().any(|c| {
+            first.left.iter().any(|c| {
                 g.contains(&c.feature)
                     && matches!(c.hits, Obstacle::Feature(f) if f != c.feature && g.contains(&f))
             })
         })
         .collect();
-    if crowded.is_empty() {
-        return left;
-    }
-    // The travels lifted for the first order go along with their layers: still travels, checked
-    // again in the new order.
-    let mut mixed = path.clone();
-    for g in crowded {
-        if let Some(m) = interleave(&mixed, g) {
-            mixed = m;
+    let second = match every {
+        _ if crowded.is_empty() => None,
+        Some(done) if crowded.len() == all.len() => Some(done),
+        _ => mixed(&crowded).map(|(mut m, p)| {
+            let w = walk(&mut m, &p, limits.as_ref());
+            (m, w)
+        }),
+    };
+    match second {
+        Some((m, second)) if second.left.len() < first.left.len() => {
+            *path = m;
+            second
+        }
+        _ => {
+            *path = first_path;
+            first
         }
     }
-    let mixed_left = check_and_route(&mut mixed, &head, Some(table), travels);
-    if mixed_left.len() < left.len() {
-        *path = mixed;
-        mixed_left
-    } else {
-        left
+}
+
+/// `path` with the tool axes `axes` (one per point).
+fn with_axes(path: &ToolPath, axes: &[V3]) -> ToolPath {
+    let mut out = path.clone();
+    for (q, &a) in out.points.iter_mut().zip(axes) {
+        q.axis = a;
     }
+    out
 }
 
 /// Per feature id, its points in the tool path (travels lifted over material add some).
@@ -99,10 +175,14 @@ pub fn points(path: &ToolPath) -> BTreeMap<usize, usize> {
     out
 }
 
-/// Per feature id, its colliding moves and the first one, as `plan.json` reports them.
-pub fn entries(collisions: &[Collision]) -> BTreeMap<usize, CollisionEntry> {
+/// Per feature id, its colliding moves, the first one and the moves tilt cleared, as
+/// `plan.json` reports them.
+pub fn entries(avoided: &Avoided) -> BTreeMap<usize, CollisionEntry> {
     let mut out: BTreeMap<usize, CollisionEntry> = BTreeMap::new();
-    for c in collisions {
+    for (&id, &n) in &avoided.cleared {
+        out.entry(id).or_default().collisions_cleared_by_tilt = n;
+    }
+    for c in &avoided.left {
         let e = out.entry(c.feature).or_default();
         e.collisions += 1;
         e.first_collision

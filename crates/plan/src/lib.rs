@@ -295,8 +295,10 @@ pub fn plan(
     tell(Progress::Planned);
     // One tool path, features in build order with their file-wide ids.
     let mut toolpath = sequence(plans);
-    // Orientation smoothing between planning and posting.
+    // Orientation smoothing between planning and posting; the planned axes are kept for the
+    // tilt that clears the head (inside the same cone about them).
     tell(Progress::Stage(STAGES[0]));
+    let planned_axes: Vec<_> = toolpath.points.iter().map(|q| q.axis).collect();
     let orientation = smooth(&mut toolpath, &process.orientation);
     // A B/C bed: axes that curved layers tip past the B limit are tilted back to it, inside
     // the orientation's tolerance cone (half its opening); farther, the post refuses them.
@@ -321,7 +323,9 @@ pub fn plan(
     }
     // The head against what is built before each move and the table (issue 18).
     tell(Progress::Stage(STAGES[1]));
-    let collided = collisions::entries(&collisions::avoid(&mut toolpath, machine, &reports));
+    let limits = collisions::tilt_limits(machine, &process.orientation);
+    let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &reports, limits);
+    let collided = collisions::entries(&avoided);
     let points = collisions::points(&toolpath);
     for r in &mut reports {
         r.collision = collided.get(&r.feature.id).cloned().unwrap_or_default();

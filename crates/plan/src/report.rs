@@ -182,6 +182,9 @@ pub struct CollisionEntry {
     pub collisions: usize,
     /// The first of them; `null` when none.
     pub first_collision: Option<FirstCollision>,
+    /// Print moves that collided with the tool axes as smoothed and are clear with the axes
+    /// tilted inside the orientation's tolerance cone (not counted in `collisions`).
+    pub collisions_cleared_by_tilt: usize,
 }
 
 /// Where the first colliding move of a feature meets what.

@@ -1,0 +1,657 @@
+//! Avoidance by tilt (issue 18, item 3, its first step): the tool axis of a colliding print move
+//! turned, inside the orientation's tolerance cone about the point's planned axis (the cone
+//! smoothing keeps, `slicer::orient`), to an axis whose head clears what lies before the move
+//! and the table, and the turn blended into the path's neighbouring points so the axes stay
+//! continuous.
+//!
+//! Each run (a continuous path: the point a bead starts from and the print points after it,
+//! one feature and layer, with the travel points of that feature and layer leading to it) is
+//! tilted on its own, against the material deposited before its group (feature, layer), which
+//! a tilt does not change:
+//!
+//! 1. **keys**: for each colliding print move, the smallest turn ω (a rotation vector: axis ×
+//!    angle) of the point's axis that clears the move: first the turn of the nearest key, then
+//!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
+//!    first that clears), [`AZIMUTHS`] directions each, starting towards +Z (away from the
+//!    table). A turn is allowed when it keeps the axis within the cone (and a B/C bed's B
+//!    limit) and differs from the keys beside it by at most the blend's slope
+//!    ([`TiltLimits::slope`]). The travel points leading to the bead and its start, which a
+//!    lift cannot clear when the head collides there, get keys of their own. Keys found in one
+//!    pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after a
+//!    move no turn clears;
+//! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
+//!    two windows, held from the bead's start (and its lead) to a first key that close,
+//!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
+//!    ([`blend`]); each point's axis turned by it, scaled back where it would leave the cone or
+//!    the B limit;
+//! 3. **check again**, with new keys where moves still collide, a few passes; the run keeps
+//!    its tilt only when every move that collides after it collided before it and fewer do.
+
+use crate::check::{move_hit, walk, Collision, Obstacle, Routed, Scene};
+use crate::head::Head;
+use crate::table::Table;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use toolpath::vec3::{add, cross, dot, norm, scale, sub, unit, V3};
+use toolpath::{PathPoint, ToolPath};
+
+/// Angle between rings of axes tried about a colliding point's axis, degrees.
+pub const RING_STEP_DEG: f64 = 5.0;
+
+/// Directions tried on each ring.
+pub const AZIMUTHS: usize = 8;
+
+/// Length of path, mm, after a point no turn clears before the search is tried again.
+pub const RETRY_MM: f64 = 1.0;
+
+/// Least length of path, mm, between keys found in one pass.
+pub const KEY_SPACING_MM: f64 = 1.0;
+
+/// Passes of key search, blend and check per continuous path.
+const PASSES: usize = 4;
+
+/// Angle (radians) an axis may exceed a limit by, for rounding.
+const SLACK: f64 = 1e-9;
+
+/// What a tilt may do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TiltLimits {
+    /// Half the opening of the tolerance cone about each point's planned axis, degrees: γ/2 of
+    /// the orientation smoothing (`cone_angle_deg / 2`).
+    pub cone_half_deg: f64,
+    /// Largest angle of an axis from +Z, degrees (a B/C bed's B limit); `None`: no limit. An
+    /// axis already beyond it may be tilted, but not farther from +Z.
+    pub max_from_z_deg: Option<f64>,
+    /// Length of path, mm, over which a tilt is blended into its neighbours: the smoothing's
+    /// window, so the turn per mm stays within `2 · cone_half_deg / window_mm`.
+    pub window_mm: f64,
+}
+
+impl TiltLimits {
+    /// The largest change of the turn field per mm of path, radians: two cone half-angles (the
+    /// most a turn inside the cone can be) over one window.
+    pub fn slope(&self) -> f64 {
+        2.0 * self.cone_half_deg.to_radians() / self.window_mm.max(1e-9)
+    }
+}
+
+/// A path after [`tilt`].
+#[derive(Debug, Clone)]
+pub struct Tilted {
+    /// The path, its tool axes tilted where that clears moves (positions and all else as
+    /// given).
+    pub path: ToolPath,
+    /// Per feature id, its print moves that collided as given and are clear tilted.
+    pub cleared: BTreeMap<usize, usize>,
+    /// The colliding moves left, in path order, as [`crate::check`] finds them on `path`.
+    pub left: Vec<Collision>,
+}
+
+/// Tilts the tool axes of `path` inside the cone about `planned` (each point's planned axis,
+/// before smoothing: one per point) to clear its colliding print moves, with `head` over
+/// `table`; see the module's comment. Points whose planned or given axis has no direction are
+/// not tilted. A pure stage: `path` is not changed, and its travels are checked, not routed
+/// ([`crate::tilt_and_route`] does both in one walk).
+pub fn tilt(
+    path: &ToolPath,
+    planned: &[V3],
+    head: &Head,
+    table: Option<Table>,
+    limits: &TiltLimits,
+) -> Tilted {
+    let mut out = path.clone();
+    let Routed { left, cleared } = walk(&mut out, head, table, None, Some((planned, limits)));
+    Tilted {
+        path: out,
+        cleared,
+        left,
+    }
+}
+
+/// `v` turned by the rotation vector `w` (Rodrigues).
+fn rotate(v: V3, w: V3) -> V3 {
+    let t = norm(w);
+    if t < 1e-15 {
+        return v;
+    }
+    let k = scale(w, 1.0 / t);
+    let (s, c) = t.sin_cos();
+    add(
+        add(scale(v, c), scale(cross(k, v), s)),
+        scale(k, dot(k, v) * (1.0 - c)),
+    )
+}
+
+/// Angle between unit vectors, radians.
+fn angle(a: V3, b: V3) -> f64 {
+    norm(cross(a, b)).atan2(dot(a, b))
+}
+
+/// The allowed axes at one point: within the cone about its planned axis, and within the B
+/// limit (or no farther from +Z than the given axis already is).
+struct Allowed {
+    planned: V3,
+    half: f64,
+    from_z: f64,
+}
+
+impl Allowed {
+    fn new(planned: V3, given: V3, limits: &TiltLimits) -> Allowed {
+        let from_z = limits.max_from_z_deg.map_or(f64::INFINITY, |b| {
+            b.to_radians().max(angle(given, [0.0, 0.0, 1.0]))
+        });
+        Allowed {
+            planned,
+            half: limits.cone_half_deg.to_radians(),
+            from_z,
+        }
+    }
+
+    fn holds(&self, a: V3) -> bool {
+        angle(a, self.planned) <= self.half + SLACK
+            && (self.from_z.is_infinite() || angle(a, [0.0, 0.0, 1.0]) <= self.from_z + SLACK)
+    }
+
+    /// The allowed axis nearest +Z: the most a tilt can lift the head off the table.
+    fn highest(&self) -> V3 {
+        let z = [0.0, 0.0, 1.0];
+        let off = angle(self.planned, z);
+        if off <= self.half {
+            return z;
+        }
+        let towards = cross(self.planned, z);
+        match unit(towards) {
+            Some(k) => rotate(self.planned, scale(k, self.half)),
+            None => self.planned,
+        }
+    }
+}
+
+/// One continuous path's tilted axes and its moves' collisions after them, or `None` when no
+/// tilt leaves fewer colliding moves without a new one. The run `r` holds `lead` travel
+/// points before the point its bead starts from (`r.start + lead`); `before[k]` is the
+/// collision of the move ending at `r.start + k` as given; `planned` is the run's planned
+/// axes; the travel moves into the run's lead and bead start are checked when `travels`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn tilt_run(
+    scene: &Scene,
+    pts: &[PathPoint],
+    r: Range<usize>,
+    lead: usize,
+    planned: &[V3],
+    limits: &TiltLimits,
+    before: &[Option<Collision>],
+    travels: bool,
+) -> Option<(Vec<V3>, Vec<Option<Collision>>)> {
+    let run = &pts[r.clone()];
+    let given: Vec<V3> = run.iter().map(|q| unit(q.axis)).collect::<Option<_>>()?;
+    let planned: Vec<V3> = planned.iter().map(|&a| unit(a)).collect::<Option<_>>()?;
+    let allowed: Vec<Allowed> = planned
+        .iter()
+        .zip(&given)
+        .map(|(&p, &g)| Allowed::new(p, g, limits))
+        .collect();
+    // Arc length along the bead, its start and the travel points before it at 0.
+    let mut s = vec![0.0; run.len()];
+    for k in lead + 1..run.len() {
+        s[k] = s[k - 1] + norm(sub(run[k].p, run[k - 1].p));
+    }
+    let mut keys: BTreeMap<usize, V3> = BTreeMap::new();
+    let mut tried = vec![false; run.len()];
+    // Where the last search along the bead found no turn: the moves just after it mostly meet
+    // the same obstacle, so the search waits [`RETRY_MM`] of path.
+    let mut failed: Option<f64> = None;
+    let mut axes = given.clone();
+    let mut now: Vec<Option<Collision>> = before.to_vec();
+    for _ in 0..PASSES {
+        let mut added = false;
+        // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
+        // for the blend, and are searched in the next pass if it leaves them colliding.
+        let mut found: Option<f64> = None;
+        for k in 0..run.len() {
+            let Some(c) = now[k] else { continue };
+            // Print moves; and travels into the lead or the bead start where the head
+            // collides at the point itself (no lift clears that).
+            let point = k <= lead && scene.at(run[k].p, axes[k]).is_some();
+            if k <= lead && !point {
+                continue;
+            }
+            // A key on the bead that still collides (its move starts from a blended axis):
+            // the point before it takes the same turn.
+            let (k, w) = match keys.get(&k) {
+                Some(&w)
+                    if k > lead
+                        && !keys.contains_key(&(k - 1))
+                        && allowed[k - 1].holds(rotate(given[k - 1], w))
+                        && near(&keys, &s, k - 1, w, limits) =>
+                {
+                    (k - 1, Some(w))
+                }
+                // Or a turn of its own, if none was searched there yet.
+                Some(_) if k > lead && !keys.contains_key(&(k - 1)) && !tried[k - 1] => {
+                    (k - 1, None)
+                }
+                Some(_) => continue,
+                None if tried[k] => continue,
+                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => continue,
+                None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
+                None => (k, None),
+            };
+            tried[k] = true;
+            let w = w.or_else(|| {
+                let at = Candidate {
+                    k,
+                    lead,
+                    hits: c.hits,
+                };
+                search(scene, run, &given, &allowed, &keys, &s, at, limits)
+            });
+            match w {
+                Some(w) => {
+                    keys.insert(k, w);
+                    found = Some(s[k]);
+                    added = true;
+                }
+                None => failed = Some(s[k]),
+            }
+        }
+        if !added {
+            break;
+        }
+        failed = None;
+        let field = blend(&keys, &s, limits.window_mm);
+        let last = axes.clone();
+        for k in 0..run.len() {
+            axes[k] = apply(given[k], field[k], &allowed[k]);
+        }
+        let mut moved: Vec<PathPoint> = run.to_vec();
+        for (q, &a) in moved.iter_mut().zip(&axes) {
+            q.axis = a;
+        }
+        // Only the moves whose ends turned are checked again.
+        let turned = |k: usize| axes[k] != last[k];
+        now = (0..run.len())
+            .map(|k| {
+                if !(turned(k) || k > 0 && turned(k - 1)) {
+                    return now[k];
+                }
+                let from = match k {
+                    _ if k <= lead && !travels => return None,
+                    0 => r.start.checked_sub(1).map(|j| &pts[j]),
+                    _ => Some(&moved[k - 1]),
+                };
+                move_hit(scene, from, &moved[k], r.start + k)
+            })
+            .collect();
+    }
+    let new = now
+        .iter()
+        .zip(before)
+        .any(|(a, b)| a.is_some() && b.is_none());
+    let fewer = now.iter().flatten().count() < before.iter().flatten().count();
+    (fewer && !new).then_some((axes, now))
+}
+
+/// Whether the turn `w` at `k` differs from the keys beside it (each side's nearest) by at most
+/// the blend's slope times their distance along the path, where they are close enough (two
+/// windows) to be blended linearly with it.
+fn near(keys: &BTreeMap<usize, V3>, s: &[f64], k: usize, w: V3, limits: &TiltLimits) -> bool {
+    let prev = keys.range(..k).next_back();
+    let next = keys.range(k + 1..).next();
+    [prev, next].into_iter().flatten().all(|(&j, &wj)| {
+        let gap = (s[j] - s[k]).abs();
+        gap > 2.0 * limits.window_mm || norm(sub(w, wj)) <= limits.slope() * gap + SLACK
+    })
+}
+
+/// The point of a run a turn is searched for: its index `k`, the run's lead (travel points
+/// before the bead start) and what the head hits there.
+struct Candidate {
+    k: usize,
+    lead: usize,
+    hits: Obstacle,
+}
+
+/// The smallest turn of the axis at `run[at.k]` that clears the print move ending there (its
+/// start point turned alike, and clear itself when it starts the bead), or on the lead and the
+/// bead start the head at the point; allowed there and within the blend's slope of the keys
+/// beside it. `None` when no turn tried clears it, or the axis given is not allowed. Against
+/// the table, the allowed axis nearest +Z is tried first: the head's lowest point rises with
+/// the axis's height, so if that one meets the table plane, every allowed axis does.
+#[allow(clippy::too_many_arguments)]
+fn search(
+    scene: &Scene,
+    run: &[PathPoint],
+    given: &[V3],
+    allowed: &[Allowed],
+    keys: &BTreeMap<usize, V3>,
+    s: &[f64],
+    at: Candidate,
+    limits: &TiltLimits,
+) -> Option<V3> {
+    let Candidate { k, lead, hits } = at;
+    let a = given[k];
+    if !allowed[k].holds(a)
+        || (hits == Obstacle::Table && scene.hits_table(run[k].p, allowed[k].highest()))
+    {
+        return None;
+    }
+    let prev = keys.range(..k).next_back();
+    let next = keys.range(k + 1..).next();
+    let near = |w: V3| near(keys, s, k, w, limits);
+    let clears = |w: V3| {
+        let b = rotate(a, w);
+        if !allowed[k].holds(b) || !near(w) {
+            return false;
+        }
+        if k <= lead {
+            return scene.at(run[k].p, b).is_none();
+        }
+        // The bead's start ends a travel; the sweep leaves it out.
+        let from = (run[k - 1].p, rotate(given[k - 1], w));
+        (k > lead + 1 || scene.at(from.0, from.1).is_none())
+            && scene.sweep(from.0, from.1, run[k].p, b).is_none()
+    };
+    // The nearest key's turn first: neighbours tilted alike keep the axes continuous.
+    let nearest = [prev, next]
+        .into_iter()
+        .flatten()
+        .min_by(|x, y| (s[*x.0] - s[k]).abs().total_cmp(&(s[*y.0] - s[k]).abs()));
+    if let Some((_, &w)) = nearest {
+        if clears(w) {
+            return Some(w);
+        }
+    }
+    // Directions across the axis, the first towards +Z.
+    let up = sub([0.0, 0.0, 1.0], scale(a, a[2]));
+    let e1 = unit(up)
+        .or_else(|| unit(cross(a, [1.0, 0.0, 0.0])))
+        .or_else(|| unit(cross(a, [0.0, 1.0, 0.0])))?;
+    let e2 = cross(a, e1);
+    let most = 2.0 * allowed[k].half;
+    let ring = |t: f64| {
+        (0..AZIMUTHS).find_map(|j| {
+            let phi = std::f64::consts::TAU * j as f64 / AZIMUTHS as f64;
+            let d = add(scale(e1, phi.cos()), scale(e2, phi.sin()));
+            let w = scale(cross(a, d), t);
+            clears(w).then_some(w)
+        })
+    };
+    // Every other ring first (a move no turn clears costs half the rings), then the ring
+    // inside the first that clears.
+    let step = RING_STEP_DEG.to_radians();
+    let rings = (most / step).ceil() as usize;
+    (2..=rings + 1).step_by(2).find_map(|n| {
+        let t = (n as f64 * step).min(most);
+        let w = ring(t)?;
+        Some(ring((n - 1) as f64 * step).unwrap_or(w))
+    })
+}
+
+/// The turn field along a run with arc lengths `s`, from its keys (index → turn): between two
+/// keys at most two windows apart, linear in arc length from one to the other; from the run's
+/// start to a first key at most two windows along, that key's turn; elsewhere each key's turn
+/// falling linearly to nothing over one window. Continuous, and its change per mm
+/// is at most the keys' largest turn over `window`, or the change between two keys over their
+/// distance.
+pub fn blend(keys: &BTreeMap<usize, V3>, s: &[f64], window: f64) -> Vec<V3> {
+    let w = window.max(1e-9);
+    (0..s.len())
+        .map(|j| {
+            let prev = keys.range(..=j).next_back();
+            let next = keys.range(j..).next();
+            match (prev, next) {
+                // From the run's first point (where its bead starts, after a travel) to a key
+                // within two windows, that key's turn is held.
+                (None, Some((&i1, &w1))) if s[i1] - s[0] <= 2.0 * w => w1,
+                (Some((&i0, &w0)), Some((&i1, &w1))) if s[i1] - s[i0] <= 2.0 * w => {
+                    let gap = s[i1] - s[i0];
+                    if gap <= 0.0 {
+                        return w0;
+                    }
+                    let t = (s[j] - s[i0]) / gap;
+                    add(scale(w0, 1.0 - t), scale(w1, t))
+                }
+                _ => {
+                    let ramp = |key: Option<(&usize, &V3)>| {
+                        key.map_or([0.0; 3], |(&i, &wi)| {
+                            scale(wi, (1.0 - (s[j] - s[i]).abs() / w).max(0.0))
+                        })
+                    };
+                    add(ramp(prev), ramp(next))
+                }
+            }
+        })
+        .collect()
+}
+
+/// `a` turned by `w`, or by the largest share of `w` (halved down to a 256th) that stays
+/// allowed; `a` itself when it is not allowed.
+fn apply(a: V3, w: V3, allowed: &Allowed) -> V3 {
+    if norm(w) < 1e-15 || !allowed.holds(a) {
+        return a;
+    }
+    let b = rotate(a, w);
+    if allowed.holds(b) {
+        return b;
+    }
+    // Bisect the share.
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..8 {
+        let mid = 0.5 * (lo + hi);
+        if allowed.holds(rotate(a, scale(w, mid))) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    rotate(a, scale(w, lo))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::check;
+    use toolpath::{MoveKind, Role};
+
+    fn pt(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
+        PathPoint {
+            feature,
+            layer,
+            kind,
+            p,
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.2,
+            width: 0.45,
+            role: Role::Perimeter,
+        }
+    }
+
+    /// A wall 10 mm tall along y at x = 0 (feature 0), then feature 1 printed along it 12 mm
+    /// beside it at the plate, its planned axes +Z but for a gentle wave: the head's body (20 mm
+    /// round, from 8 mm up) holds the wall's top as planned; tilted away by some 10° it does not.
+    fn wall_and_line() -> (ToolPath, Vec<V3>) {
+        let mut points = vec![];
+        for layer in 0..50 {
+            let z = 0.2 * (layer + 1) as f64;
+            points.push(pt(0, layer, MoveKind::Travel, [0.0, -30.0, z]));
+            points.push(pt(0, layer, MoveKind::Print, [0.0, 30.0, z]));
+        }
+        points.push(pt(1, 0, MoveKind::Travel, [12.0, -40.0, 0.2]));
+        for i in 0..=160 {
+            let y = -40.0 + 0.5 * i as f64;
+            let lean = 0.05 * (y / 7.0).sin();
+            let mut q = pt(1, 0, MoveKind::Print, [12.0, y, 0.2]);
+            q.axis = unit([lean, 0.0, 1.0]).unwrap();
+            points.push(q);
+        }
+        let planned = points.iter().map(|q| q.axis).collect();
+        (ToolPath { points }, planned)
+    }
+
+    /// Depth (mm) material must lie inside the head for the brute-force check below: the
+    /// planner's tolerance (0.1), a grain's quarter cell (0.22) and the grain spacing (0.25).
+    const DEPTH: f64 = 0.6;
+
+    /// Independent of the planner's deposit: whether any point of the beads before `i` (every
+    /// 0.1 mm along each) lies more than [`DEPTH`] inside the default head at point `i`, or the
+    /// head more than that below the plate z = 0 (rims sampled).
+    fn brute_hits(points: &[PathPoint], i: usize) -> bool {
+        let (tip_r, tan, nozzle, body_r, body) = (0.5, 30f64.to_radians().tan(), 8.0, 20.0, 60.0);
+        let q = &points[i];
+        let a = unit(q.axis).unwrap();
+        let inside = |m: V3| {
+            let d = sub(m, q.p);
+            let h = dot(d, a);
+            let r = norm(sub(d, scale(a, h)));
+            let cone = h > DEPTH && h < nozzle - DEPTH && r < tip_r + h * tan - DEPTH;
+            let cyl = h > nozzle + DEPTH && h < body - DEPTH && r < body_r - DEPTH;
+            cone || cyl
+        };
+        let group = (q.feature, q.layer);
+        let before = points
+            .iter()
+            .position(|p| (p.feature, p.layer) == group)
+            .unwrap();
+        for j in 1..before {
+            if points[j].kind != MoveKind::Print {
+                continue;
+            }
+            let (u, v) = (points[j - 1].p, points[j].p);
+            let n = (norm(sub(v, u)) / 0.1).ceil() as usize;
+            for t in 0..=n {
+                if inside(add(u, scale(sub(v, u), t as f64 / n as f64))) {
+                    return true;
+                }
+            }
+        }
+        // The plate: the head's rims.
+        let e1 = unit(cross(a, [0.0, 1.0, 0.0])).unwrap();
+        let e2 = cross(a, e1);
+        [
+            (0.0, tip_r),
+            (nozzle, tip_r + nozzle * tan),
+            (nozzle, body_r),
+            (body, body_r),
+        ]
+        .iter()
+        .any(|&(h, r)| {
+            (0..64).any(|k| {
+                let f = std::f64::consts::TAU * k as f64 / 64.0;
+                let p = add(
+                    add(q.p, scale(a, h)),
+                    add(scale(e1, r * f.cos()), scale(e2, r * f.sin())),
+                );
+                p[2] < -DEPTH
+            })
+        })
+    }
+
+    #[test]
+    fn tilt_clears_a_line_beside_a_wall_inside_the_cone_and_continuously() {
+        let head = Head::default();
+        let table = Some(Table::Plane { z: 0.0 });
+        let (path, planned) = wall_and_line();
+        let limits = TiltLimits {
+            cone_half_deg: 30.0,
+            max_from_z_deg: Some(45.0),
+            window_mm: 5.0,
+        };
+        let given = check(&path, &head, table);
+        let prints = |c: &[Collision]| c.iter().filter(|c| c.kind == MoveKind::Print).count();
+        assert!(
+            prints(&given) > 100,
+            "the wall is in the way: {}",
+            given.len()
+        );
+        let t = tilt(&path, &planned, &head, table, &limits);
+        // Only axes change.
+        assert_eq!(t.path.points.len(), path.points.len());
+        for (a, b) in t.path.points.iter().zip(&path.points) {
+            assert_eq!(
+                (a.p, a.kind, a.feature, a.layer, a.e),
+                (b.p, b.kind, b.feature, b.layer, b.e)
+            );
+        }
+        // (c) Fewer colliding moves, as the check finds them again, and what tilt counts.
+        let after = check(&t.path, &head, table);
+        assert_eq!(after, t.left);
+        assert!(
+            prints(&after) < prints(&given),
+            "{} → {}",
+            prints(&given),
+            prints(&after)
+        );
+        let cleared: usize = t.cleared.values().sum();
+        assert_eq!(cleared, prints(&given) - prints(&after));
+        // The moves cleared are clear by the brute-force check, which finds them colliding
+        // as given.
+        let mut seen = 0;
+        for c in &given {
+            if c.kind == MoveKind::Print && after.iter().all(|d| d.index != c.index) {
+                assert!(!brute_hits(&t.path.points, c.index), "move {}", c.index);
+                seen += usize::from(brute_hits(&path.points, c.index));
+            }
+        }
+        assert!(
+            seen > 0,
+            "the brute-force check sees the given moves collide"
+        );
+        // (a) Every axis unit, within the cone about its planned axis and the B limit.
+        for (q, &b) in t.path.points.iter().zip(&planned) {
+            assert!((norm(q.axis) - 1.0).abs() < 1e-9);
+            let off = angle(q.axis, unit(b).unwrap()).to_degrees();
+            assert!(off <= limits.cone_half_deg + 1e-6, "{off}");
+            assert!(angle(q.axis, [0.0, 0.0, 1.0]).to_degrees() <= 45.0 + 1e-6);
+        }
+        // Continuous: along the bead each step turns at most the step as given plus the
+        // blend's slope over the step's length (the turn field is that Lipschitz in arc
+        // length, and turning two axes by turns ω, ω' moves them apart by at most |ω − ω'|).
+        let mut tilted = 0;
+        for j in 1..path.points.len() {
+            let (p0, p1) = (&path.points[j - 1], &path.points[j]);
+            if p1.kind != MoveKind::Print || p0.feature != p1.feature {
+                continue;
+            }
+            let (t0, t1) = (&t.path.points[j - 1], &t.path.points[j]);
+            let len = norm(sub(p1.p, p0.p));
+            let before = angle(p0.axis, p1.axis);
+            let step = angle(t0.axis, t1.axis);
+            assert!(
+                step <= before + limits.slope() * len + 1e-9,
+                "{j}: {step} vs {before}"
+            );
+            tilted += usize::from(angle(t1.axis, p1.axis) > 1e-6);
+        }
+        assert!(tilted > 0);
+        // No cone, no tilt.
+        let none = TiltLimits {
+            cone_half_deg: 0.0,
+            ..limits
+        };
+        let t0 = tilt(&path, &planned, &head, table, &none);
+        assert_eq!(t0.path, path);
+        assert!(t0.cleared.is_empty());
+    }
+
+    #[test]
+    fn blend_holds_keys_and_fades_over_a_window() {
+        let s: Vec<f64> = (0..40).map(|i| i as f64 * 0.5).collect();
+        let mut keys = BTreeMap::new();
+        keys.insert(4, [0.0, 0.2, 0.0]);
+        keys.insert(8, [0.0, 0.1, 0.0]);
+        let f = blend(&keys, &s, 5.0);
+        assert_eq!(f[4], [0.0, 0.2, 0.0]);
+        assert_eq!(f[8], [0.0, 0.1, 0.0]);
+        // Held back to the start, linear between, gone a window after the last key.
+        assert_eq!(f[0], f[4]);
+        assert!((f[6][1] - 0.15).abs() < 1e-12);
+        assert!(f[8 + 10..].iter().all(|w| norm(*w) == 0.0));
+        // Per step: the larger of the change between the keys over their distance (0.1 over
+        // 2 mm) and the last key's turn over the window (0.1 over 5 mm), times 0.5 mm.
+        for j in 1..s.len() {
+            assert!(norm(sub(f[j], f[j - 1])) <= 0.1 / 2.0 * 0.5 + 1e-12);
+        }
+    }
+}
