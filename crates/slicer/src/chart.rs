@@ -145,7 +145,7 @@ impl<'a> Chart<'a> {
     /// largest stretch there), to turn 3-D lengths into chart lengths conservatively.
     pub(crate) fn stretch(&self, q: Point2, d: f64) -> f64 {
         let e = 1e-4;
-        let at = |dq: [f64; 2]| self.at([q[0] + dq[0], q[1] + dq[1]], d).map(|x| x.0);
+        let at = |dq: [f64; 2]| self.point([q[0] + dq[0], q[1] + dq[1]], d);
         match (at([0.0, 0.0]), at([e, 0.0]), at([0.0, e])) {
             (Some(p), Some(a), Some(b)) => ((a - p).norm().max((b - p).norm()) / e).max(1e-6),
             _ => 1.0,
@@ -169,7 +169,7 @@ impl<'a> Chart<'a> {
             let (mut a, mut b) = (c, c);
             a[k] -= e;
             b[k] += e;
-            Some((self.at(b, d)?.0 - self.at(a, d)?.0) / (2.0 * e))
+            Some((self.point(b, d)? - self.point(a, d)?) / (2.0 * e))
         };
         match (diff(0), diff(1)) {
             (Some(ps), Some(pt)) if c[0].is_finite() && c[1].is_finite() => {
@@ -231,6 +231,23 @@ impl<'a> Chart<'a> {
         }
         let m = m / len;
         Some((p, if m.dot(&n) < 0.0 { -m } else { m }))
+    }
+
+    /// The point of [`Chart::at`] alone, without the layer surface's normal (which a
+    /// transition layer takes by central differences, four more evaluations): `None` exactly
+    /// where [`Chart::at`] is.
+    pub fn point(&self, q: Point2, d: f64) -> Option<P3> {
+        let Some(top) = self.blend else {
+            return self.offset_at(q, d).map(|x| x.0);
+        };
+        let plain = Chart {
+            blend: None,
+            ..*self
+        };
+        let lower = top.lower(q);
+        plain
+            .offset_at(q, lower + d * (top.height(q) - lower))
+            .map(|x| x.0)
     }
 
     /// [`Chart::at`] on an offset of the reference.

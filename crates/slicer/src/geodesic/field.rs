@@ -2,7 +2,6 @@
 //! local maximum of a field (a strip's ridge).
 
 use super::mesh::LayerMesh;
-use crate::fast_hash::FastMap;
 use crate::geom2d::Point2;
 use brep::math::{P3, V3};
 use std::cmp::Ordering;
@@ -126,9 +125,9 @@ impl LayerMesh {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
             ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
         };
-        // Each segment with its direction and length computed once, so a vertex's pass over
-        // its cells reads them in a row.
-        let mut grid: FastMap<(i64, i64), Vec<Segment>> = FastMap::default();
+        // Each segment with its direction and length computed once, sorted by cell (row, then
+        // column), so that the cells of one row a vertex looks at are one run of the list.
+        let mut segments: Vec<((i64, i64), Segment)> = vec![];
         for ring in &self.rings {
             let n = ring.len();
             for i in 0..n {
@@ -136,11 +135,46 @@ impl LayerMesh {
                 let qa = self.q[a as usize];
                 let qb = self.q[b as usize];
                 let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
-                grid.entry(key(mid))
-                    .or_default()
-                    .push(Segment::new(self.p[a as usize], self.p[b as usize]));
+                let (i, j) = key(mid);
+                segments.push(((j, i), Segment::new(self.p[a as usize], self.p[b as usize])));
             }
         }
+        segments.sort_by_key(|s| s.0);
+        let cells: Vec<(i64, i64)> = segments.iter().map(|s| s.0).collect();
+        let grid: Vec<Segment> = segments.into_iter().map(|s| s.1).collect();
+        // Where each row's run starts, by row from the lowest one with a segment, when the
+        // rows are few enough to list (else found by bisection).
+        let rows = match (cells.first(), cells.last()) {
+            (Some(a), Some(b)) if b.0 - a.0 < 1 << 20 => {
+                let (j0, n) = (a.0, (b.0 - a.0 + 1) as usize);
+                let mut first = vec![0usize; n + 1];
+                for c in &cells {
+                    first[(c.0 - j0) as usize + 1] += 1;
+                }
+                for r in 0..n {
+                    first[r + 1] += first[r];
+                }
+                Some((j0, first))
+            }
+            _ => None,
+        };
+        // The segments of cells `(i0..=i1, j)`.
+        let run = |j: i64, i0: i64, i1: i64| -> &[Segment] {
+            let (a, b) = match &rows {
+                Some((j0, first)) => {
+                    if j < *j0 || j - j0 >= (first.len() - 1) as i64 {
+                        return &[];
+                    }
+                    let r = (j - j0) as usize;
+                    (first[r], first[r + 1])
+                }
+                None => (0, cells.len()),
+            };
+            let row = &cells[a..b];
+            let lo = a + row.partition_point(|c| *c < (j, i0));
+            let hi = a + row.partition_point(|c| *c <= (j, i1));
+            &grid[lo..hi]
+        };
         let mut out = vec![];
         for (v, q) in self.q.iter().enumerate() {
             let (i, j) = key(*q);
@@ -148,11 +182,9 @@ impl LayerMesh {
             // `segment_distance` squared; the square root of the least square is the least
             // distance (the root is monotone and rounded correctly).
             let mut best2 = f64::INFINITY;
-            for a in i - 2..=i + 2 {
-                for b in j - 2..=j + 2 {
-                    for s in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
-                        best2 = best2.min(s.distance2(&p));
-                    }
+            for b in j - 2..=j + 2 {
+                for s in run(b, i - 2, i + 2) {
+                    best2 = best2.min(s.distance2(&p));
                 }
             }
             let mut best = best2.sqrt();

@@ -144,8 +144,8 @@ pub(crate) fn fill_region(
     }
     let mut pts = Vec::with_capacity(lm.q.len());
     for q in &lm.q {
-        match chart.at(*q, z) {
-            Some((p, _)) => pts.push(p),
+        match chart.point(*q, z) {
+            Some(p) => pts.push(p),
             None => return out,
         }
     }
@@ -299,8 +299,8 @@ pub(crate) fn fill_region(
     let stretch = {
         let e = 1e-3;
         let step = |d: [f64; 2]| -> Option<V3> {
-            let a = chart.at([q0[0] + e * d[0], q0[1] + e * d[1]], z)?.0;
-            let b = chart.at([q0[0] - e * d[0], q0[1] - e * d[1]], z)?.0;
+            let a = chart.point([q0[0] + e * d[0], q0[1] + e * d[1]], z)?;
+            let b = chart.point([q0[0] - e * d[0], q0[1] - e * d[1]], z)?;
             Some((a - b) / (2.0 * e))
         };
         match (step(dir), step(nrm)) {
@@ -521,8 +521,8 @@ fn conserved(
 
 /// The length on the layer surface at `d` of the chart segment `a`–`b` (its chord there).
 fn surface_length(chart: &Chart, d: f64, a: Point2, b: Point2) -> f64 {
-    match (chart.at(a, d), chart.at(b, d)) {
-        (Some((p, _)), Some((q, _))) => (q - p).norm(),
+    match (chart.point(a, d), chart.point(b, d)) {
+        (Some(p), Some(q)) => (q - p).norm(),
         _ => f64::NAN,
     }
 }
