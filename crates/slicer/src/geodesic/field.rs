@@ -200,13 +200,16 @@ impl LayerMesh {
 
     /// For each vertex where `mask` holds, the largest `f` over the vertices joined to it
     /// through the mesh within 3-D distance `radius` (others get `f` itself): the local height
-    /// of a ridge of `f` seen from its flanks.
-    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
+    /// of a ridge of `f` seen from its flanks. Exact up to the vertex's `cap`: its search stops
+    /// at the first value above that, which it keeps (above `cap`, at most the largest); with
+    /// `f64::INFINITY` the value is exact.
+    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool], cap: &[f64]) -> Vec<f64> {
         let mut out = f.to_vec();
         if !mask.iter().any(|&m| m) {
             return out;
         }
         let (first, next) = self.neighbours();
+        let around = |u: usize| &next[first[u] as usize..first[u + 1] as usize];
         let within = sqrt_at_most(radius);
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
         // between vertices; each vertex's distance is taken once per flood).
@@ -216,18 +219,57 @@ impl LayerMesh {
             if !mask[v] {
                 continue;
             }
+            let pv = self.p[v];
+            let cap = cap[v];
+            // A climb first, from each vertex to its highest neighbour inside the ball while
+            // that is higher: every vertex on the way is joined to v inside the ball, and a
+            // flank's climb passes the cap in a few steps where the search would look at the
+            // whole ball.
+            let mut climbed = f[v];
+            let mut u = v;
+            while !(climbed > cap) {
+                let mut hi = if f[u].is_finite() {
+                    f[u]
+                } else {
+                    f64::NEG_INFINITY
+                };
+                let mut step = None;
+                for &x in around(u) {
+                    let fx = f[x as usize];
+                    if fx.is_finite()
+                        && fx > hi
+                        && (self.p[x as usize] - pv).norm_squared() <= within
+                    {
+                        hi = fx;
+                        step = Some(x as usize);
+                    }
+                }
+                match step {
+                    Some(x) => {
+                        u = x;
+                        climbed = climbed.max(hi);
+                    }
+                    None => break,
+                }
+            }
+            if climbed > cap {
+                out[v] = climbed;
+                continue;
+            }
             let stamp = v as u32 + 1;
             stack.clear();
             stack.push(v as u32);
             seen[v] = stamp;
             let mut best = f[v];
-            let pv = self.p[v];
             while let Some(u) = stack.pop() {
                 let u = u as usize;
                 if f[u].is_finite() {
                     best = best.max(f[u]);
                 }
-                for &x in &next[first[u] as usize..first[u + 1] as usize] {
+                if best > cap {
+                    break;
+                }
+                for &x in around(u) {
                     if seen[x as usize] != stamp {
                         seen[x as usize] = stamp;
                         if (self.p[x as usize] - pv).norm_squared() <= within {
