@@ -41,6 +41,21 @@ impl Segment {
     }
 }
 
+/// An occupied cell of [`LayerMesh::boundary_seeds`]' grid: its key (row, column), its run of
+/// segments and their 3-D box.
+struct Cell {
+    key: (i64, i64),
+    start: usize,
+    end: usize,
+    lo: P3,
+    hi: P3,
+}
+
+/// Squared distance (mm²) by which a cell's box must lie beyond the least segment distance so
+/// far for the cell to be passed over: far above the round-off of either (some 1e-13 mm² for
+/// parts a metre across), far below any distance that matters.
+const BOX_SLACK: f64 = 1e-9;
+
 /// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
 /// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
 /// the root, without taking it.
@@ -140,16 +155,36 @@ impl LayerMesh {
             }
         }
         segments.sort_by_key(|s| s.0);
-        let cells: Vec<(i64, i64)> = segments.iter().map(|s| s.0).collect();
-        let grid: Vec<Segment> = segments.into_iter().map(|s| s.1).collect();
-        // Where each row's run starts, by row from the lowest one with a segment, when the
+        let grid: Vec<Segment> = segments.iter().map(|s| s.1).collect();
+        // The occupied cells in that order: each with its run of `grid` and the 3-D box of its
+        // segments, which bounds their distance from below.
+        let mut cells: Vec<Cell> = vec![];
+        for (k, (c, seg)) in segments.iter().enumerate() {
+            let b = seg.a + seg.d;
+            let (lo, hi) = (seg.a.inf(&b), seg.a.sup(&b));
+            match cells.last_mut() {
+                Some(last) if last.key == *c => {
+                    last.end = k + 1;
+                    last.lo = last.lo.inf(&lo);
+                    last.hi = last.hi.sup(&hi);
+                }
+                _ => cells.push(Cell {
+                    key: *c,
+                    start: k,
+                    end: k + 1,
+                    lo,
+                    hi,
+                }),
+            }
+        }
+        // Where each row's cells start, by row from the lowest one with a segment, when the
         // rows are few enough to list (else found by bisection).
         let rows = match (cells.first(), cells.last()) {
-            (Some(a), Some(b)) if b.0 - a.0 < 1 << 20 => {
-                let (j0, n) = (a.0, (b.0 - a.0 + 1) as usize);
+            (Some(a), Some(b)) if b.key.0 - a.key.0 < 1 << 20 => {
+                let (j0, n) = (a.key.0, (b.key.0 - a.key.0 + 1) as usize);
                 let mut first = vec![0usize; n + 1];
                 for c in &cells {
-                    first[(c.0 - j0) as usize + 1] += 1;
+                    first[(c.key.0 - j0) as usize + 1] += 1;
                 }
                 for r in 0..n {
                     first[r + 1] += first[r];
@@ -158,8 +193,8 @@ impl LayerMesh {
             }
             _ => None,
         };
-        // The segments of cells `(i0..=i1, j)`.
-        let run = |j: i64, i0: i64, i1: i64| -> &[Segment] {
+        // The occupied cells `(i0..=i1, j)`.
+        let run = |j: i64, i0: i64, i1: i64| -> &[Cell] {
             let (a, b) = match &rows {
                 Some((j0, first)) => {
                     if j < *j0 || j - j0 >= (first.len() - 1) as i64 {
@@ -171,20 +206,28 @@ impl LayerMesh {
                 None => (0, cells.len()),
             };
             let row = &cells[a..b];
-            let lo = a + row.partition_point(|c| *c < (j, i0));
-            let hi = a + row.partition_point(|c| *c <= (j, i1));
-            &grid[lo..hi]
+            let lo = a + row.partition_point(|c| c.key < (j, i0));
+            let hi = a + row.partition_point(|c| c.key <= (j, i1));
+            &cells[lo..hi]
         };
         let mut out = vec![];
         for (v, q) in self.q.iter().enumerate() {
             let (i, j) = key(*q);
             let p = self.p[v];
             // `segment_distance` squared; the square root of the least square is the least
-            // distance (the root is monotone and rounded correctly).
+            // distance (the root is monotone and rounded correctly). The vertex's own row
+            // first; a cell whose box lies farther than the least so far (by more than any
+            // round-off) holds no nearer segment and is passed over.
             let mut best2 = f64::INFINITY;
-            for b in j - 2..=j + 2 {
-                for s in run(b, i - 2, i + 2) {
-                    best2 = best2.min(s.distance2(&p));
+            for b in [j, j - 1, j + 1, j - 2, j + 2] {
+                for c in run(b, i - 2, i + 2) {
+                    let out = (c.lo - p).sup(&(p - c.hi)).sup(&V3::zeros());
+                    if out.norm_squared() > best2 + BOX_SLACK {
+                        continue;
+                    }
+                    for s in &grid[c.start..c.end] {
+                        best2 = best2.min(s.distance2(&p));
+                    }
                 }
             }
             let mut best = best2.sqrt();
