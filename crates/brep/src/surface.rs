@@ -376,6 +376,32 @@ impl Surface {
         }
     }
 
+    /// [`Surface::eval`] and [`Surface::normal`] together, the same values bit for bit: a
+    /// surface of revolution evaluates its profile (point and derivative in one pass) and
+    /// the angle's sine and cosine once for both, instead of the profile three times.
+    pub fn eval_normal(&self, u: f64, v: f64) -> (P3, Option<V3>) {
+        let Surface::Revolution(rev) = self else {
+            return (self.eval(u, v), self.normal(u, v));
+        };
+        let (pt, w1) = rev.profile.eval_d1(v);
+        let ax = rev.axis;
+        let w = pt - rev.origin;
+        let a = w.dot(&ax);
+        let r = w - ax * a;
+        let (s, c) = (u.sin(), u.cos());
+        let p = rev.origin + ax * a + r * c + ax.cross(&r) * s;
+        let a1 = w1.dot(&ax);
+        let r1 = w1 - ax * a1;
+        let su = -r * s + ax.cross(&r) * c;
+        let sv = ax * a1 + r1 * c + ax.cross(&r1) * s;
+        let n = su.cross(&sv);
+        let scale = su.norm() * sv.norm();
+        if scale > 0.0 && n.norm() > PARALLEL * scale {
+            return (p, Some(n / n.norm()));
+        }
+        (p, self.normal(u, v))
+    }
+
     /// The natural unit normal `S_u × S_v / |S_u × S_v|`, or `None` where it degenerates (a pole,
     /// an apex). Poles of spheres, cones and revolved profiles touching the axis get their limit.
     pub fn normal(&self, u: f64, v: f64) -> Option<V3> {

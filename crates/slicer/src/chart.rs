@@ -117,10 +117,11 @@ impl<'a> Chart<'a> {
             r.map(|(a, b)| x.clamp(a.min(b), a.max(b))).unwrap_or(x)
         };
         let (uc, vc) = (clamp(u, bu), clamp(v, bv));
-        let n = self.normal_at(uc, vc)?;
         if uc == u && vc == v {
-            return Some((self.surf.eval(u, v), n));
+            let (p, n) = self.surf.eval_normal(u, v);
+            return Some((p, n? * self.sign));
         }
+        let n = self.normal_at(uc, vc)?;
         let (p, su, sv) = self.surf.eval_d1(uc, vc);
         Some((p + su * (u - uc) + sv * (v - vc), n))
     }
@@ -255,7 +256,10 @@ impl<'a> Chart<'a> {
         let (u, v) = self.uv(q)?;
         let (f, n) = match self.kind {
             ChartKind::Native { .. } => self.eval_ext(u, v)?,
-            ChartKind::Ortho { .. } => (self.surf.eval(u, v), self.normal_at(u, v)?),
+            ChartKind::Ortho { .. } => {
+                let (p, n) = self.surf.eval_normal(u, v);
+                (p, n? * self.sign)
+            }
         };
         let p = f + n * d;
         (p.coords.iter().all(|x| x.is_finite()) && n.iter().all(|x| x.is_finite()))
