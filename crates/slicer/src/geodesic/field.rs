@@ -251,7 +251,7 @@ impl LayerMesh {
         if !mask.iter().any(|&m| m) {
             return out;
         }
-        let (first, next) = self.neighbours();
+        let (first, next) = self.adjacency.get_or_init(|| self.neighbours());
         let around = |u: usize| &next[first[u] as usize..first[u + 1] as usize];
         let within = sqrt_at_most(radius);
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
@@ -327,7 +327,7 @@ impl LayerMesh {
     }
 
     /// The vertices joined to each vertex by an edge of a triangle, as offsets (`first[v]` ..
-    /// `first[v + 1]`) into one list.
+    /// `first[v + 1]`) into one list (kept in `adjacency` once made).
     fn neighbours(&self) -> (Vec<u32>, Vec<u32>) {
         let n = self.q.len();
         let mut first = Vec::with_capacity(n + 1);

@@ -20,6 +20,9 @@ pub struct LayerMesh {
     pub rings: Vec<Vec<u32>>,
     /// Triangles around each vertex.
     pub(super) around: Vec<Vec<u32>>,
+    /// The vertices joined to each vertex by an edge (offsets into one list, and the list),
+    /// made by the first search that needs them.
+    pub(super) adjacency: std::sync::OnceLock<(Vec<u32>, Vec<u32>)>,
     /// The upper-triangular map `(m00, m01, m11)` from chart to the surface-isotropic frame
     /// of [`LayerMesh::build_with_metric`]; `None`: the chart itself.
     pub(super) frame: Option<[f64; 3]>,
