@@ -210,19 +210,21 @@ impl LayerMesh {
             let hi = a + row.partition_point(|c| c.key <= (j, i1));
             &cells[lo..hi]
         };
+        let reach2 = reach * reach;
         let mut out = vec![];
         for (v, q) in self.q.iter().enumerate() {
             let (i, j) = key(*q);
             let p = self.p[v];
             // `segment_distance` squared; the square root of the least square is the least
             // distance (the root is monotone and rounded correctly). The vertex's own row
-            // first; a cell whose box lies farther than the least so far (by more than any
-            // round-off) holds no nearer segment and is passed over.
+            // first; a cell whose box lies farther than the least so far, or than `reach` (a
+            // vertex farther than that is no seed), by more than any round-off, holds no
+            // segment that matters and is passed over.
             let mut best2 = f64::INFINITY;
             for b in [j, j - 1, j + 1, j - 2, j + 2] {
                 for c in run(b, i - 2, i + 2) {
                     let out = (c.lo - p).sup(&(p - c.hi)).sup(&V3::zeros());
-                    if out.norm_squared() > best2 + BOX_SLACK {
+                    if out.norm_squared() > best2.min(reach2) + BOX_SLACK {
                         continue;
                     }
                     for s in &grid[c.start..c.end] {
