@@ -168,7 +168,10 @@ impl Row {
     /// [`RegionIndex::contains`] of the point at `x` on the line: an odd number of crossings
     /// beyond `x`.
     pub(crate) fn contains(&self, x: f64) -> bool {
-        let beyond = self.xs.len() - self.xs.partition_point(|c| !(*c > x));
+        let beyond = self.xs.len()
+            - self
+                .xs
+                .partition_point(|c| c.partial_cmp(&x) != Some(std::cmp::Ordering::Greater));
         beyond % 2 == 1
     }
 }

@@ -272,7 +272,7 @@ impl LayerMesh {
             // whole ball.
             let mut climbed = f[v];
             let mut u = v;
-            while !(climbed > cap) {
+            while climbed.partial_cmp(&cap) != Some(Ordering::Greater) {
                 let mut hi = if f[u].is_finite() {
                     f[u]
                 } else {
