@@ -376,6 +376,60 @@ impl Surface {
         }
     }
 
+    /// [`Surface::eval`] and [`Surface::normal`] together, the same values bit for bit: a
+    /// cylinder, cone or surface of revolution takes the angle's sine and cosine once for
+    /// both, and a surface of revolution evaluates its profile once (point and derivative in
+    /// one pass) instead of three times.
+    pub fn eval_normal(&self, u: f64, v: f64) -> (P3, Option<V3>) {
+        let (p, su, sv) = match self {
+            Surface::Cylinder { frame, radius } => {
+                let (s, c) = (u.sin(), u.cos());
+                (
+                    frame.at(radius * c, radius * s, v),
+                    frame.vec(-radius * s, radius * c, 0.0),
+                    frame.z,
+                )
+            }
+            Surface::Cone {
+                frame,
+                radius,
+                semi_angle,
+            } => {
+                let (s, c) = (u.sin(), u.cos());
+                let t = semi_angle.tan();
+                let r = radius + v * t;
+                (
+                    frame.at(r * c, r * s, v),
+                    frame.vec(-r * s, r * c, 0.0),
+                    frame.vec(t * c, t * s, 1.0),
+                )
+            }
+            Surface::Revolution(rev) => {
+                let (pt, w1) = rev.profile.eval_d1(v);
+                let ax = rev.axis;
+                let w = pt - rev.origin;
+                let a = w.dot(&ax);
+                let r = w - ax * a;
+                let (s, c) = (u.sin(), u.cos());
+                let a1 = w1.dot(&ax);
+                let r1 = w1 - ax * a1;
+                (
+                    rev.origin + ax * a + r * c + ax.cross(&r) * s,
+                    -r * s + ax.cross(&r) * c,
+                    ax * a1 + r1 * c + ax.cross(&r1) * s,
+                )
+            }
+            _ => return (self.eval(u, v), self.normal(u, v)),
+        };
+        // As `normal`; where the derivatives degenerate, `normal` itself steps off.
+        let n = su.cross(&sv);
+        let scale = su.norm() * sv.norm();
+        if scale > 0.0 && n.norm() > PARALLEL * scale {
+            return (p, Some(n / n.norm()));
+        }
+        (p, self.normal(u, v))
+    }
+
     /// The natural unit normal `S_u × S_v / |S_u × S_v|`, or `None` where it degenerates (a pole,
     /// an apex). Poles of spheres, cones and revolved profiles touching the axis get their limit.
     pub fn normal(&self, u: f64, v: f64) -> Option<V3> {

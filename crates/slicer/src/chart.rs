@@ -124,10 +124,11 @@ impl<'a> Chart<'a> {
             r.map(|(a, b)| x.clamp(a.min(b), a.max(b))).unwrap_or(x)
         };
         let (uc, vc) = (clamp(u, bu), clamp(v, bv));
-        let n = self.normal_at(uc, vc)?;
         if uc == u && vc == v {
-            return Some((self.surf.eval(u, v), n));
+            let (p, n) = self.surf.eval_normal(u, v);
+            return Some((p, n? * self.sign));
         }
+        let n = self.normal_at(uc, vc)?;
         let (p, su, sv) = self.surf.eval_d1(uc, vc);
         Some((p + su * (u - uc) + sv * (v - vc), n))
     }
@@ -152,7 +153,7 @@ impl<'a> Chart<'a> {
     /// largest stretch there), to turn 3-D lengths into chart lengths conservatively.
     pub(crate) fn stretch(&self, q: Point2, d: f64) -> f64 {
         let e = 1e-4;
-        let at = |dq: [f64; 2]| self.at([q[0] + dq[0], q[1] + dq[1]], d).map(|x| x.0);
+        let at = |dq: [f64; 2]| self.point([q[0] + dq[0], q[1] + dq[1]], d);
         match (at([0.0, 0.0]), at([e, 0.0]), at([0.0, e])) {
             (Some(p), Some(a), Some(b)) => ((a - p).norm().max((b - p).norm()) / e).max(1e-6),
             _ => 1.0,
@@ -176,7 +177,7 @@ impl<'a> Chart<'a> {
             let (mut a, mut b) = (c, c);
             a[k] -= e;
             b[k] += e;
-            Some((self.at(b, d)?.0 - self.at(a, d)?.0) / (2.0 * e))
+            Some((self.point(b, d)? - self.point(a, d)?) / (2.0 * e))
         };
         match (diff(0), diff(1)) {
             (Some(ps), Some(pt)) if c[0].is_finite() && c[1].is_finite() => {
@@ -241,12 +242,32 @@ impl<'a> Chart<'a> {
         Some((p, if m.dot(&n) < 0.0 { -m } else { m }))
     }
 
+    /// The point of [`Chart::at`] alone, without the layer surface's normal (which a
+    /// transition layer takes by central differences, four more evaluations): `None` exactly
+    /// where [`Chart::at`] is.
+    pub fn point(&self, q: Point2, d: f64) -> Option<P3> {
+        let Some(top) = self.blend else {
+            return self.offset_at(q, d).map(|x| x.0);
+        };
+        let plain = Chart {
+            blend: None,
+            ..*self
+        };
+        let lower = top.lower(q);
+        plain
+            .offset_at(q, lower + d * (top.height(q) - lower))
+            .map(|x| x.0)
+    }
+
     /// [`Chart::at`] on an offset of the reference.
     fn offset_at(&self, q: Point2, d: f64) -> Option<(P3, V3)> {
         let (u, v) = self.uv(q)?;
         let (f, n) = match self.kind {
             ChartKind::Native { .. } => self.eval_ext(u, v)?,
-            ChartKind::Ortho { .. } => (self.surf.eval(u, v), self.normal_at(u, v)?),
+            ChartKind::Ortho { .. } => {
+                let (p, n) = self.surf.eval_normal(u, v);
+                (p, n? * self.sign)
+            }
         };
         let p = f + self.along.unwrap_or(n) * d;
         (p.coords.iter().all(|x| x.is_finite()) && n.iter().all(|x| x.is_finite()))

@@ -143,6 +143,37 @@ impl RegionIndex {
         }
         inside
     }
+
+    /// The region's crossings of the line at height `y`, for [`RegionIndex::contains`] of many
+    /// points on it: where [`crosses_right`] puts each edge's crossing (the same arithmetic,
+    /// so the same answers), in increasing order.
+    pub(crate) fn row(&self, y: f64) -> Row {
+        let mut xs: Vec<f64> = self.bands[self.band(y)]
+            .iter()
+            .filter(|(a, b)| (a[1] > y) != (b[1] > y))
+            .map(|(a, b)| a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]))
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        Row { xs }
+    }
+}
+
+/// The crossings of one horizontal line with a region's edges ([`RegionIndex::row`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Row {
+    xs: Vec<f64>,
+}
+
+impl Row {
+    /// [`RegionIndex::contains`] of the point at `x` on the line: an odd number of crossings
+    /// beyond `x`.
+    pub(crate) fn contains(&self, x: f64) -> bool {
+        let beyond = self.xs.len()
+            - self
+                .xs
+                .partition_point(|c| c.partial_cmp(&x) != Some(std::cmp::Ordering::Greater));
+        beyond % 2 == 1
+    }
 }
 
 /// Distance from `p` to the segment `a`–`b`.

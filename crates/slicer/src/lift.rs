@@ -24,20 +24,29 @@ pub(crate) struct Lifted {
 
 /// Lifts a chart polyline onto the offset surface at `z`, inserting points until every chord
 /// is within `tol` of the surface, then dropping points whose removal keeps the polyline
-/// within `tol / 2` of the dense one (Douglas–Peucker in 3-D).
+/// within `tol / 2` of the dense one (Douglas–Peucker in 3-D). On a transition layer, whose
+/// normal takes four more evaluations than its point, only the points kept get a normal.
 pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lifted> {
+    // The point at `q`, with its normal where that costs nothing more (zero: to be taken).
+    let lazy = chart.blend.is_some();
+    let eval = |q: Point2| -> Option<(P3, V3)> {
+        if lazy {
+            chart.point(q, z).map(|p| (p, V3::zeros()))
+        } else {
+            chart.at(q, z)
+        }
+    };
     fn refine(
-        chart: &Chart,
+        eval: &dyn Fn(Point2) -> Option<(P3, V3)>,
         a: Lifted,
         b: Lifted,
-        z: f64,
         tol: f64,
         depth: u32,
         out: &mut Vec<Lifted>,
     ) {
         if depth < 10 {
             let qm = [0.5 * (a.q[0] + b.q[0]), 0.5 * (a.q[1] + b.q[1])];
-            if let Some((p, n)) = chart.at(qm, z) {
+            if let Some((p, n)) = eval(qm) {
                 let mid = Lifted {
                     q: qm,
                     p,
@@ -47,8 +56,8 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
                     role: a.role,
                 };
                 if (p - P3::from(0.5 * (a.p.coords + b.p.coords))).norm() > tol {
-                    refine(chart, a, mid, z, tol, depth + 1, out);
-                    refine(chart, mid, b, z, tol, depth + 1, out);
+                    refine(eval, a, mid, tol, depth + 1, out);
+                    refine(eval, mid, b, tol, depth + 1, out);
                     return;
                 }
             }
@@ -57,7 +66,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
     }
     let mut dense: Vec<Lifted> = vec![];
     for (q, w) in path.points.iter().zip(&path.widths) {
-        let Some((p, n)) = chart.at(*q, z) else {
+        let Some((p, n)) = eval(*q) else {
             continue;
         };
         let cur = Lifted {
@@ -69,39 +78,50 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
             role: path.role,
         };
         match dense.last().copied() {
-            Some(prev) => refine(chart, prev, cur, z, tol, 0, &mut dense),
+            Some(prev) => refine(&eval, prev, cur, tol, 0, &mut dense),
             None => dense.push(cur),
         }
     }
-    if dense.len() <= 2 {
-        return dense;
-    }
-    let mut keep = vec![false; dense.len()];
-    keep[0] = true;
-    keep[dense.len() - 1] = true;
-    let mut stack = vec![(0usize, dense.len() - 1)];
-    while let Some((i, j)) = stack.pop() {
-        if j <= i + 1 {
-            continue;
-        }
-        let (a, b) = (dense[i].p, dense[j].p);
-        let (mut worst, mut at) = (0.0f64, i);
-        for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
-            let d = segment_distance(&x.p, &a, &b);
-            if d > worst {
-                worst = d;
-                at = k;
+    let mut kept = if dense.len() <= 2 {
+        dense
+    } else {
+        let mut keep = vec![false; dense.len()];
+        keep[0] = true;
+        keep[dense.len() - 1] = true;
+        let mut stack = vec![(0usize, dense.len() - 1)];
+        while let Some((i, j)) = stack.pop() {
+            if j <= i + 1 {
+                continue;
+            }
+            let (a, b) = (dense[i].p, dense[j].p);
+            let (mut worst, mut at) = (0.0f64, i);
+            for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
+                let d = segment_distance(&x.p, &a, &b);
+                if d > worst {
+                    worst = d;
+                    at = k;
+                }
+            }
+            if worst > 0.5 * tol {
+                keep[at] = true;
+                stack.push((i, at));
+                stack.push((at, j));
             }
         }
-        if worst > 0.5 * tol {
-            keep[at] = true;
-            stack.push((i, at));
-            stack.push((at, j));
+        dense
+            .into_iter()
+            .zip(keep)
+            .filter_map(|(x, k)| k.then_some(x))
+            .collect::<Vec<_>>()
+    };
+    if lazy {
+        // The same point again, with its normal.
+        for x in &mut kept {
+            if let Some((_, n)) = chart.at(x.q, z) {
+                x.n = n;
+                x.ln = n;
+            }
         }
     }
-    dense
-        .into_iter()
-        .zip(keep)
-        .filter_map(|(x, k)| k.then_some(x))
-        .collect()
+    kept
 }

@@ -103,13 +103,15 @@ pub(crate) fn build_top_field(
     // points put back on its exact surface (the slicing mesh's own facets stray by degrees
     // at its chord tolerance), keeps it near 0.3° on R = 47 mm.
     let mut pieces = vec![];
+    // One face at a time over the whole mesh's points (copied once, not once per face).
+    let mut one = Mesh {
+        positions: mesh.positions.clone(),
+        faces: vec![],
+        edge_points: Default::default(),
+        edge_params: Default::default(),
+    };
     for ft in &top.faces {
-        let one = Mesh {
-            positions: mesh.positions.clone(),
-            faces: vec![ft.clone()],
-            edge_points: Default::default(),
-            edge_params: Default::default(),
-        };
+        one.faces = vec![ft.clone()];
         let mut fine = compact(&refined(&compact(&one), TOP_EDGE));
         let surf = brep.face_surface(ft.face);
         for p in &mut fine.positions {

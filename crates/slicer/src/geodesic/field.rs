@@ -2,7 +2,6 @@
 //! local maximum of a field (a strip's ridge).
 
 use super::mesh::LayerMesh;
-use crate::fast_hash::FastMap;
 use crate::geom2d::Point2;
 use brep::math::{P3, V3};
 use std::cmp::Ordering;
@@ -41,6 +40,21 @@ impl Segment {
         (p - (self.a + self.d * t)).norm_squared()
     }
 }
+
+/// An occupied cell of [`LayerMesh::boundary_seeds`]' grid: its key (row, column), its run of
+/// segments and their 3-D box.
+struct Cell {
+    key: (i64, i64),
+    start: usize,
+    end: usize,
+    lo: P3,
+    hi: P3,
+}
+
+/// Squared distance (mm²) by which a cell's box must lie beyond the least segment distance so
+/// far for the cell to be passed over: far above the round-off of either (some 1e-13 mm² for
+/// parts a metre across), far below any distance that matters.
+const BOX_SLACK: f64 = 1e-9;
 
 /// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
 /// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
@@ -126,9 +140,9 @@ impl LayerMesh {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];
             ((y[0] / cell).floor() as i64, (y[1] / cell).floor() as i64)
         };
-        // Each segment with its direction and length computed once, so a vertex's pass over
-        // its cells reads them in a row.
-        let mut grid: FastMap<(i64, i64), Vec<Segment>> = FastMap::default();
+        // Each segment with its direction and length computed once, sorted by cell (row, then
+        // column), so that the cells of one row a vertex looks at are one run of the list.
+        let mut segments: Vec<((i64, i64), Segment)> = vec![];
         for ring in &self.rings {
             let n = ring.len();
             for i in 0..n {
@@ -136,21 +150,84 @@ impl LayerMesh {
                 let qa = self.q[a as usize];
                 let qb = self.q[b as usize];
                 let mid = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
-                grid.entry(key(mid))
-                    .or_default()
-                    .push(Segment::new(self.p[a as usize], self.p[b as usize]));
+                let (i, j) = key(mid);
+                segments.push(((j, i), Segment::new(self.p[a as usize], self.p[b as usize])));
             }
         }
+        segments.sort_by_key(|s| s.0);
+        let grid: Vec<Segment> = segments.iter().map(|s| s.1).collect();
+        // The occupied cells in that order: each with its run of `grid` and the 3-D box of its
+        // segments, which bounds their distance from below.
+        let mut cells: Vec<Cell> = vec![];
+        for (k, (c, seg)) in segments.iter().enumerate() {
+            let b = seg.a + seg.d;
+            let (lo, hi) = (seg.a.inf(&b), seg.a.sup(&b));
+            match cells.last_mut() {
+                Some(last) if last.key == *c => {
+                    last.end = k + 1;
+                    last.lo = last.lo.inf(&lo);
+                    last.hi = last.hi.sup(&hi);
+                }
+                _ => cells.push(Cell {
+                    key: *c,
+                    start: k,
+                    end: k + 1,
+                    lo,
+                    hi,
+                }),
+            }
+        }
+        // Where each row's cells start, by row from the lowest one with a segment, when the
+        // rows are few enough to list (else found by bisection).
+        let rows = match (cells.first(), cells.last()) {
+            (Some(a), Some(b)) if b.key.0 - a.key.0 < 1 << 20 => {
+                let (j0, n) = (a.key.0, (b.key.0 - a.key.0 + 1) as usize);
+                let mut first = vec![0usize; n + 1];
+                for c in &cells {
+                    first[(c.key.0 - j0) as usize + 1] += 1;
+                }
+                for r in 0..n {
+                    first[r + 1] += first[r];
+                }
+                Some((j0, first))
+            }
+            _ => None,
+        };
+        // The occupied cells `(i0..=i1, j)`.
+        let run = |j: i64, i0: i64, i1: i64| -> &[Cell] {
+            let (a, b) = match &rows {
+                Some((j0, first)) => {
+                    if j < *j0 || j - j0 >= (first.len() - 1) as i64 {
+                        return &[];
+                    }
+                    let r = (j - j0) as usize;
+                    (first[r], first[r + 1])
+                }
+                None => (0, cells.len()),
+            };
+            let row = &cells[a..b];
+            let lo = a + row.partition_point(|c| c.key < (j, i0));
+            let hi = a + row.partition_point(|c| c.key <= (j, i1));
+            &cells[lo..hi]
+        };
+        let reach2 = reach * reach;
         let mut out = vec![];
         for (v, q) in self.q.iter().enumerate() {
             let (i, j) = key(*q);
             let p = self.p[v];
             // `segment_distance` squared; the square root of the least square is the least
-            // distance (the root is monotone and rounded correctly).
+            // distance (the root is monotone and rounded correctly). The vertex's own row
+            // first; a cell whose box lies farther than the least so far, or than `reach` (a
+            // vertex farther than that is no seed), by more than any round-off, holds no
+            // segment that matters and is passed over.
             let mut best2 = f64::INFINITY;
-            for a in i - 2..=i + 2 {
-                for b in j - 2..=j + 2 {
-                    for s in grid.get(&(a, b)).map(|x| x.as_slice()).unwrap_or(&[]) {
+            for b in [j, j - 1, j + 1, j - 2, j + 2] {
+                for c in run(b, i - 2, i + 2) {
+                    let out = (c.lo - p).sup(&(p - c.hi)).sup(&V3::zeros());
+                    if out.norm_squared() > best2.min(reach2) + BOX_SLACK {
+                        continue;
+                    }
+                    for s in &grid[c.start..c.end] {
                         best2 = best2.min(s.distance2(&p));
                     }
                 }
@@ -168,13 +245,16 @@ impl LayerMesh {
 
     /// For each vertex where `mask` holds, the largest `f` over the vertices joined to it
     /// through the mesh within 3-D distance `radius` (others get `f` itself): the local height
-    /// of a ridge of `f` seen from its flanks.
-    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool]) -> Vec<f64> {
+    /// of a ridge of `f` seen from its flanks. Exact up to the vertex's `cap`: its search stops
+    /// at the first value above that, which it keeps (above `cap`, at most the largest); with
+    /// `f64::INFINITY` the value is exact.
+    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool], cap: &[f64]) -> Vec<f64> {
         let mut out = f.to_vec();
         if !mask.iter().any(|&m| m) {
             return out;
         }
-        let (first, next) = self.neighbours();
+        let (first, next) = self.adjacency.get_or_init(|| self.neighbours());
+        let around = |u: usize| &next[first[u] as usize..first[u + 1] as usize];
         let within = sqrt_at_most(radius);
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
         // between vertices; each vertex's distance is taken once per flood).
@@ -184,18 +264,57 @@ impl LayerMesh {
             if !mask[v] {
                 continue;
             }
+            let pv = self.p[v];
+            let cap = cap[v];
+            // A climb first, from each vertex to its highest neighbour inside the ball while
+            // that is higher: every vertex on the way is joined to v inside the ball, and a
+            // flank's climb passes the cap in a few steps where the search would look at the
+            // whole ball.
+            let mut climbed = f[v];
+            let mut u = v;
+            while climbed.partial_cmp(&cap) != Some(Ordering::Greater) {
+                let mut hi = if f[u].is_finite() {
+                    f[u]
+                } else {
+                    f64::NEG_INFINITY
+                };
+                let mut step = None;
+                for &x in around(u) {
+                    let fx = f[x as usize];
+                    if fx.is_finite()
+                        && fx > hi
+                        && (self.p[x as usize] - pv).norm_squared() <= within
+                    {
+                        hi = fx;
+                        step = Some(x as usize);
+                    }
+                }
+                match step {
+                    Some(x) => {
+                        u = x;
+                        climbed = climbed.max(hi);
+                    }
+                    None => break,
+                }
+            }
+            if climbed > cap {
+                out[v] = climbed;
+                continue;
+            }
             let stamp = v as u32 + 1;
             stack.clear();
             stack.push(v as u32);
             seen[v] = stamp;
             let mut best = f[v];
-            let pv = self.p[v];
             while let Some(u) = stack.pop() {
                 let u = u as usize;
                 if f[u].is_finite() {
                     best = best.max(f[u]);
                 }
-                for &x in &next[first[u] as usize..first[u + 1] as usize] {
+                if best > cap {
+                    break;
+                }
+                for &x in around(u) {
                     if seen[x as usize] != stamp {
                         seen[x as usize] = stamp;
                         if (self.p[x as usize] - pv).norm_squared() <= within {
@@ -210,7 +329,7 @@ impl LayerMesh {
     }
 
     /// The vertices joined to each vertex by an edge of a triangle, as offsets (`first[v]` ..
-    /// `first[v + 1]`) into one list.
+    /// `first[v + 1]`) into one list (kept in `adjacency` once made).
     fn neighbours(&self) -> (Vec<u32>, Vec<u32>) {
         let n = self.q.len();
         let mut first = Vec::with_capacity(n + 1);

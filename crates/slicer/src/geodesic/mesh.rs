@@ -1,7 +1,6 @@
 //! The layer mesh: a region of a layer, in its chart, triangulated on a lattice equilateral on
 //! the layer surface.
 
-use crate::fast_hash::FastMap;
 use crate::geom2d::{dist2, Point2, Region, RegionIndex};
 use brep::math::P3;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
@@ -21,6 +20,9 @@ pub struct LayerMesh {
     pub rings: Vec<Vec<u32>>,
     /// Triangles around each vertex.
     pub(super) around: Vec<Vec<u32>>,
+    /// The vertices joined to each vertex by an edge (offsets into one list, and the list),
+    /// made by the first search that needs them.
+    pub(super) adjacency: std::sync::OnceLock<(Vec<u32>, Vec<u32>)>,
     /// The upper-triangular map `(m00, m01, m11)` from chart to the surface-isotropic frame
     /// of [`LayerMesh::build_with_metric`]; `None`: the chart itself.
     pub(super) frame: Option<[f64; 3]>,
@@ -74,6 +76,80 @@ fn convex_corners(ring: &[Point2], min_turn: f64) -> Vec<Point2> {
         }
     }
     out
+}
+
+/// Points in the cells of a grid, cell by cell in rows (one list, a run of it per cell), for
+/// the points of a few neighbouring cells at a time.
+struct PointGrid {
+    /// The lowest cell (column, row) with a point.
+    lo: (i64, i64),
+    /// Columns from `lo.0` to the highest with a point.
+    width: usize,
+    /// Rows from `lo.1`.
+    height: usize,
+    /// Where each cell's run starts in `points` (one more at the end).
+    first: Vec<usize>,
+    points: Vec<Point2>,
+}
+
+impl PointGrid {
+    /// The grid of `points`, each with its cell (column, row).
+    fn new(points: impl Iterator<Item = ((i64, i64), Point2)>) -> PointGrid {
+        let points: Vec<((i64, i64), Point2)> = points.collect();
+        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+        for ((i, j), _) in &points {
+            lo = (lo.0.min(*i), lo.1.min(*j));
+            hi = (hi.0.max(*i), hi.1.max(*j));
+        }
+        if points.is_empty() {
+            return PointGrid {
+                lo: (0, 0),
+                width: 0,
+                height: 0,
+                first: vec![0],
+                points: vec![],
+            };
+        }
+        let (width, height) = ((hi.0 - lo.0 + 1) as usize, (hi.1 - lo.1 + 1) as usize);
+        let at = |(i, j): (i64, i64)| (j - lo.1) as usize * width + (i - lo.0) as usize;
+        let mut first = vec![0usize; width * height + 1];
+        for (c, _) in &points {
+            first[at(*c) + 1] += 1;
+        }
+        for k in 0..width * height {
+            first[k + 1] += first[k];
+        }
+        let mut fill = first.clone();
+        let mut sorted = vec![[0.0; 2]; points.len()];
+        for (c, q) in points {
+            sorted[fill[at(c)]] = q;
+            fill[at(c)] += 1;
+        }
+        PointGrid {
+            lo,
+            width,
+            height,
+            first,
+            points: sorted,
+        }
+    }
+
+    /// The points of cells `i0..=i1` of row `j`.
+    fn row(&self, j: i64, i0: i64, i1: i64) -> &[Point2] {
+        if j < self.lo.1 || j - self.lo.1 >= self.height as i64 {
+            return &[];
+        }
+        let (i0, i1) = (i0.max(self.lo.0), i1.min(self.lo.0 + self.width as i64 - 1));
+        if i0 > i1 {
+            return &[];
+        }
+        let base = (j - self.lo.1) as usize * self.width;
+        let (a, b) = (
+            base + (i0 - self.lo.0) as usize,
+            base + (i1 - self.lo.0) as usize,
+        );
+        &self.points[self.first[a]..self.first[b + 1]]
+    }
 }
 
 /// The most lattice cells (of the region's box) a layer mesh is built with.
@@ -145,17 +221,13 @@ impl LayerMesh {
                 ((q[1] - lo[1]) / step).floor() as i64,
             )
         };
-        let mut grid: FastMap<(i64, i64), Vec<Point2>> = FastMap::default();
-        for q in rings.iter().flatten() {
-            grid.entry(cell(*q)).or_default().push(*q);
-        }
+        let grid = PointGrid::new(rings.iter().flatten().map(|q| (cell(*q), *q)));
         let near_boundary = |q: Point2, s: f64| {
             let (i, j) = cell(q);
-            (i - 1..=i + 1).any(|a| {
-                (j - 1..=j + 1).any(|b| {
-                    grid.get(&(a, b))
-                        .is_some_and(|v| v.iter().any(|p| dist2(*p, q) < (0.6 * s) * (0.6 * s)))
-                })
+            (j - 1..=j + 1).any(|b| {
+                grid.row(b, i - 1, i + 1)
+                    .iter()
+                    .any(|p| dist2(*p, q) < (0.6 * s) * (0.6 * s))
             })
         };
         let mut cdt: ConstrainedDelaunayTriangulation<SPoint<f64>> =
@@ -200,9 +272,10 @@ impl LayerMesh {
         for r in 0..=rows {
             let y = lo[1] + r as f64 * dy;
             let shift = if r % 2 == 1 { 0.5 * step } else { 0.0 };
+            let row = inside.row(y);
             for c in 0..=cols {
                 let q = [lo[0] + shift + c as f64 * step, y];
-                if inside.contains(q) && !near_boundary(q, step) {
+                if row.contains(q[0]) && !near_boundary(q, step) {
                     add(&mut cdt, &mut m, q, false);
                 }
             }
@@ -217,11 +290,12 @@ impl LayerMesh {
             for r in r0..=r1 {
                 let y = lo[1] + r as f64 * fdy;
                 let shift = if r % 2 == 1 { 0.5 * fine } else { 0.0 };
+                let row = inside.row(y);
                 let c0 = ((c[0] - span - lo[0] - shift) / fine).floor().max(0.0) as usize;
                 let c1 = ((c[0] + span - lo[0] - shift) / fine).ceil().max(0.0) as usize;
                 for k in c0..=c1 {
                     let q = [lo[0] + shift + k as f64 * fine, y];
-                    if dist2(*c, q) <= reach2 && inside.contains(q) && !near_boundary(q, fine) {
+                    if dist2(*c, q) <= reach2 && row.contains(q[0]) && !near_boundary(q, fine) {
                         add(&mut cdt, &mut m, q, false);
                     }
                 }

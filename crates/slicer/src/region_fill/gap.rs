@@ -16,28 +16,78 @@ pub(super) struct Gap {
     pub(super) below: f64,
 }
 
-/// Marks both ends of every lattice edge that one of `levels` of `db` crosses: the vertices
-/// an iso-line at those levels interpolates between.
-pub(super) fn crossing_vertices(lm: &LayerMesh, db: &[f64], levels: &[f64]) -> Vec<bool> {
-    let mut mask = vec![false; db.len()];
+/// How far above the highest level a fill tells apart a ridge value must be to count as
+/// above it, mm: far more than the round-off of interpolating between two such values.
+const RIDGE_CAP_MARGIN: f64 = 1e-6;
+
+/// The local ridge height of `db` (within one and a half spacings) seen from the flanks of
+/// the region, at the vertices the iso-lines at `levels` interpolate between (the ends of the
+/// lattice edges each `(level, top)` crosses), where the fills read it only through
+/// thresholds no higher than that level's `top` (a ring's width limit, a gap's `below` or
+/// full bead). Exact at a vertex up to the highest `top` of the levels its edges cross (plus
+/// [`RIDGE_CAP_MARGIN`]), and wherever a crossing edge joins it to a vertex exact below its
+/// own; a vertex above its cap whose crossing edges all end above theirs keeps some value
+/// above it (its search stops there), and so does every value interpolated between two such
+/// ends, which the fills then read as they would the exact one.
+pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], spacing: f64) -> Vec<f64> {
+    let radius = 1.5 * spacing;
+    let n = db.len();
+    let crosses = |a: usize, b: usize, l: f64| (db[a] - l) * (db[b] - l) <= 0.0;
+    let mut cap = vec![f64::NEG_INFINITY; n];
     for t in &lm.tris {
         for k in 0..3 {
             let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            if levels.iter().any(|l| (db[a] - l) * (db[b] - l) <= 0.0) {
-                mask[a] = true;
-                mask[b] = true;
+            for &(l, top) in levels {
+                if crosses(a, b, l) {
+                    let c = top + RIDGE_CAP_MARGIN;
+                    cap[a] = cap[a].max(c);
+                    cap[b] = cap[b].max(c);
+                }
             }
         }
     }
-    mask
+    let mask: Vec<bool> = cap.iter().map(|c| *c > f64::NEG_INFINITY).collect();
+    let mut r = lm.local_max(db, radius, &mask, &cap);
+    // A crossing edge with one end above its cap and the other exact: that end exact too.
+    let above = |v: usize| r[v] > cap[v];
+    let mut redo = vec![false; n];
+    let mut any = false;
+    for t in &lm.tris {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            if above(a) != above(b) && levels.iter().any(|&(l, _)| crosses(a, b, l)) {
+                redo[if above(a) { a } else { b }] = true;
+                any = true;
+            }
+        }
+    }
+    if any {
+        let exact = lm.local_max(db, radius, &redo, &vec![f64::INFINITY; n]);
+        for (v, x) in r.iter_mut().enumerate() {
+            if redo[v] {
+                *x = exact[v];
+            }
+        }
+    }
+    r
 }
 
-/// The local ridge height of `db` (within one and a half spacings) seen from the flanks of
-/// the strip beyond `gap.edge`, where the gap fill's iso-line needs it: at the vertices it
-/// interpolates between.
-pub(super) fn ridge_for(lm: &LayerMesh, db: &[f64], gap: Gap, spacing: f64) -> Vec<f64> {
-    let mask = crossing_vertices(lm, db, &[gap.edge + gap.inset]);
-    lm.local_max(db, 1.5 * spacing, &mask)
+/// [`ridge`] where [`gap_fill`] runs for `gap`: it reads the ridge only through `below`
+/// (nothing at or above it) or, without one, through the edge plus a bead `width` (a full
+/// bead from there up).
+pub(super) fn ridge_for(
+    lm: &LayerMesh,
+    db: &[f64],
+    gap: Gap,
+    spacing: f64,
+    width: f64,
+) -> Vec<f64> {
+    let top = if gap.below.is_finite() {
+        gap.below
+    } else {
+        gap.edge + width
+    };
+    ridge(lm, db, &[(gap.edge + gap.inset, top)], spacing)
 }
 
 /// Gap fill: the strip of a region farther than `gap.edge` from its boundary (`db`, the

@@ -18,7 +18,7 @@ use crate::toolpath::Role;
 use border::Border;
 use brep::math::{P3, V3};
 use brep::surface::Surface;
-use gap::{crossing_vertices, gap_fill, ridge_for, Gap};
+use gap::{gap_fill, ridge, ridge_for, Gap};
 
 pub(crate) use spurs::corner_spurs;
 
@@ -144,8 +144,8 @@ pub(crate) fn fill_region(
     }
     let mut pts = Vec::with_capacity(lm.q.len());
     for q in &lm.q {
-        match chart.at(*q, z) {
-            Some((p, _)) => pts.push(p),
+        match chart.point(*q, z) {
+            Some(p) => pts.push(p),
             None => return out,
         }
     }
@@ -182,13 +182,25 @@ pub(crate) fn fill_region(
     let ridge = if levels.is_empty() {
         vec![]
     } else {
-        let wanted: Vec<f64> = levels
+        // Each level with the highest ridge its fill tells apart: a ring's width (a full bead
+        // above the gap fill's narrowest one past its edge) and the gap fill between rings
+        // (nothing at or above the next ring's level).
+        let wanted: Vec<(f64, f64)> = levels
             .iter()
-            .copied()
-            .chain(levels.iter().skip(1).map(|c| c - 0.5 * width + gap_inset))
+            .map(|&c| {
+                (
+                    c,
+                    c - 0.5 * width + GAP_MIN_WIDTH_SHARE.mul_add(width, width),
+                )
+            })
+            .chain(
+                levels
+                    .iter()
+                    .skip(1)
+                    .map(|&c| (c - 0.5 * width + gap_inset, c)),
+            )
             .collect();
-        let mask = crossing_vertices(&lm, &db, &wanted);
-        lm.local_max(&db, 1.5 * spacing, &mask)
+        ridge(&lm, &db, &wanted, spacing)
     };
     let mut last_ring = None;
     for (j, &c) in levels.iter().enumerate() {
@@ -237,7 +249,7 @@ pub(crate) fn fill_region(
     // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
     // it), within what that core holds.
     let core_fill = |gap: Gap| {
-        let ridge = ridge_for(&lm, &db, gap, spacing);
+        let ridge = ridge_for(&lm, &db, gap, spacing, width);
         conserved(
             gap_fill(&lm, &db, &ridge, gap, width),
             &lm,
@@ -299,8 +311,8 @@ pub(crate) fn fill_region(
     let stretch = {
         let e = 1e-3;
         let step = |d: [f64; 2]| -> Option<V3> {
-            let a = chart.at([q0[0] + e * d[0], q0[1] + e * d[1]], z)?.0;
-            let b = chart.at([q0[0] - e * d[0], q0[1] - e * d[1]], z)?.0;
+            let a = chart.point([q0[0] + e * d[0], q0[1] + e * d[1]], z)?;
+            let b = chart.point([q0[0] - e * d[0], q0[1] - e * d[1]], z)?;
             Some((a - b) / (2.0 * e))
         };
         match (step(dir), step(nrm)) {
@@ -524,8 +536,8 @@ fn conserved(
 
 /// The length on the layer surface at `d` of the chart segment `a`–`b` (its chord there).
 fn surface_length(chart: &Chart, d: f64, a: Point2, b: Point2) -> f64 {
-    match (chart.at(a, d), chart.at(b, d)) {
-        (Some((p, _)), Some((q, _))) => (q - p).norm(),
+    match (chart.point(a, d), chart.point(b, d)) {
+        (Some(p), Some(q)) => (q - p).norm(),
         _ => f64::NAN,
     }
 }

@@ -30,7 +30,7 @@ pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -
         .collect();
     let lifted: Option<Vec<Vec<P3>>> = rings
         .iter()
-        .map(|r| r.iter().map(|q| chart.at(*q, z).map(|x| x.0)).collect())
+        .map(|r| r.iter().map(|q| chart.point(*q, z)).collect())
         .collect();
     let Some(lifted) = lifted else { return out };
     let to_boundary = |p: &P3| -> f64 {
@@ -139,7 +139,7 @@ pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -
                 if !crate::geom2d::region_contains(region, q) {
                     break;
                 }
-                let Some((p, _)) = chart.at(q, z) else { break };
+                let Some(p) = chart.point(q, z) else { break };
                 let db = to_boundary(&p);
                 // Another side of the region comes nearer than the wedge's: stop.
                 if db < 0.8 * rho * sn {
