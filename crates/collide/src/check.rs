@@ -1,181 +1,15 @@
-//! The check of every move: the head swept along it (tip and tool axis interpolated, positions
-//! at most [`SWEEP_STEP`] apart, the head's far end included) against what was deposited before
-//! it and the table. Before a move of feature F in layer L lie every bead of the groups of
-//! points (feature, layer) that precede its own in the path: the features built before, and
-//! F's earlier layers. Colliding travels are re-routed over the material when a lift clears them
-//! ([`check_and_route`]).
+//! Avoidance along the path: colliding travels re-routed over the material when a lift clears
+//! them ([`check_and_route`]), colliding print moves tilted inside the orientation cone first
+//! where asked ([`tilt_and_route`], [`tilt`]: [`crate::tilt`]), in one walk that checks every
+//! move with [`crate::scene::Scene`].
 
-use crate::deposit::{Deposit, GRAIN_SPACING};
-use crate::head::{Head, HeadShape};
+use crate::head::Head;
+use crate::scene::{move_collision, same_group, Collision, Scene, TOLERANCE};
 use crate::table::Table;
-use crate::tilt::{tilt_run, TiltLimits};
+use crate::tilt::{tilt_run, TiltLimits, Tilted};
 use std::collections::BTreeMap;
-use toolpath::vec3::{add, norm, scale, sub, unit, V3};
+use toolpath::vec3::{add, scale, unit, V3};
 use toolpath::{MoveKind, PathPoint, ToolPath};
-
-/// Largest distance (mm) between head positions checked along a move, measured at the head's
-/// farthest point (a turn of the tool axis sweeps the body's top furthest).
-pub const SWEEP_STEP: f64 = 1.0;
-
-/// Depth (mm) material must lie inside the head (a quarter-millimetre cell of it wholly, see
-/// [`crate::Deposit`]), or the head below the table surface, to count:
-/// the tip rests on the layer below and beside the beads of its own layer, and bead surfaces
-/// are not exact.
-pub const TOLERANCE: f64 = 0.1;
-
-/// What a colliding move hits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Obstacle {
-    /// Material laid by the feature of this file-wide id.
-    Feature(usize),
-    /// The machine's table.
-    Table,
-}
-
-/// A move that drives the head into material or the table.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Collision {
-    /// Index in the path of the point that ends the move.
-    pub index: usize,
-    /// The feature of that point.
-    pub feature: usize,
-    /// Print or travel.
-    pub kind: MoveKind,
-    /// Tip position where the head first meets the obstacle along the move, mm.
-    pub at: V3,
-    /// What it meets.
-    pub hits: Obstacle,
-}
-
-/// The head, the table and what is deposited, as a move is checked.
-pub struct Scene {
-    shape: HeadShape,
-    table: Option<Table>,
-    /// What lies before the move being checked.
-    pub deposit: Deposit,
-}
-
-impl Scene {
-    /// Nothing deposited yet.
-    pub fn new(head: &Head, table: Option<Table>) -> Scene {
-        Scene {
-            shape: head.shape(),
-            table,
-            deposit: Deposit::new(),
-        }
-    }
-
-    /// What the head with its tip at `tip` and tool axis `axis` meets, if anything.
-    pub fn at(&self, tip: V3, axis: V3) -> Option<Obstacle> {
-        let axis = unit(axis)?;
-        if let Some(t) = &self.table {
-            if t.hits(&self.shape, tip, axis, TOLERANCE) {
-                return Some(Obstacle::Table);
-            }
-        }
-        self.deposit
-            .first_inside(&self.shape, tip, axis, TOLERANCE)
-            .map(Obstacle::Feature)
-    }
-
-    /// Whether the head with its tip at `tip` and unit tool axis `axis` meets the table.
-    pub(crate) fn hits_table(&self, tip: V3, axis: V3) -> bool {
-        self.table
-            .as_ref()
-            .is_some_and(|t| t.hits(&self.shape, tip, axis, TOLERANCE))
-    }
-
-    /// The first obstacle the head meets swept from (`a`, axis `aa`) to (`b`, axis `ab`), with
-    /// the tip position there; `a` itself is not checked (the move before ended there).
-    pub fn sweep(&self, a: V3, aa: V3, b: V3, ab: V3) -> Option<(V3, Obstacle)> {
-        let turn = norm(sub(aa, ab)) * self.shape.reach();
-        let n = ((norm(sub(b, a)).max(turn)) / SWEEP_STEP)
-            .ceil()
-            .clamp(1.0, 1e5) as usize;
-        (1..=n).find_map(|k| {
-            let t = k as f64 / n as f64;
-            let tip = add(a, scale(sub(b, a), t));
-            let axis = add(scale(aa, 1.0 - t), scale(ab, t));
-            self.at(tip, axis).map(|o| (tip, o))
-        })
-    }
-
-    /// Deposits the beads of the print points `points[range]` (each from the point before it):
-    /// along each run of beads, grains at most [`GRAIN_SPACING`] apart and, where the planned
-    /// points lie closer, at least half that apart (every point of a bead is then within a
-    /// quarter of the spacing of a grain), the run's ends always.
-    pub(crate) fn deposit(&mut self, points: &[PathPoint], range: std::ops::Range<usize>) {
-        let mut last: Option<V3> = None;
-        for j in range {
-            let q = &points[j];
-            if j == 0 || q.kind != MoveKind::Print {
-                last = None;
-                continue;
-            }
-            let from = last.unwrap_or(points[j - 1].p);
-            if last.is_none() {
-                self.deposit.add(from, q.feature);
-            }
-            let ends = points.get(j + 1).is_none_or(|n| n.kind != MoveKind::Print);
-            if ends || norm(sub(q.p, from)) >= GRAIN_SPACING / 2.0 {
-                self.deposit.add_bead(from, q.p, q.feature);
-                last = Some(q.p);
-            } else {
-                last = Some(from);
-            }
-        }
-    }
-}
-
-/// Whether `a` and `b` belong to one group of points (same feature and layer).
-pub(crate) fn same_group(a: &PathPoint, b: &PathPoint) -> bool {
-    a.feature == b.feature && a.layer == b.layer
-}
-
-/// Every colliding move of `path` with `head` over `table`, in path order.
-pub fn check(path: &ToolPath, head: &Head, table: Option<Table>) -> Vec<Collision> {
-    let mut scene = Scene::new(head, table);
-    let pts = &path.points;
-    let mut out = vec![];
-    let mut group = 0;
-    for i in 0..pts.len() {
-        if i > 0 && !same_group(&pts[i - 1], &pts[i]) {
-            scene.deposit(pts, group..i);
-            group = i;
-        }
-        if let Some(c) = move_collision(&scene, pts, i) {
-            out.push(c);
-        }
-    }
-    out
-}
-
-/// The collision of the move ending at `pts[i]`, if any.
-pub(crate) fn move_collision(scene: &Scene, pts: &[PathPoint], i: usize) -> Option<Collision> {
-    move_hit(scene, i.checked_sub(1).map(|j| &pts[j]), &pts[i], i)
-}
-
-/// The collision of the move from `from` (none: the path's first point) to `q`, the point of
-/// index `index` in its path, if any.
-pub(crate) fn move_hit(
-    scene: &Scene,
-    from: Option<&PathPoint>,
-    q: &PathPoint,
-    index: usize,
-) -> Option<Collision> {
-    let hit = match from {
-        Some(a) => scene.sweep(a.p, a.axis, q.p, q.axis),
-        None => scene.at(q.p, q.axis).map(|o| (q.p, o)),
-    }?;
-    Some(Collision {
-        index,
-        feature: q.feature,
-        kind: q.kind,
-        at: hit.0,
-        hits: hit.1,
-    })
-}
-
 /// Lifts tried for a detour, as multiples of the head's length (then the material's height).
 const LIFTS: [f64; 4] = [0.05, 0.15, 0.5, 1.0];
 
@@ -232,6 +66,27 @@ pub fn tilt_and_route(
         Some(travels),
         limits.map(|l| (planned, l)),
     )
+}
+
+/// Tilts the tool axes of `path` inside the cone about `planned` (each point's planned axis,
+/// before smoothing: one per point) to clear its colliding print moves, with `head` over
+/// `table`; see [`crate::tilt`]. Points whose planned or given axis has no direction are
+/// not tilted. A pure stage: `path` is not changed, and its travels are checked, not routed
+/// ([`tilt_and_route`] does both in one walk).
+pub fn tilt(
+    path: &ToolPath,
+    planned: &[V3],
+    head: &Head,
+    table: Option<Table>,
+    limits: &TiltLimits,
+) -> Tilted {
+    let mut out = path.clone();
+    let Routed { left, cleared } = walk(&mut out, head, table, None, Some((planned, limits)));
+    Tilted {
+        path: out,
+        cleared,
+        left,
+    }
 }
 
 /// The walk along `path` behind [`check_and_route`], [`tilt_and_route`] and [`crate::tilt`]:
@@ -393,6 +248,7 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::{check, Obstacle};
 
     fn pt(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
         PathPoint {

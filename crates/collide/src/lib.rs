@@ -21,15 +21,14 @@ mod check;
 mod deposit;
 mod head;
 mod order;
+mod scene;
 mod table;
 mod tilt;
 
-pub use check::{
-    check, check_and_route, tilt_and_route, Collision, Obstacle, Routed, Scene, Travels,
-    SWEEP_STEP, TOLERANCE,
-};
+pub use check::{check_and_route, tilt, tilt_and_route, Routed, Travels};
 pub use deposit::{Deposit, GRAIN_SPACING};
 pub use head::{Head, HeadShape};
 pub use order::interleave;
+pub use scene::{check, Collision, Obstacle, Scene, SWEEP_STEP, TOLERANCE};
 pub use table::Table;
-pub use tilt::{blend, tilt, TiltLimits, Tilted, AZIMUTHS, RING_STEP_DEG};
+pub use tilt::{blend, TiltLimits, Tilted, AZIMUTHS, RING_STEP_DEG};
