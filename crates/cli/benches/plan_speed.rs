@@ -172,6 +172,66 @@ fn run_prusa(stl: &Path, gcode: &Path) -> prusa::Run {
     }
 }
 
+/// Wall seconds of a plan's stages.
+struct Stages {
+    features: f64,
+    smoothing: f64,
+    head: f64,
+    program: f64,
+}
+
+/// Plans `step` for `machine` in this process and times its stages by the plan's progress
+/// reports ([`plan::Progress`]): the features up to `Planned`, then each of [`plan::STAGES`]
+/// to the next (the last to the plan's return).
+fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
+    use plan::Progress;
+    use std::sync::Mutex;
+    let kind = match machine {
+        "marlin" => robot_post::MachineKind::Marlin,
+        "kuka" => robot_post::MachineKind::Kuka,
+        _ => robot_post::MachineKind::Delta5,
+    };
+    let part = brep::read_step(step).map_err(|e| format!("{}: {e}", step.display()))?;
+    let machine = robot_post::MachineProfile::builtin(kind);
+    let marks: Mutex<Vec<(&'static str, Instant)>> = Mutex::new(vec![]);
+    let mark = |p: Progress| {
+        let label = match p {
+            Progress::Start { .. } => Some("start"),
+            Progress::Planned => Some("planned"),
+            Progress::Stage(s) => Some(s),
+            _ => None,
+        };
+        if let (Some(l), Ok(mut m)) = (label, marks.lock()) {
+            m.push((l, Instant::now()));
+        }
+    };
+    let options = plan::Options {
+        source: step.display().to_string(),
+        stem: "part".into(),
+        allow_collisions: true,
+        keep_going: true,
+        progress: Some(&mark),
+        ..Default::default()
+    };
+    let t0 = Instant::now();
+    plan::plan(&part, &plan::Process::default(), &machine, &options)
+        .map_err(|e| format!("plan failed: {e}"))?;
+    let end = Instant::now();
+    let marks = marks.into_inner().map_err(|e| e.to_string())?;
+    let at = |l: &str| marks.iter().find(|m| m.0 == l).map(|m| m.1);
+    let span = |a: Option<Instant>, b: Option<Instant>| match (a, b) {
+        (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
+        _ => 0.0,
+    };
+    let [smooth, head, program] = plan::STAGES;
+    Ok(Stages {
+        features: span(Some(t0), at("planned")),
+        smoothing: span(at(smooth), at(head)),
+        head: span(at(head), at(program)),
+        program: span(at(program), Some(end)),
+    })
+}
+
 fn median(v: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     if v.is_empty() {
@@ -395,6 +455,40 @@ fn main() {
         }
         println!("{line}");
     }
+
+    // Where the time goes: each part planned once more in this process, its stages timed by the
+    // plan's progress reports.
+    println!();
+    println!(
+        "{:<16} | {:>9} {:>9} {:>11} {:>9} | {:>7}",
+        "stages (1 run)", "features", "smoothing", "print head", "program", "head %"
+    );
+    println!("{}", "-".repeat(72));
+    for (step, machine) in &parts {
+        let name = step
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        match stage_times(step, machine) {
+            Ok(t) => {
+                let rest = t.features + t.smoothing + t.program;
+                println!(
+                    "{name:<16} | {:>9.2} {:>9.2} {:>11.2} {:>9.2} | {:>6.1}%",
+                    t.features,
+                    t.smoothing,
+                    t.head,
+                    t.program,
+                    100.0 * t.head / rest.max(1e-9)
+                );
+            }
+            Err(e) => println!("{name:<16} | {e}"),
+        }
+    }
+    println!(
+        "seconds of wall time in `plan::plan` (reading the part not included): features = \
+         extraction and every feature's layers; head % = the print-head check (issue 18) over \
+         the rest of the plan"
+    );
     println!("(files in {})", tmp.display());
     if failed {
         std::process::exit(1);
