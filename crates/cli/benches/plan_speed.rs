@@ -211,7 +211,6 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         allow_collisions: true,
         keep_going: true,
         progress: Some(&mark),
-        ..Default::default()
     };
     let t0 = Instant::now();
     plan::plan(&part, &plan::Process::default(), &machine, &options)
