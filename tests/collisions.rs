@@ -267,13 +267,11 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
             let cleared = f["collisions_cleared_by_tilt"]
                 .as_u64()
                 .expect("collisions_cleared_by_tilt");
-            // The impeller's blades: tilting the axis inside the cone clears most of the
-            // moves whose body meets the hub.
+            // The impeller's blades: tilting the axis inside the cone clears every move whose
+            // body meets the hub (a few degrees suffice: the body's rim grazes the hub's top).
             if name == "impeller" && id > 0 {
-                assert!(
-                    cleared > n,
-                    "{name}: feature {id}: {cleared} cleared, {n} left"
-                );
+                assert!(cleared > 0, "{name}: feature {id}: nothing cleared");
+                assert_eq!(n, 0, "{name}: feature {id}: {n} left ({cleared} cleared)");
             }
             if f["parents"].as_array().expect("parents").is_empty() {
                 assert_eq!(n, 0, "{name}: base feature {id} collides");

@@ -91,8 +91,9 @@ pub fn tilt(
 
 /// The walk along `path` behind [`check_and_route`], [`tilt_and_route`] and [`crate::tilt`]:
 /// run by run (continuous paths), the material before each run's group deposited, its moves
-/// checked, tilted by `tilt` (planned axes and limits) where that clears print moves, and its
-/// colliding travels routed by `travels` (`None`: checked and reported, not routed).
+/// checked, tilted by `tilt` (planned axes and limits) where that clears print moves (or the
+/// head at the travel points leading to its bead), and its colliding travels routed by
+/// `travels` (`None`: checked and reported, not routed).
 pub(crate) fn walk(
     path: &mut ToolPath,
     head: &Head,
@@ -117,7 +118,12 @@ pub(crate) fn walk(
             .map(|i| (!skip(&pts[i])).then(|| move_collision(&scene, pts, i))?)
             .collect();
         if let Some((planned, limits)) = tilt {
-            let prints = found[lead + 1..].iter().any(Option::is_some);
+            // Print moves that collide, or lead points the head collides at (no lift clears
+            // those).
+            let prints = found[lead + 1..].iter().any(Option::is_some)
+                || (r.start..=r.start + lead)
+                    .zip(&found)
+                    .any(|(i, c)| c.is_some() && scene.at(pts[i].p, pts[i].axis).is_some());
             let checked = travels != Some(Travels::Skip);
             if let Some((axes, after)) = (prints && planned.len() == pts.len())
                 .then(|| {

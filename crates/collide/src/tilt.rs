@@ -10,20 +10,24 @@
 //! a tilt does not change:
 //!
 //! 1. **keys**: for each colliding print move, the smallest turn ω (a rotation vector: axis ×
-//!    angle) of the point's axis that clears the move: first the turn of the nearest key, then
+//!    angle) of the point's axis that clears the move (its start turned by its own key where it
+//!    has one, as the blend will turn it, else alike): first the turn of the nearest key, then
 //!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
-//!    first that clears), [`AZIMUTHS`] directions each, starting towards +Z (away from the
-//!    table). A turn is allowed when it keeps the axis within the cone (and a B/C bed's B
-//!    limit) and differs from the keys beside it by at most the blend's slope
-//!    ([`TiltLimits::slope`]). The travel points leading to the bead and its start, which a
-//!    lift cannot clear when the head collides there, get keys of their own. Keys found in one
-//!    pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after a
-//!    move no turn clears;
+//!    first that clears), [`AZIMUTHS`] directions each, starting the way the nearest key turns
+//!    (two turns the other way about would average to less than either between them), else
+//!    towards +Z (away from the table). A turn is allowed when it keeps the axis within the
+//!    cone (and a B/C bed's B limit) and differs from the keys beside it by at most the blend's
+//!    slope ([`TiltLimits::slope`]). The bead's start, which a lift cannot clear when the head
+//!    collides there, gets a key of its own on the same terms; so does each travel point
+//!    leading to it, but bound to no other key (a travel lays no bead, and those points all
+//!    lie at arc length 0, where the slope would force one turn on them all). Keys found in
+//!    one pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after
+//!    a move no turn clears;
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
 //!    two windows, held from the bead's start (and its lead) to a first key that close,
 //!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
-//!    ([`blend`]); each point's axis turned by it, scaled back where it would leave the cone or
-//!    the B limit;
+//!    ([`blend`]); each point's axis turned by it (a lead travel point with a key of its own,
+//!    by that), scaled back where it would leave the cone or the B limit;
 //! 3. **check again**, with new keys where moves still collide, a few passes; the run keeps
 //!    its tilt only when every move that collides after it collided before it and fewer do.
 
@@ -174,6 +178,11 @@ pub(crate) fn tilt_run(
         s[k] = s[k - 1] + norm(sub(run[k].p, run[k - 1].p));
     }
     let mut keys: BTreeMap<usize, V3> = BTreeMap::new();
+    // The lead's travel points before the bead start: a travel does not lay a bead, so each
+    // takes a turn of its own, bound neither to the bead's keys nor to each other (they all lie
+    // at arc length 0, where the slope would demand one turn for all).
+    let mut lead_keys: BTreeMap<usize, V3> = BTreeMap::new();
+    let none: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
     // Where the last search along the bead found no turn: the moves just after it mostly meet
     // the same obstacle, so the search waits [`RETRY_MM`] of path.
@@ -191,6 +200,22 @@ pub(crate) fn tilt_run(
             // collides at the point itself (no lift clears that).
             let point = k <= lead && scene.at(run[k].p, axes[k]).is_some();
             if k <= lead && !point {
+                continue;
+            }
+            if k < lead {
+                if lead_keys.contains_key(&k) || tried[k] {
+                    continue;
+                }
+                tried[k] = true;
+                let at = Candidate {
+                    k,
+                    lead,
+                    hits: c.hits,
+                };
+                if let Some(w) = search(scene, run, &given, &allowed, &none, &s, at, limits) {
+                    lead_keys.insert(k, w);
+                    added = true;
+                }
                 continue;
             }
             // A key on the bead that still collides (its move starts from a blended axis):
@@ -239,7 +264,8 @@ pub(crate) fn tilt_run(
         let field = blend(&keys, &s, limits.window_mm);
         let last = axes.clone();
         for k in 0..run.len() {
-            axes[k] = apply(given[k], field[k], &allowed[k]);
+            let w = lead_keys.get(&k).copied().unwrap_or(field[k]);
+            axes[k] = apply(given[k], w, &allowed[k]);
         }
         let mut moved: Vec<PathPoint> = run.to_vec();
         for (q, &a) in moved.iter_mut().zip(&axes) {
@@ -324,8 +350,11 @@ fn search(
         if k <= lead {
             return scene.at(run[k].p, b).is_none();
         }
-        // The bead's start ends a travel; the sweep leaves it out.
-        let from = (run[k - 1].p, rotate(given[k - 1], w));
+        // The move's start turned as the blend will turn it: by its own key, where it has one
+        // (the blend passes through keys), else alike. The bead's start ends a travel; the
+        // sweep leaves it out.
+        let from_turn = keys.get(&(k - 1)).copied().unwrap_or(w);
+        let from = (run[k - 1].p, rotate(given[k - 1], from_turn));
         (k > lead + 1 || scene.at(from.0, from.1).is_none())
             && scene.sweep(from.0, from.1, run[k].p, b).is_none()
     };
@@ -339,9 +368,16 @@ fn search(
             return Some(w);
         }
     }
-    // Directions across the axis, the first towards +Z.
+    // Directions across the axis, the first the way the nearest key turns (keys turned alike
+    // keep the blend between them clear: two turns the other way about average to less than
+    // either), else towards +Z.
     let up = sub([0.0, 0.0, 1.0], scale(a, a[2]));
-    let e1 = unit(up)
+    let along = nearest.and_then(|(_, &w)| {
+        let d = cross(w, a);
+        unit(sub(d, scale(a, dot(a, d))))
+    });
+    let e1 = along
+        .or_else(|| unit(up))
         .or_else(|| unit(cross(a, [1.0, 0.0, 0.0])))
         .or_else(|| unit(cross(a, [0.0, 1.0, 0.0])))?;
     let e2 = cross(a, e1);
