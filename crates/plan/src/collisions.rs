@@ -99,6 +99,10 @@ pub fn avoid(
         }
     };
     let groups = sibling_groups(features);
+    if groups.is_empty() {
+        // No order to try but the one built: walked in place, without copies of the path.
+        return walk(path, planned, limits.as_ref());
+    }
     // The siblings interleaved: the path and its planned axes (a path of them interleaved
     // alike), `None` where no group interleaves.
     let mixed = |groups: &[&Vec<usize>]| {
