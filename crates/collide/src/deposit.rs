@@ -248,11 +248,23 @@ impl Query<'_> {
     /// Whether the box of `centre` ± `half` may hold a point deeper than `depth` inside the
     /// head: not wholly at or below the tip's level, not cleared by the distance bound.
     fn may_hold(&self, centre: V3, half: V3, depth: f64) -> bool {
-        let h = dot(sub(centre, self.tip), self.axis);
+        let d = sub(centre, self.tip);
+        let h = dot(d, self.axis);
         let reach = half[0] * self.axis[0].abs()
             + half[1] * self.axis[1].abs()
             + half[2] * self.axis[2].abs();
-        h + reach > depth && self.distance(centre) - norm(half) < -depth
+        if h + reach <= depth {
+            return false;
+        }
+        let r = (dot(d, d) - h * h).max(0.0).sqrt();
+        let rho = norm(half);
+        // A box wholly below the body's bottom by more than `depth` (its extent along the axis
+        // is exact, unlike the half-diagonal: a layer's flat box grazing the body's bottom rim)
+        // can only be deeper than `depth` in the cone.
+        if h + reach < self.shape.body_bottom() - depth {
+            return self.shape.cone_distance(h, r) - rho < -depth;
+        }
+        self.shape.distance(h, r) - rho < -depth
     }
 
     /// The feature of leaf `n` if one of its quarter cells lies wholly deeper than the

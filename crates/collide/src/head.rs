@@ -107,13 +107,22 @@ impl HeadShape {
     /// wholly outside. The cone and the body are each an intersection of convex constraints
     /// (the largest constraint distance), the head their union (the smaller).
     pub fn distance(&self, h: f64, r: f64) -> f64 {
-        let cone = (-h)
-            .max(h - self.nozzle)
-            .max((r - self.tip - h * self.tan) * self.cos);
+        let cone = self.cone_distance(h, r);
         let body = (self.nozzle - h)
             .max(h - self.body)
             .max(r - self.body_radius);
         cone.min(body)
+    }
+
+    /// [`HeadShape::distance`] of the nozzle cone alone (1-Lipschitz too).
+    pub fn cone_distance(&self, h: f64, r: f64) -> f64 {
+        (-h).max(h - self.nozzle)
+            .max((r - self.tip - h * self.tan) * self.cos)
+    }
+
+    /// Height of the body's bottom (the cone's top) up the tool axis from the tip.
+    pub fn body_bottom(&self) -> f64 {
+        self.nozzle
     }
 
     /// Radius of the circles that bound the head across the tool axis, bottom to top, with
