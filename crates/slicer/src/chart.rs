@@ -187,6 +187,20 @@ impl<'a> Chart<'a> {
         }
     }
 
+    /// The projection chart onto the plane through `c` square to the unit normal `n` (into the
+    /// feature), its normal coordinate growing along `along` when set ([`Chart::along`]).
+    fn tangent_plane(surf: &'a Surface, sign: f64, c: P3, n: V3, along: Option<V3>) -> Chart<'a> {
+        let e1 = any_perpendicular(&n).normalize();
+        let e2 = n.cross(&e1);
+        Chart {
+            surf,
+            sign,
+            blend: None,
+            along,
+            kind: ChartKind::Ortho { c, e1, e2 },
+        }
+    }
+
     /// The same chart with its normal coordinate the morph level towards `top`.
     pub(crate) fn blended<'b>(&self, top: &'b TopField) -> Chart<'b>
     where
@@ -277,10 +291,8 @@ impl<'a> Chart<'a> {
     /// Chart coordinates and distance `d` of `p` (its nearest point on the reference); on a
     /// blended chart, the morph level instead of the distance.
     pub fn inverse(&self, p: &P3) -> Option<(Point2, f64)> {
-        if let (Some(a), ChartKind::Ortho { c, e1, e2 }) = (self.along, self.kind) {
-            // A translate chart: the reference point under `p` along `a`.
-            let q = [(p - c).dot(&e1), (p - c).dot(&e2)];
-            let (u, v) = self.uv(q)?;
+        if let Some(a) = self.along {
+            let (q, (u, v)) = self.foot_along(p)?;
             let d = (p - self.surf.eval(u, v)).dot(&a);
             return self.level(q, d);
         }
@@ -329,6 +341,17 @@ impl<'a> Chart<'a> {
             ChartKind::Ortho { c, e1, e2 } => [(f - c).dot(&e1), (f - c).dot(&e2)],
         };
         self.level(q, d)
+    }
+
+    /// On a translate chart, the chart point of `p` and the parameters of the reference point
+    /// under it along [`Chart::along`]; `None` on other charts.
+    fn foot_along(&self, p: &P3) -> Option<(Point2, (f64, f64))> {
+        let ChartKind::Ortho { c, e1, e2 } = self.kind else {
+            return None;
+        };
+        self.along?;
+        let q = [(p - c).dot(&e1), (p - c).dot(&e2)];
+        Some((q, self.uv(q)?))
     }
 
     /// Chart point `q` at distance `d`, with `d` made the morph level on a blended chart (the
@@ -460,16 +483,7 @@ pub(crate) fn choose_chart<'a>(
             },
         });
     }
-    let c = surf.eval(u0, v0);
-    let e1 = any_perpendicular(&n0).normalize();
-    let e2 = n0.cross(&e1);
-    let chart = Chart {
-        surf,
-        sign,
-        blend: None,
-        along: None,
-        kind: ChartKind::Ortho { c, e1, e2 },
-    };
+    let chart = Chart::tangent_plane(surf, sign, surf.eval(u0, v0), n0, None);
     // The projection chart needs the reference to be a height field over the tangent plane.
     for p in mesh.positions.iter().step_by(stride) {
         let (u, v) = surf.project(p, None);
@@ -482,6 +496,30 @@ pub(crate) fn choose_chart<'a>(
         }
     }
     Ok(chart)
+}
+
+/// A point of a feature's root: its parameters on the reference and its place.
+pub(crate) type RootPoint = (f64, f64, P3);
+
+/// A feature's root on its reference: the vertices of its mesh that lie on the surface (within
+/// `tol`, or a micrometre), as `(u, v, point)`, and the parameters of the surface point nearest
+/// their centre. `None` without any.
+pub(crate) fn root(surf: &Surface, mesh: &Mesh, tol: f64) -> Option<(Vec<RootPoint>, (f64, f64))> {
+    let roots: Vec<RootPoint> = mesh
+        .positions
+        .iter()
+        .filter_map(|p| {
+            let (u, v) = surf.project(p, None);
+            let f = surf.eval(u, v);
+            ((p - f).norm() < 1e-3f64.max(2.0 * tol)).then_some((u, v, f))
+        })
+        .collect();
+    if roots.is_empty() {
+        return None;
+    }
+    let centre = roots.iter().fold(V3::zeros(), |a, r| a + r.2.coords) / roots.len() as f64;
+    let uv = surf.project(&P3::from(centre), None);
+    Some((roots, uv))
 }
 
 /// Most a translate chart's direction may lean from the reference's normal under the feature,
@@ -502,36 +540,13 @@ pub(crate) fn translate_chart<'a>(
     mesh: &Mesh,
     tol: f64,
 ) -> Option<Chart<'a>> {
-    let roots: Vec<(f64, f64, P3)> = mesh
-        .positions
-        .iter()
-        .filter_map(|p| {
-            let (u, v) = surf.project(p, None);
-            let f = surf.eval(u, v);
-            ((p - f).norm() < 1e-3f64.max(2.0 * tol)).then_some((u, v, f))
-        })
-        .collect();
-    if roots.is_empty() {
-        return None;
-    }
-    let centre = roots.iter().fold(V3::zeros(), |a, r| a + r.2.coords) / roots.len() as f64;
-    let (u0, v0) = surf.project(&P3::from(centre), None);
+    let (_, (u0, v0)) = root(surf, mesh, tol)?;
     let a = surf.normal(u0, v0)? * sign;
-    let c = surf.eval(u0, v0);
-    let e1 = any_perpendicular(&a).normalize();
-    let e2 = a.cross(&e1);
-    let chart = Chart {
-        surf,
-        sign,
-        blend: None,
-        along: Some(a),
-        kind: ChartKind::Ortho { c, e1, e2 },
-    };
+    let chart = Chart::tangent_plane(surf, sign, surf.eval(u0, v0), a, Some(a));
     let lean = TRANSLATE_LEAN_DEG.to_radians().cos();
     let stride = (mesh.positions.len() / 2000).max(1);
     for p in mesh.positions.iter().step_by(stride) {
-        let q = [(p - c).dot(&e1), (p - c).dot(&e2)];
-        let (u, v) = chart.uv(q)?;
+        let (_, (u, v)) = chart.foot_along(p)?;
         let n = chart.normal_at(u, v)?;
         if n.dot(&a) < lean || (p - surf.eval(u, v)).dot(&a) < -2.0 * tol.max(MICROMETRE) {
             return None;

@@ -1,11 +1,11 @@
 //! Offset deterioration (feature-based AM paper, Fig. 9): where the reference surface is
 //! concave with a radius of curvature under a layer's offset, the offset folds over itself.
 
-use crate::chart::{Chart, ChartKind};
+use crate::chart::{root, Chart, ChartKind};
 use crate::error::PlanError;
 use crate::params::LayerParams;
 use crate::tolerance::{DEGENERATE_LENGTH, FLAT_CURVATURE, MICROMETRE};
-use brep::math::{P3, V3};
+
 use brep::mesh::Mesh;
 use brep::surface::Surface;
 
@@ -22,20 +22,9 @@ pub(crate) fn fold_check(
     id: usize,
 ) -> Result<(), PlanError> {
     // The root: mesh vertices on the reference surface.
-    let roots: Vec<(f64, f64, P3)> = mesh
-        .positions
-        .iter()
-        .filter_map(|p| {
-            let (u, v) = surf.project(p, None);
-            let f = surf.eval(u, v);
-            ((p - f).norm() < 1e-3f64.max(2.0 * tol)).then_some((u, v, f))
-        })
-        .collect();
-    if roots.is_empty() {
+    let Some((roots, (u0, v0))) = root(surf, mesh, tol) else {
         return Ok(());
-    }
-    let c = roots.iter().fold(V3::zeros(), |a, r| a + r.2.coords) / roots.len() as f64;
-    let (u0, v0) = surf.project(&P3::from(c), None);
+    };
     let (su, sv) = surf.derivs(u0, v0);
     let Some(n0) = surf.normal(u0, v0).map(|n| n * sign) else {
         return Ok(());

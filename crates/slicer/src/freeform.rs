@@ -229,12 +229,11 @@ pub fn fill_freeform<'a>(
     let stride = (mapped.positions.len() / 300).max(1);
     let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
     let mut lambda = 0.0f64;
-    for p in mapped.positions.iter().step_by(stride) {
-        if translate.is_some() {
-            break;
-        }
-        if let Some(l) = chart.min_curvature([p.x, p.y], step) {
-            lambda = lambda.min(l);
+    if translate.is_none() {
+        for p in mapped.positions.iter().step_by(stride) {
+            if let Some(l) = chart.min_curvature([p.x, p.y], step) {
+                lambda = lambda.min(l);
+            }
         }
     }
     let concave_radius = if lambda < -FLAT_CURVATURE {
