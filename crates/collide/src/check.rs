@@ -254,21 +254,7 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{check, Obstacle};
-
-    fn pt(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
-        PathPoint {
-            feature,
-            layer,
-            kind,
-            p,
-            axis: [0.0, 0.0, 1.0],
-            e: 0.0,
-            thickness: 0.2,
-            width: 0.45,
-            role: toolpath::Role::Perimeter,
-        }
-    }
+    use crate::scene::{check, test_point as pt, Obstacle};
 
     /// A wall 5 mm tall (feature 0, lower than the head's body is above its tip), then travels
     /// from its top down to the plate 15 mm beside it and across, through the wall.

@@ -172,3 +172,19 @@ pub(crate) fn move_hit(
         hits: hit.1,
     })
 }
+
+/// A path point for the tests: +Z axis, no filament, a 0.45 × 0.2 mm perimeter bead.
+#[cfg(test)]
+pub(crate) fn test_point(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
+    PathPoint {
+        feature,
+        layer,
+        kind,
+        p,
+        axis: [0.0, 0.0, 1.0],
+        e: 0.0,
+        thickness: 0.2,
+        width: 0.45,
+        role: toolpath::Role::Perimeter,
+    }
+}

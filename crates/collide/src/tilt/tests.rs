@@ -3,23 +3,9 @@
 use super::*;
 use crate::check::tilt;
 use crate::head::Head;
-use crate::scene::check;
+use crate::scene::{check, test_point as pt};
 use crate::table::Table;
-use toolpath::{MoveKind, Role};
-
-fn pt(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
-    PathPoint {
-        feature,
-        layer,
-        kind,
-        p,
-        axis: [0.0, 0.0, 1.0],
-        e: 0.0,
-        thickness: 0.2,
-        width: 0.45,
-        role: Role::Perimeter,
-    }
-}
+use toolpath::MoveKind;
 
 /// A wall 10 mm tall along y at x = 0 (feature 0), then feature 1 printed along it 12 mm
 /// beside it at the plate, its planned axes +Z but for a gentle wave: the head's body (20 mm
