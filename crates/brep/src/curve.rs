@@ -81,6 +81,9 @@ pub struct NurbsData {
     pub degree: usize,
     /// The same curve for fast local evaluation.
     pub local: crate::nurbs::LocalCurve,
+    /// The points [`Curve::project`] compares `p` with to seed its Newton iterations, made on
+    /// first use: the curve at `samples + 1` evenly spaced parameters over `[t0, t1]`.
+    pub samples: std::sync::OnceLock<Vec<P3>>,
 }
 
 impl NurbsData {
@@ -112,7 +115,36 @@ impl NurbsData {
             t1,
             spans: spans.max(1),
             degree,
+            samples: std::sync::OnceLock::new(),
         }
+    }
+
+    /// How many intervals [`Curve::project`] samples the curve in before Newton's method.
+    fn sample_count(&self) -> usize {
+        (self.spans * (self.degree + 1) * 2).clamp(16, 2000)
+    }
+
+    /// The parameter of the sample nearest to `p` (the first of equals), the samples evaluated
+    /// once per curve and kept.
+    fn nearest_sample(&self, p: &P3) -> f64 {
+        let n = self.sample_count();
+        let at = |i: usize| self.t0 + (self.t1 - self.t0) * i as f64 / n as f64;
+        let pts = self.samples.get_or_init(|| {
+            (0..=n)
+                .map(|i| {
+                    let [q, _, _] = self.local.ders_upto(at(i).clamp(self.t0, self.t1), 0);
+                    P3::new(q[0], q[1], q[2])
+                })
+                .collect()
+        });
+        let mut best = (f64::INFINITY, self.t0);
+        for (i, q) in pts.iter().enumerate() {
+            let d = (q - p).norm_squared();
+            if d < best.0 {
+                best = (d, at(i));
+            }
+        }
+        best.1
     }
 }
 
@@ -263,8 +295,7 @@ impl Curve {
                 self.newton(p, l.y / (2.0 * focal), None)
             }
             Curve::Nurbs(n) => {
-                let samples = (n.spans * (n.degree + 1) * 2).clamp(16, 2000);
-                let t = self.best_sample(p, n.t0, n.t1, samples);
+                let t = n.nearest_sample(p);
                 self.newton(p, t, Some((n.t0, n.t1)))
             }
             Curve::Polyline(pts) => {
@@ -312,18 +343,6 @@ impl Curve {
             }
             _ => self.project(p),
         }
-    }
-
-    fn best_sample(&self, p: &P3, a: f64, b: f64, n: usize) -> f64 {
-        let mut best = (f64::INFINITY, a);
-        for i in 0..=n {
-            let t = a + (b - a) * i as f64 / n as f64;
-            let d = (self.eval(t) - p).norm_squared();
-            if d < best.0 {
-                best = (d, t);
-            }
-        }
-        best.1
     }
 
     /// Newton iterations on `f(t) = C'(t)·(C(t) − p)`.

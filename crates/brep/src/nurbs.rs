@@ -10,6 +10,8 @@
 /// Largest degree we evaluate (the reader rejects higher ones).
 pub const MAX_DEGREE: usize = 25;
 const M: usize = MAX_DEGREE + 1;
+/// Scratch width for degrees below it (nearly every real spline): the basis arrays stay small.
+const SMALL: usize = 8;
 
 /// The knot span `i` with `knots[i] <= t < knots[i+1]`, clamped to `[p, n-1]`.
 pub fn find_span(knots: &[f64], p: usize, n: usize, t: f64) -> usize {
@@ -44,11 +46,11 @@ pub fn find_span(knots: &[f64], p: usize, n: usize, t: f64) -> usize {
 /// `span`: `ders[k][j]` is the k-th derivative of `N_{span-p+j}`.
 pub fn basis_ders(knots: &[f64], span: usize, t: f64, p: usize, nd: usize) -> [[f64; M]; 3] {
     // Scratch sized for the usual degrees keeps the zero-filling cheap.
-    if p < 8 {
-        let d = basis_ders_n::<8>(knots, span, t, p, nd);
+    if p < SMALL {
+        let d = basis_ders_n::<SMALL>(knots, span, t, p, nd);
         let mut out = [[0.0f64; M]; 3];
         for k in 0..3 {
-            out[k][..8].copy_from_slice(&d[k]);
+            out[k][..SMALL].copy_from_slice(&d[k]);
         }
         return out;
     }
@@ -154,9 +156,18 @@ impl LocalCurve {
     /// Point and derivatives up to order `nd` (≤ 2) at `t`; higher orders come back zero.
     pub fn ders_upto(&self, t: f64, nd: usize) -> [[f64; 3]; 3] {
         let p = self.degree;
-        let n = self.cps.len();
-        let span = find_span(&self.knots, p, n, t);
-        let b = basis_ders(&self.knots, span, t, p, nd);
+        let span = find_span(&self.knots, p, self.cps.len(), t);
+        // The usual degrees on a small scratch: the basis is not copied into the widest one.
+        if p < SMALL {
+            self.combine(&basis_ders_n::<SMALL>(&self.knots, span, t, p, nd), span, nd)
+        } else {
+            self.combine(&basis_ders_n::<M>(&self.knots, span, t, p, nd), span, nd)
+        }
+    }
+
+    /// The curve's homogeneous derivatives from the basis on `span`, made rational.
+    fn combine<const N: usize>(&self, b: &[[f64; N]; 3], span: usize, nd: usize) -> [[f64; 3]; 3] {
+        let p = self.degree;
         let mut h = [[0.0f64; 4]; 3];
         for j in 0..=p {
             let c = &self.cps[span - p + j];
@@ -206,8 +217,27 @@ impl LocalSurface {
         let (p, q) = self.degree;
         let su = find_span(&self.ku, p, self.n.0, u);
         let sv = find_span(&self.kv, q, self.n.1, v);
-        let bu = basis_ders(&self.ku, su, u, p, 1);
-        let bv = basis_ders(&self.kv, sv, v, q, 1);
+        // The usual degrees on a small scratch, as for curves.
+        if p < SMALL && q < SMALL {
+            let bu = basis_ders_n::<SMALL>(&self.ku, su, u, p, 1);
+            let bv = basis_ders_n::<SMALL>(&self.kv, sv, v, q, 1);
+            self.combine(&bu, &bv, su, sv)
+        } else {
+            let bu = basis_ders_n::<M>(&self.ku, su, u, p, 1);
+            let bv = basis_ders_n::<M>(&self.kv, sv, v, q, 1);
+            self.combine(&bu, &bv, su, sv)
+        }
+    }
+
+    /// Point, `S_u` and `S_v` from the bases in `u` and `v` on spans `su`, `sv`.
+    fn combine<const N: usize>(
+        &self,
+        bu: &[[f64; N]; 3],
+        bv: &[[f64; N]; 3],
+        su: usize,
+        sv: usize,
+    ) -> [[f64; 3]; 3] {
+        let (p, q) = self.degree;
         // h[0] = S_w, h[1] = ∂u S_w, h[2] = ∂v S_w.
         let mut h = [[0.0f64; 4]; 3];
         for a in 0..=p {
