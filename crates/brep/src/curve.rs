@@ -189,6 +189,22 @@ impl Curve {
         }
     }
 
+    /// The point and first two derivatives at `t`, in one evaluation where the curve allows
+    /// (the same values as [`Curve::eval`], [`Curve::deriv`] and [`Curve::deriv2`]).
+    pub fn eval_d2(&self, t: f64) -> (P3, V3, V3) {
+        match self {
+            Curve::Nurbs(n) => {
+                let [p, d, dd] = n.local.ders(t.clamp(n.t0, n.t1));
+                (
+                    P3::new(p[0], p[1], p[2]),
+                    V3::new(d[0], d[1], d[2]),
+                    V3::new(dd[0], dd[1], dd[2]),
+                )
+            }
+            _ => (self.eval(t), self.deriv(t), self.deriv2(t)),
+        }
+    }
+
     /// The first derivative `C'(t)`.
     pub fn deriv(&self, t: f64) -> V3 {
         match self {
@@ -348,9 +364,8 @@ impl Curve {
     /// Newton iterations on `f(t) = C'(t)·(C(t) − p)`.
     fn newton(&self, p: &P3, mut t: f64, clamp: Option<(f64, f64)>) -> f64 {
         for _ in 0..30 {
-            let d = self.eval(t) - p;
-            let c1 = self.deriv(t);
-            let c2 = self.deriv2(t);
+            let (c, c1, c2) = self.eval_d2(t);
+            let d = c - p;
             let f = c1.dot(&d);
             let df = c2.dot(&d) + c1.norm_squared();
             if df.abs() < NONZERO || !df.is_finite() {
