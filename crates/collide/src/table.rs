@@ -28,6 +28,17 @@ pub enum Table {
 /// Points sampled around a rim of the head when it reaches below the table surface.
 const RIM_SAMPLES: usize = 32;
 
+/// `(cos t, sin t)` at the rim samples' angles `t = 2πk / RIM_SAMPLES`, computed once.
+fn rim_angles() -> &'static [(f64, f64); RIM_SAMPLES] {
+    static ANGLES: std::sync::OnceLock<[(f64, f64); RIM_SAMPLES]> = std::sync::OnceLock::new();
+    ANGLES.get_or_init(|| {
+        std::array::from_fn(|k| {
+            let t = std::f64::consts::TAU * k as f64 / RIM_SAMPLES as f64;
+            (t.cos(), t.sin())
+        })
+    })
+}
+
 impl Table {
     /// Whether the head with its tip at `tip` and unit tool axis `axis` reaches more than `tol`
     /// below the table surface (within the disc). The head's lowest points lie on its rims
@@ -64,9 +75,8 @@ impl Table {
         let v = toolpath::vec3::cross(axis, u);
         for &(h, r) in &shape.rims() {
             let c = add(tip, scale(axis, h));
-            for k in 0..RIM_SAMPLES {
-                let t = std::f64::consts::TAU * k as f64 / RIM_SAMPLES as f64;
-                let p = add(c, add(scale(u, r * t.cos()), scale(v, r * t.sin())));
+            for &(cos, sin) in rim_angles() {
+                let p = add(c, add(scale(u, r * cos), scale(v, r * sin)));
                 if p[2] < z - tol && (p[0] - centre[0]).hypot(p[1] - centre[1]) <= radius {
                     return true;
                 }
