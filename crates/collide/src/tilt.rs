@@ -15,14 +15,16 @@
 //!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
 //!    first that clears), [`AZIMUTHS`] directions each, starting the way the nearest key turns
 //!    (two turns the other way about would average to less than either between them), else
-//!    towards +Z (away from the table). A turn is allowed when it keeps the axis within the
+//!    towards +Z (away from the table); against the table, before the rings, the turns towards
+//!    the allowed axis nearest +Z in steps of [`FINE_STEP_DEG`] (near the cone's rim the clear
+//!    turns are too few for the rings' directions to meet). A turn is allowed when it keeps the axis within the
 //!    cone (and a B/C bed's B limit) and differs from the keys beside it by at most the blend's
 //!    slope ([`TiltLimits::slope`]). The bead's start, which a lift cannot clear when the head
 //!    collides there, gets a key of its own on the same terms; so does each travel point
 //!    leading to it, but bound to no other key (a travel lays no bead, and those points all
 //!    lie at arc length 0, where the slope would force one turn on them all). Keys found in
 //!    one pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after
-//!    a move no turn clears;
+//!    a move no turn clears (the moves it passed over are tried in the next pass);
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
 //!    two windows, held from the bead's start (and its lead) to a first key that close,
 //!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
@@ -39,6 +41,10 @@ use toolpath::{PathPoint, ToolPath};
 
 /// Angle between rings of axes tried about a colliding point's axis, degrees.
 pub const RING_STEP_DEG: f64 = 5.0;
+
+/// Step, degrees, of the turns tried towards the allowed axis nearest +Z where the head meets
+/// the table.
+pub const FINE_STEP_DEG: f64 = 1.0;
 
 /// Directions tried on each ring.
 pub const AZIMUTHS: usize = 8;
@@ -184,13 +190,15 @@ pub(crate) fn tilt_run(
     let mut lead_keys: BTreeMap<usize, V3> = BTreeMap::new();
     let none: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
-    // Where the last search along the bead found no turn: the moves just after it mostly meet
-    // the same obstacle, so the search waits [`RETRY_MM`] of path.
-    let mut failed: Option<f64> = None;
     let mut axes = given.clone();
     let mut now: Vec<Option<Collision>> = before.to_vec();
     for _ in 0..PASSES {
         let mut added = false;
+        // Where the last search along the bead found no turn: the moves just after it mostly
+        // meet the same obstacle, so the search waits [`RETRY_MM`] of path; those it passed
+        // over are tried in the next pass.
+        let mut failed: Option<f64> = None;
+        let mut waited = false;
         // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
         // for the blend, and are searched in the next pass if it leaves them colliding.
         let mut found: Option<f64> = None;
@@ -235,7 +243,10 @@ pub(crate) fn tilt_run(
                 }
                 Some(_) => continue,
                 None if tried[k] => continue,
-                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => continue,
+                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => {
+                    waited = true;
+                    continue;
+                }
                 None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
                 None => (k, None),
             };
@@ -258,9 +269,11 @@ pub(crate) fn tilt_run(
             }
         }
         if !added {
+            if waited {
+                continue;
+            }
             break;
         }
-        failed = None;
         let field = blend(&keys, &s, limits.window_mm);
         let last = axes.clone();
         for k in 0..run.len() {
@@ -366,6 +379,22 @@ fn search(
     if let Some((_, &w)) = nearest {
         if clears(w) {
             return Some(w);
+        }
+    }
+    // Against the table, the way to the allowed axis nearest +Z, in fine steps: the head's
+    // lowest point rises with the axis's height, and near the cone's rim the clear turns are
+    // too few for the rings' directions to meet.
+    if hits == Obstacle::Table {
+        let h = allowed[k].highest();
+        let full = angle(a, h);
+        if let Some(about) = unit(cross(a, h)) {
+            let n = (full / FINE_STEP_DEG.to_radians()).ceil() as usize;
+            if let Some(w) = (1..=n)
+                .map(|i| scale(about, full * i as f64 / n as f64))
+                .find(|&w| clears(w))
+            {
+                return Some(w);
+            }
         }
     }
     // Directions across the axis, the first the way the nearest key turns (keys turned alike
