@@ -190,6 +190,8 @@ pub(crate) fn tilt_run(
     let mut lead_keys: BTreeMap<usize, V3> = BTreeMap::new();
     let none: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
+    // Points before a key given the least turn that clears the head there (see below).
+    let mut lifted = vec![false; run.len()];
     let mut axes = given.clone();
     let mut now: Vec<Option<Collision>> = before.to_vec();
     for _ in 0..PASSES {
@@ -228,18 +230,23 @@ pub(crate) fn tilt_run(
             }
             // A key on the bead that still collides (its move starts from a blended axis):
             // the point before it takes the same turn.
-            let (k, w) = match keys.get(&k) {
+            let (k, w, ahead) = match keys.get(&k) {
                 Some(&w)
                     if k > lead
                         && !keys.contains_key(&(k - 1))
                         && allowed[k - 1].holds(rotate(given[k - 1], w))
                         && near(&keys, &s, k - 1, w, limits) =>
                 {
-                    (k - 1, Some(w))
+                    (k - 1, Some(w), true)
                 }
-                // Or a turn of its own, if none was searched there yet.
-                Some(_) if k > lead && !keys.contains_key(&(k - 1)) && !tried[k - 1] => {
-                    (k - 1, None)
+                // Or a turn of its own, if none was searched there yet, or none that clears
+                // the head at the point alone.
+                Some(_)
+                    if k > lead
+                        && !keys.contains_key(&(k - 1))
+                        && !(tried[k - 1] && lifted[k - 1]) =>
+                {
+                    (k - 1, None, true)
                 }
                 Some(_) => continue,
                 None if tried[k] => continue,
@@ -248,10 +255,13 @@ pub(crate) fn tilt_run(
                     continue;
                 }
                 None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
-                None => (k, None),
+                None => (k, None, false),
             };
-            tried[k] = true;
+            let searched = std::mem::replace(&mut tried[k], true);
             let w = w.or_else(|| {
+                if searched {
+                    return None;
+                }
                 let at = Candidate {
                     k,
                     lead,
@@ -259,6 +269,46 @@ pub(crate) fn tilt_run(
                 };
                 search(scene, run, &given, &allowed, &keys, &s, at, limits)
             });
+            // Against the table, a move no one turn clears (its start needs a larger turn than
+            // its end allows, or the other way about): its start gets a key of its own first,
+            // the least turn towards the allowed axis nearest +Z that clears the head there,
+            // and the move is searched again from it.
+            let w = match w {
+                None if !searched
+                    && c.hits == Obstacle::Table
+                    && k > lead
+                    && !keys.contains_key(&(k - 1)) =>
+                {
+                    let start = lift(scene, run[k - 1].p, given[k - 1], &allowed[k - 1], |w| {
+                        near(&keys, &s, k - 1, w, limits)
+                    });
+                    start.and_then(|w0| {
+                        keys.insert(k - 1, w0);
+                        let at = Candidate {
+                            k,
+                            lead,
+                            hits: c.hits,
+                        };
+                        let w = search(scene, run, &given, &allowed, &keys, &s, at, limits);
+                        if w.is_none() {
+                            keys.remove(&(k - 1));
+                        }
+                        w
+                    })
+                }
+                w => w,
+            };
+            // The point before a key whose move still collides, when no turn clears the move
+            // into it: turned so the head clears it there at least, which the move from it
+            // needs.
+            let w = match w {
+                None if ahead && !std::mem::replace(&mut lifted[k], true) => {
+                    lift(scene, run[k].p, given[k], &allowed[k], |w| {
+                        near(&keys, &s, k, w, limits)
+                    })
+                }
+                w => w,
+            };
             match w {
                 Some(w) => {
                     keys.insert(k, w);
@@ -306,6 +356,25 @@ pub(crate) fn tilt_run(
         .any(|(a, b)| a.is_some() && b.is_none());
     let fewer = now.iter().flatten().count() < before.iter().flatten().count();
     (fewer && !new).then_some((axes, now))
+}
+
+/// The least turn of the axis `a` at `tip`, towards the allowed axis nearest +Z in steps of
+/// [`FINE_STEP_DEG`], that keeps it allowed, passes `fits` and clears the head there; `None`
+/// when none does (at once when that axis meets the table).
+fn lift(scene: &Scene, tip: V3, a: V3, allowed: &Allowed, fits: impl Fn(V3) -> bool) -> Option<V3> {
+    let h = allowed.highest();
+    if !allowed.holds(a) || scene.hits_table(tip, h) {
+        return None;
+    }
+    let full = angle(a, h);
+    let about = unit(cross(a, h))?;
+    let n = (full / FINE_STEP_DEG.to_radians()).ceil() as usize;
+    (1..=n)
+        .map(|i| scale(about, full * i as f64 / n as f64))
+        .find(|&w| {
+            let b = rotate(a, w);
+            allowed.holds(b) && fits(w) && scene.at(tip, b).is_none()
+        })
 }
 
 /// Whether the turn `w` at `k` differs from the keys beside it (each side's nearest) by at most
