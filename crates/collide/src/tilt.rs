@@ -248,6 +248,9 @@ pub(crate) fn tilt_run(
                 {
                     (k - 1, None, true)
                 }
+                // Or, where the head meets something at the key's point itself, the least turn
+                // that clears it there.
+                Some(_) if !lifted[k] && scene.at(run[k].p, axes[k]).is_some() => (k, None, true),
                 Some(_) => continue,
                 None if tried[k] => continue,
                 None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => {
@@ -282,19 +285,64 @@ pub(crate) fn tilt_run(
                     let start = lift(scene, run[k - 1].p, given[k - 1], &allowed[k - 1], |w| {
                         near(&keys, &s, k - 1, w, limits)
                     });
-                    start.and_then(|w0| {
-                        keys.insert(k - 1, w0);
-                        let at = Candidate {
-                            k,
-                            lead,
-                            hits: c.hits,
-                        };
-                        let w = search(scene, run, &given, &allowed, &keys, &s, at, limits);
-                        if w.is_none() {
-                            keys.remove(&(k - 1));
+                    start
+                        .and_then(|w0| {
+                            keys.insert(k - 1, w0);
+                            let at = Candidate {
+                                k,
+                                lead,
+                                hits: c.hits,
+                            };
+                            let w = search(scene, run, &given, &allowed, &keys, &s, at, limits);
+                            if w.is_none() {
+                                keys.remove(&(k - 1));
+                            }
+                            w
+                        })
+                        .or_else(|| {
+                            // Else both ends turned all the way to their highest allowed axes.
+                            let w0 = towards(given[k - 1], allowed[k - 1].highest());
+                            let w1 = towards(given[k], allowed[k].highest());
+                            let (a0, a1) = (rotate(given[k - 1], w0), rotate(given[k], w1));
+                            let clear = near(&keys, &s, k - 1, w0, limits)
+                                && (k - 1 > lead || scene.at(run[k - 1].p, a0).is_none())
+                                && scene.sweep(run[k - 1].p, a0, run[k].p, a1).is_none();
+                            if !clear {
+                                return None;
+                            }
+                            keys.insert(k - 1, w0);
+                            if near(&keys, &s, k, w1, limits) {
+                                Some(w1)
+                            } else {
+                                keys.remove(&(k - 1));
+                                None
+                            }
+                        })
+                }
+                // Or, where the key at its start holds the turn back (the slope between them),
+                // one turn for both: that key moved to it.
+                None if !searched && c.hits == Obstacle::Table && k > lead => {
+                    let old = keys.remove(&(k - 1));
+                    let at = Candidate {
+                        k,
+                        lead,
+                        hits: c.hits,
+                    };
+                    let w =
+                        search(scene, run, &given, &allowed, &keys, &s, at, limits).filter(|&w| {
+                            allowed[k - 1].holds(rotate(given[k - 1], w))
+                                && near(&keys, &s, k - 1, w, limits)
+                        });
+                    match (w, old) {
+                        (Some(w), _) => {
+                            keys.insert(k - 1, w);
                         }
-                        w
-                    })
+                        (None, Some(old)) => {
+                            keys.insert(k - 1, old);
+                        }
+                        (None, None) => {}
+                    }
+                    w
                 }
                 w => w,
             };
@@ -305,6 +353,19 @@ pub(crate) fn tilt_run(
                 None if ahead && !std::mem::replace(&mut lifted[k], true) => {
                     lift(scene, run[k].p, given[k], &allowed[k], |w| {
                         near(&keys, &s, k, w, limits)
+                    })
+                    .or_else(|| {
+                        // Where the key just before it holds the turn back (the slope between
+                        // them), that key moved to the same turn.
+                        let j = k.checked_sub(1).filter(|&j| j >= lead)?;
+                        let old = keys.remove(&j)?;
+                        let w = lift(scene, run[k].p, given[k], &allowed[k], |w| {
+                            near(&keys, &s, k, w, limits)
+                                && allowed[j].holds(rotate(given[j], w))
+                                && near(&keys, &s, j, w, limits)
+                        });
+                        keys.insert(j, w.unwrap_or(old));
+                        w
                     })
                 }
                 w => w,
@@ -375,6 +436,11 @@ fn lift(scene: &Scene, tip: V3, a: V3, allowed: &Allowed, fits: impl Fn(V3) -> b
             let b = rotate(a, w);
             allowed.holds(b) && fits(w) && scene.at(tip, b).is_none()
         })
+}
+
+/// The turn (rotation vector) that takes the unit axis `a` to the unit axis `b` the short way.
+fn towards(a: V3, b: V3) -> V3 {
+    unit(cross(a, b)).map_or([0.0; 3], |k| scale(k, angle(a, b)))
 }
 
 /// Whether the turn `w` at `k` differs from the keys beside it (each side's nearest) by at most
