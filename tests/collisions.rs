@@ -468,7 +468,7 @@ impl TableModel {
 /// must then be one whose clearing breaks the axis's step bound, or leaves a neighbouring move
 /// on the table, or that ends its bead. The counts per feature go to stderr.
 fn left_moves_meet_the_table_whatever_the_axis(name: &str, machine: &str, run: &Planned) {
-    let (window, half) = SMOOTHING;
+    let (_, half) = SMOOTHING;
     let m = MachineProfile::builtin(if machine == "kuka" {
         MachineKind::Kuka
     } else {
