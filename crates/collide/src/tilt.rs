@@ -24,7 +24,13 @@
 //!    leading to it, but bound to no other key (a travel lays no bead, and those points all
 //!    lie at arc length 0, where the slope would force one turn on them all). Keys found in
 //!    one pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after
-//!    a move no turn clears (the moves it passed over are tried in the next pass);
+//!    a move no turn clears (the moves it passed over are tried in the next pass). Against the
+//!    table, a move no one turn clears (its ends need different turns) gets a key at its start
+//!    first, the least turn towards the highest allowed axis that clears the head there, or
+//!    both ends that axis, and is searched again; a key at its start that holds its turn back
+//!    by the slope is moved to its turn. Where a key's move still collides and the key's turn
+//!    is not allowed at the point before, that point gets the least turn clearing the head
+//!    there; so does a key's own point where the head still meets something;
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
 //!    two windows, held from the bead's start (and its lead) to a first key that close,
 //!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
