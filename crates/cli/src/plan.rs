@@ -144,9 +144,13 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     // The preview: the features and the path, in one page that opens offline.
     let preview_name = outputs.name("preview.html");
     let page = crate::preview::plan_page(&plan, &path.display().to_string());
+    // The colliding moves left, one line each, where there are any.
+    let collisions_name =
+        (!plan.collisions.left.is_empty()).then(|| outputs.name("collisions.csv"));
     plan.report.outputs = std::iter::once(csv.clone())
         .chain(program.iter().map(|(n, _)| n.clone()))
         .chain(std::iter::once(preview_name.clone()))
+        .chain(collisions_name.clone())
         .collect();
     let json = plan.report.to_json().map_err(|e| Failure::new(path, e))?;
     let written = |name: &str, r: std::io::Result<()>| {
@@ -164,6 +168,14 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         &preview_name,
         write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),
     )?;
+    if let Some(name) = &collisions_name {
+        written(
+            name,
+            write_atomic(&dir.join(name), |w| {
+                plan::collisions::write_csv(&plan.collisions, w)
+            }),
+        )?;
+    }
     // The report last: a folder with plan.json holds a whole plan.
     let report = outputs.name("plan.json");
     written(

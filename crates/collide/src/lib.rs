@@ -31,4 +31,4 @@ pub use head::{Head, HeadShape};
 pub use order::interleave;
 pub use scene::{check, Collision, Obstacle, Scene, SWEEP_STEP, TOLERANCE};
 pub use table::Table;
-pub use tilt::{blend, TiltLimits, Tilted, AZIMUTHS, RING_STEP_DEG};
+pub use tilt::{blend, TiltLimits, Tilted, AZIMUTHS, FINE_STEP_DEG, RING_STEP_DEG};

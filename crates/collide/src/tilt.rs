@@ -15,14 +15,22 @@
 //!    rings of [`RING_STEP_DEG`] about the axis (every other one, then the one inside the
 //!    first that clears), [`AZIMUTHS`] directions each, starting the way the nearest key turns
 //!    (two turns the other way about would average to less than either between them), else
-//!    towards +Z (away from the table). A turn is allowed when it keeps the axis within the
+//!    towards +Z (away from the table); against the table, before the rings, the turns towards
+//!    the allowed axis nearest +Z in steps of [`FINE_STEP_DEG`] (near the cone's rim the clear
+//!    turns are too few for the rings' directions to meet). A turn is allowed when it keeps the axis within the
 //!    cone (and a B/C bed's B limit) and differs from the keys beside it by at most the blend's
 //!    slope ([`TiltLimits::slope`]). The bead's start, which a lift cannot clear when the head
 //!    collides there, gets a key of its own on the same terms; so does each travel point
 //!    leading to it, but bound to no other key (a travel lays no bead, and those points all
 //!    lie at arc length 0, where the slope would force one turn on them all). Keys found in
 //!    one pass lie [`KEY_SPACING_MM`] apart at least, and the search waits [`RETRY_MM`] after
-//!    a move no turn clears;
+//!    a move no turn clears (the moves it passed over are tried in the next pass). Against the
+//!    table, a move no one turn clears (its ends need different turns) gets a key at its start
+//!    first, the least turn towards the highest allowed axis that clears the head there, or
+//!    both ends that axis, and is searched again; a key at its start that holds its turn back
+//!    by the slope is moved to its turn. Where a key's move still collides and the key's turn
+//!    is not allowed at the point before, that point gets the least turn clearing the head
+//!    there; so does a key's own point where the head still meets something;
 //! 2. **blend**: the turn field along the path, linear in arc length between keys closer than
 //!    two windows, held from the bead's start (and its lead) to a first key that close,
 //!    falling to nothing over one window (the smoothing's `window_mm`) beyond the outer keys
@@ -39,6 +47,10 @@ use toolpath::{PathPoint, ToolPath};
 
 /// Angle between rings of axes tried about a colliding point's axis, degrees.
 pub const RING_STEP_DEG: f64 = 5.0;
+
+/// Step, degrees, of the turns tried towards the allowed axis nearest +Z where the head meets
+/// the table.
+pub const FINE_STEP_DEG: f64 = 1.0;
 
 /// Directions tried on each ring.
 pub const AZIMUTHS: usize = 8;
@@ -184,13 +196,17 @@ pub(crate) fn tilt_run(
     let mut lead_keys: BTreeMap<usize, V3> = BTreeMap::new();
     let none: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
-    // Where the last search along the bead found no turn: the moves just after it mostly meet
-    // the same obstacle, so the search waits [`RETRY_MM`] of path.
-    let mut failed: Option<f64> = None;
+    // Points before a key given the least turn that clears the head there (see below).
+    let mut lifted = vec![false; run.len()];
     let mut axes = given.clone();
     let mut now: Vec<Option<Collision>> = before.to_vec();
     for _ in 0..PASSES {
         let mut added = false;
+        // Where the last search along the bead found no turn: the moves just after it mostly
+        // meet the same obstacle, so the search waits [`RETRY_MM`] of path; those it passed
+        // over are tried in the next pass.
+        let mut failed: Option<f64> = None;
+        let mut waited = false;
         // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
         // for the blend, and are searched in the next pass if it leaves them colliding.
         let mut found: Option<f64> = None;
@@ -220,27 +236,41 @@ pub(crate) fn tilt_run(
             }
             // A key on the bead that still collides (its move starts from a blended axis):
             // the point before it takes the same turn.
-            let (k, w) = match keys.get(&k) {
+            let (k, w, ahead) = match keys.get(&k) {
                 Some(&w)
                     if k > lead
                         && !keys.contains_key(&(k - 1))
                         && allowed[k - 1].holds(rotate(given[k - 1], w))
                         && near(&keys, &s, k - 1, w, limits) =>
                 {
-                    (k - 1, Some(w))
+                    (k - 1, Some(w), true)
                 }
-                // Or a turn of its own, if none was searched there yet.
-                Some(_) if k > lead && !keys.contains_key(&(k - 1)) && !tried[k - 1] => {
-                    (k - 1, None)
+                // Or a turn of its own, if none was searched there yet, or none that clears
+                // the head at the point alone.
+                Some(_)
+                    if k > lead
+                        && !keys.contains_key(&(k - 1))
+                        && !(tried[k - 1] && lifted[k - 1]) =>
+                {
+                    (k - 1, None, true)
                 }
+                // Or, where the head meets something at the key's point itself, the least turn
+                // that clears it there.
+                Some(_) if !lifted[k] && scene.at(run[k].p, axes[k]).is_some() => (k, None, true),
                 Some(_) => continue,
                 None if tried[k] => continue,
-                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => continue,
+                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => {
+                    waited = true;
+                    continue;
+                }
                 None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
-                None => (k, None),
+                None => (k, None, false),
             };
-            tried[k] = true;
+            let searched = std::mem::replace(&mut tried[k], true);
             let w = w.or_else(|| {
+                if searched {
+                    return None;
+                }
                 let at = Candidate {
                     k,
                     lead,
@@ -248,6 +278,104 @@ pub(crate) fn tilt_run(
                 };
                 search(scene, run, &given, &allowed, &keys, &s, at, limits)
             });
+            // Against the table, a move no one turn clears (its start needs a larger turn than
+            // its end allows, or the other way about): its start gets a key of its own first,
+            // the least turn towards the allowed axis nearest +Z that clears the head there,
+            // and the move is searched again from it.
+            let w = match w {
+                None if !searched
+                    && c.hits == Obstacle::Table
+                    && k > lead
+                    && !keys.contains_key(&(k - 1)) =>
+                {
+                    let start = lift(scene, run[k - 1].p, given[k - 1], &allowed[k - 1], |w| {
+                        near(&keys, &s, k - 1, w, limits)
+                    });
+                    start
+                        .and_then(|w0| {
+                            keys.insert(k - 1, w0);
+                            let at = Candidate {
+                                k,
+                                lead,
+                                hits: c.hits,
+                            };
+                            let w = search(scene, run, &given, &allowed, &keys, &s, at, limits);
+                            if w.is_none() {
+                                keys.remove(&(k - 1));
+                            }
+                            w
+                        })
+                        .or_else(|| {
+                            // Else both ends turned all the way to their highest allowed axes.
+                            let w0 = towards(given[k - 1], allowed[k - 1].highest());
+                            let w1 = towards(given[k], allowed[k].highest());
+                            let (a0, a1) = (rotate(given[k - 1], w0), rotate(given[k], w1));
+                            let clear = near(&keys, &s, k - 1, w0, limits)
+                                && (k - 1 > lead || scene.at(run[k - 1].p, a0).is_none())
+                                && scene.sweep(run[k - 1].p, a0, run[k].p, a1).is_none();
+                            if !clear {
+                                return None;
+                            }
+                            keys.insert(k - 1, w0);
+                            if near(&keys, &s, k, w1, limits) {
+                                Some(w1)
+                            } else {
+                                keys.remove(&(k - 1));
+                                None
+                            }
+                        })
+                }
+                // Or, where the key at its start holds the turn back (the slope between them),
+                // one turn for both: that key moved to it.
+                None if !searched && c.hits == Obstacle::Table && k > lead => {
+                    let old = keys.remove(&(k - 1));
+                    let at = Candidate {
+                        k,
+                        lead,
+                        hits: c.hits,
+                    };
+                    let w =
+                        search(scene, run, &given, &allowed, &keys, &s, at, limits).filter(|&w| {
+                            allowed[k - 1].holds(rotate(given[k - 1], w))
+                                && near(&keys, &s, k - 1, w, limits)
+                        });
+                    match (w, old) {
+                        (Some(w), _) => {
+                            keys.insert(k - 1, w);
+                        }
+                        (None, Some(old)) => {
+                            keys.insert(k - 1, old);
+                        }
+                        (None, None) => {}
+                    }
+                    w
+                }
+                w => w,
+            };
+            // The point before a key whose move still collides, when no turn clears the move
+            // into it: turned so the head clears it there at least, which the move from it
+            // needs.
+            let w = match w {
+                None if ahead && !std::mem::replace(&mut lifted[k], true) => {
+                    lift(scene, run[k].p, given[k], &allowed[k], |w| {
+                        near(&keys, &s, k, w, limits)
+                    })
+                    .or_else(|| {
+                        // Where the key just before it holds the turn back (the slope between
+                        // them), that key moved to the same turn.
+                        let j = k.checked_sub(1).filter(|&j| j >= lead)?;
+                        let old = keys.remove(&j)?;
+                        let w = lift(scene, run[k].p, given[k], &allowed[k], |w| {
+                            near(&keys, &s, k, w, limits)
+                                && allowed[j].holds(rotate(given[j], w))
+                                && near(&keys, &s, j, w, limits)
+                        });
+                        keys.insert(j, w.unwrap_or(old));
+                        w
+                    })
+                }
+                w => w,
+            };
             match w {
                 Some(w) => {
                     keys.insert(k, w);
@@ -258,9 +386,11 @@ pub(crate) fn tilt_run(
             }
         }
         if !added {
+            if waited {
+                continue;
+            }
             break;
         }
-        failed = None;
         let field = blend(&keys, &s, limits.window_mm);
         let last = axes.clone();
         for k in 0..run.len() {
@@ -293,6 +423,30 @@ pub(crate) fn tilt_run(
         .any(|(a, b)| a.is_some() && b.is_none());
     let fewer = now.iter().flatten().count() < before.iter().flatten().count();
     (fewer && !new).then_some((axes, now))
+}
+
+/// The least turn of the axis `a` at `tip`, towards the allowed axis nearest +Z in steps of
+/// [`FINE_STEP_DEG`], that keeps it allowed, passes `fits` and clears the head there; `None`
+/// when none does (at once when that axis meets the table).
+fn lift(scene: &Scene, tip: V3, a: V3, allowed: &Allowed, fits: impl Fn(V3) -> bool) -> Option<V3> {
+    let h = allowed.highest();
+    if !allowed.holds(a) || scene.hits_table(tip, h) {
+        return None;
+    }
+    let full = angle(a, h);
+    let about = unit(cross(a, h))?;
+    let n = (full / FINE_STEP_DEG.to_radians()).ceil() as usize;
+    (1..=n)
+        .map(|i| scale(about, full * i as f64 / n as f64))
+        .find(|&w| {
+            let b = rotate(a, w);
+            allowed.holds(b) && fits(w) && scene.at(tip, b).is_none()
+        })
+}
+
+/// The turn (rotation vector) that takes the unit axis `a` to the unit axis `b` the short way.
+fn towards(a: V3, b: V3) -> V3 {
+    unit(cross(a, b)).map_or([0.0; 3], |k| scale(k, angle(a, b)))
 }
 
 /// Whether the turn `w` at `k` differs from the keys beside it (each side's nearest) by at most
@@ -366,6 +520,22 @@ fn search(
     if let Some((_, &w)) = nearest {
         if clears(w) {
             return Some(w);
+        }
+    }
+    // Against the table, the way to the allowed axis nearest +Z, in fine steps: the head's
+    // lowest point rises with the axis's height, and near the cone's rim the clear turns are
+    // too few for the rings' directions to meet.
+    if hits == Obstacle::Table {
+        let h = allowed[k].highest();
+        let full = angle(a, h);
+        if let Some(about) = unit(cross(a, h)) {
+            let n = (full / FINE_STEP_DEG.to_radians()).ceil() as usize;
+            if let Some(w) = (1..=n)
+                .map(|i| scale(about, full * i as f64 / n as f64))
+                .find(|&w| clears(w))
+            {
+                return Some(w);
+            }
         }
     }
     // Directions across the axis, the first the way the nearest key turns (keys turned alike

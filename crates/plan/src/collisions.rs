@@ -52,6 +52,67 @@ pub struct Avoided {
     pub left: Vec<Collision>,
     /// Per feature id, its print moves cleared by tilting the tool axis.
     pub cleared: BTreeMap<usize, usize>,
+    /// The planned tool axes (before smoothing: the axes of the cones a tilt stays in) at the
+    /// start and the end of each move of `left`, in its order (the start: the end's, for a
+    /// path's first point).
+    pub planned: Vec<[V3; 2]>,
+}
+
+/// Header of `collisions.csv`: one line per colliding move left, `index` its end point's row
+/// in `toolpath.csv` (0 the first point after the header), `hits` a feature id or `table`,
+/// `x,y,z` where the head first meets it, `from_i,from_j,from_k` and
+/// `planned_i,planned_j,planned_k` the planned tool axes at the move's start and end points
+/// (before smoothing: the axes of the tolerance cones a tilt stays in).
+pub const CSV_HEADER: &str =
+    "index,feature,kind,hits,x,y,z,from_i,from_j,from_k,planned_i,planned_j,planned_k";
+
+/// Writes `collisions.csv` (see [`CSV_HEADER`]) for the moves `avoided` leaves.
+pub fn write_csv(avoided: &Avoided, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(w, "{CSV_HEADER}")?;
+    for (c, [f, a]) in avoided.left.iter().zip(&avoided.planned) {
+        let hits = match c.hits {
+            Obstacle::Feature(f) => f.to_string(),
+            Obstacle::Table => "table".into(),
+        };
+        writeln!(
+            w,
+            "{},{},{},{hits},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            c.index,
+            c.feature,
+            c.kind.as_str(),
+            c.at[0],
+            c.at[1],
+            c.at[2],
+            f[0],
+            f[1],
+            f[2],
+            a[0],
+            a[1],
+            a[2]
+        )?;
+    }
+    Ok(())
+}
+
+/// The planned axes of each of `left`'s start and end points in `path` after avoidance, which holds the
+/// points `before` (as given, `planned` their planned axes) in order with travel points lifted
+/// over the material put between some: a point of `path` at the position of the next point
+/// of `before` is that point; a lifted travel point takes its own axis.
+fn planned_at(path: &ToolPath, before: &[V3], planned: &[V3], left: &[Collision]) -> Vec<[V3; 2]> {
+    let mut of = Vec::with_capacity(path.points.len());
+    let mut i = 0;
+    for q in &path.points {
+        if i < before.len() && q.p == before[i] {
+            of.push(planned.get(i).copied());
+            i += 1;
+        } else {
+            of.push(None);
+        }
+    }
+    let at = |i: usize| of.get(i).copied().flatten().unwrap_or(path.points[i].axis);
+    left.iter()
+        .map(|c| [at(c.index.saturating_sub(1)), at(c.index)])
+        .collect()
 }
 
 /// How far [`avoid`] may tilt tool axes: inside the smoothing's tolerance cone, blended over its
@@ -92,8 +153,10 @@ pub fn avoid(
         _ => Travels::Route,
     };
     let walk = |path: &mut ToolPath, planned: &[V3], limits: Option<&TiltLimits>| {
+        let before: Vec<V3> = path.points.iter().map(|q| q.p).collect();
         let r = tilt_and_route(path, planned, &head, Some(table), travels, limits);
         Avoided {
+            planned: planned_at(path, &before, planned, &r.left),
             left: r.left,
             cleared: r.cleared,
         }

@@ -114,6 +114,8 @@ pub struct Plan {
     pub program: Vec<ProgramFile>,
     /// The features the part was planned as (one tree per solid), for previews.
     pub assembly: features::Assembly,
+    /// The print head's colliding moves left after avoidance (`collisions.csv`).
+    pub collisions: collisions::Avoided,
 }
 
 impl Plan {
@@ -391,6 +393,7 @@ pub fn plan(
         toolpath,
         program: program.files,
         assembly,
+        collisions: avoided,
     })
 }
 

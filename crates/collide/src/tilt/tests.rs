@@ -193,3 +193,42 @@ fn blend_holds_keys_and_fades_over_a_window() {
         assert!(norm(sub(f[j], f[j - 1])) <= 0.1 / 2.0 * 0.5 + 1e-12);
     }
 }
+
+/// A line printed 17 mm over the table with the tool axis level (the B limit's clamp) and
+/// planned 12° below level: the head's body clears the table only from some 16° above level,
+/// and the cone about the planned axis reaches 18°. The clear turns lie between the rings'
+/// 15° and 20° (outside the cone); the fine steps towards the highest allowed axis find them.
+#[test]
+fn tilt_finds_clear_axes_near_the_cone_rim_over_the_table() {
+    let below = 12f64.to_radians();
+    let planned_axis = [0.0, -below.cos(), -below.sin()];
+    let mut points = vec![pt(0, 0, MoveKind::Travel, [-20.0, 0.0, 17.0])];
+    for i in 0..=40 {
+        points.push(pt(0, 0, MoveKind::Print, [-20.0 + i as f64, 0.0, 17.0]));
+    }
+    for q in &mut points {
+        q.axis = [0.0, -1.0, 0.0];
+    }
+    let path = ToolPath { points };
+    let planned = vec![planned_axis; path.points.len()];
+    let head = Head::default();
+    let table = Some(Table::Plane { z: 0.0 });
+    let limits = TiltLimits {
+        cone_half_deg: 30.0,
+        max_from_z_deg: None,
+        window_mm: 5.0,
+    };
+    let given = check(&path, &head, table);
+    assert!(
+        given.iter().filter(|c| c.kind == MoveKind::Print).count() > 30,
+        "level, the head meets the table: {given:?}"
+    );
+    let out = tilt(&path, &planned, &head, table, &limits);
+    assert!(out.left.is_empty(), "{:?}", out.left);
+    assert_eq!(check(&out.path, &head, table), vec![]);
+    for q in &out.path.points {
+        let up = q.axis[2].asin().to_degrees();
+        assert!(up > 15.0 && up <= 18.0 + 1e-6, "{up}° above level");
+        assert!(angle(q.axis, planned_axis).to_degrees() <= 30.0 + 1e-6);
+    }
+}
