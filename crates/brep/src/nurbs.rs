@@ -159,7 +159,11 @@ impl LocalCurve {
         let span = find_span(&self.knots, p, self.cps.len(), t);
         // The usual degrees on a small scratch: the basis is not copied into the widest one.
         if p < SMALL {
-            self.combine(&basis_ders_n::<SMALL>(&self.knots, span, t, p, nd), span, nd)
+            self.combine(
+                &basis_ders_n::<SMALL>(&self.knots, span, t, p, nd),
+                span,
+                nd,
+            )
         } else {
             self.combine(&basis_ders_n::<M>(&self.knots, span, t, p, nd), span, nd)
         }

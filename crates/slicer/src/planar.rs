@@ -8,6 +8,7 @@
 
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
+use crate::geom2d::Point2;
 use crate::params::{LayerParams, PathMode};
 use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint};
@@ -198,20 +199,18 @@ pub fn fill_two5d(
         tops.push((z + 0.5 * dl, z + dl, dl));
         z += dl;
     }
-    let filled: Vec<Vec<FillPath>> = tops
+    let sections: Vec<Vec<Region>> = tops
         .par_iter()
-        .enumerate()
-        .map(|(layer, &(mid, _, _))| {
+        .map(|&(mid, _, _)| {
             let cut = plane.offset(mid);
             let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
                 .iter()
                 .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
                 .collect();
-            let regions = regions_from_loops(&loops);
-            let paths = fill_regions(regions, params, layer, bead.width, spacing);
-            solid_on_skins(paths, layer, heights.len())
+            regions_from_loops(&loops)
         })
         .collect();
+    let filled = fill_sections(sections, params, bead.width, spacing);
     Ok(Two5dFill {
         id: f.id,
         plane,
@@ -220,6 +219,143 @@ pub fn fill_two5d(
         filled,
         fig,
     })
+}
+
+/// Each layer's paths from its section's regions, filled in parallel. A layer whose section is
+/// the same polygon as an earlier layer's of the same parity ([`SectionKey`]; the zig-zag's
+/// angle turns every other layer, and nothing else of a fill depends on the layer) takes a copy
+/// of that layer's fill instead of making it again: the layers of a prism are all one section.
+/// Bottom and top layers then get their solid skins.
+fn fill_sections(
+    sections: Vec<Vec<Region>>,
+    params: &LayerParams,
+    width: f64,
+    spacing: f64,
+) -> Vec<Vec<FillPath>> {
+    let n = sections.len();
+    let keys: Vec<SectionKey> = sections.par_iter().map(|r| SectionKey::new(r)).collect();
+    // The first layer with each section and parity; every layer points at its first.
+    let mut first: Vec<usize> = Vec::with_capacity(n);
+    let mut seen: crate::fast_hash::FastMap<(u64, usize), Vec<usize>> = Default::default();
+    for (layer, key) in keys.iter().enumerate() {
+        let same = seen.entry((key.hash, layer % 2)).or_default();
+        match same.iter().find(|&&j| keys[j].rings == key.rings) {
+            Some(&j) => first.push(j),
+            None => {
+                same.push(layer);
+                first.push(layer);
+            }
+        }
+    }
+    let mut fills: Vec<Option<Vec<FillPath>>> = sections
+        .into_par_iter()
+        .enumerate()
+        .map(|(layer, regions)| {
+            (first[layer] == layer).then(|| fill_regions(regions, params, layer, width, spacing))
+        })
+        .collect();
+    // The last layer to take each fill, which moves it instead of copying it.
+    let mut last: Vec<usize> = (0..n).collect();
+    for (layer, &j) in first.iter().enumerate() {
+        last[j] = layer;
+    }
+    (0..n)
+        .map(|layer| {
+            let j = first[layer];
+            let paths = if last[j] == layer {
+                fills[j].take()
+            } else {
+                fills[j].clone()
+            }
+            .unwrap_or_default();
+            solid_on_skins(paths, layer, n)
+        })
+        .collect()
+}
+
+/// A layer's section as a polygon, to find layers cut through the same one: each ring without
+/// the vertices that lie on the segment between their neighbours (where a plane cuts the
+/// diagonal of a side face's two triangles, at a point that moves along the face's edge from
+/// layer to layer), starting at its least point; the coordinates in steps of [`KEY_GRID`]
+/// (an edge a rounding off square to the layers moves its crossing by 1e-14 mm a layer).
+#[derive(Debug, PartialEq)]
+struct SectionKey {
+    /// Every ring of every region, outer first, in grid steps.
+    rings: Vec<Vec<[u64; 2]>>,
+    /// A hash of `rings`.
+    hash: u64,
+}
+
+impl SectionKey {
+    fn new(regions: &[Region]) -> SectionKey {
+        use std::hash::{Hash, Hasher};
+        let mut rings = vec![];
+        for r in regions {
+            for (k, ring) in std::iter::once(&r.outer).chain(&r.holes).enumerate() {
+                let mut pts = without_straight_vertices(ring);
+                let start = (0..pts.len())
+                    .min_by(|&a, &b| {
+                        pts[a]
+                            .partial_cmp(&pts[b])
+                            .unwrap_or(std::cmp::Ordering::Equal)
+                    })
+                    .unwrap_or(0);
+                pts.rotate_left(start);
+                // A region's first ring is its outer one: mark it, so that holes do not pair
+                // with outer rings of other regions.
+                let mut bits = vec![[k as u64, 0]];
+                bits.extend(
+                    pts.iter()
+                        .map(|p| p.map(|x| (x / KEY_GRID).round() as i64 as u64)),
+                );
+                rings.push(bits);
+            }
+        }
+        let mut h = crate::fast_hash::FastHasher::default();
+        rings.hash(&mut h);
+        SectionKey {
+            hash: h.finish(),
+            rings,
+        }
+    }
+}
+
+/// The step sections are compared in, mm: a ten-thousandth of a micrometre, far below any
+/// tolerance of the fill (a layer taking another's fill lays it on a section this close).
+const KEY_GRID: f64 = 1e-7;
+
+/// A closed ring without its vertices that lie between their neighbours on the segment joining
+/// them (to within rounding: 1e-12 of the segment's length squared), each judged against the
+/// neighbours left after the ones before it are dropped.
+fn without_straight_vertices(ring: &[Point2]) -> Vec<Point2> {
+    let mut out: Vec<Point2> = Vec::with_capacity(ring.len());
+    let straight = |a: Point2, b: Point2, c: Point2| {
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+        let len2 = v[0] * v[0] + v[1] * v[1];
+        let along = u[0] * v[0] + u[1] * v[1];
+        (u[0] * v[1] - u[1] * v[0]).abs() <= 1e-12 * len2 && along > 0.0 && along < len2
+    };
+    for &p in ring {
+        while out.len() >= 2 && straight(out[out.len() - 2], out[out.len() - 1], p) {
+            out.pop();
+        }
+        out.push(p);
+    }
+    // Round the closing corner: the last and first vertices against their neighbours.
+    loop {
+        let m = out.len();
+        if m < 4 {
+            break;
+        }
+        if straight(out[m - 2], out[m - 1], out[0]) {
+            out.pop();
+        } else if straight(out[m - 1], out[0], out[1]) {
+            out.remove(0);
+        } else {
+            break;
+        }
+    }
+    out
 }
 
 impl Two5dFill {
@@ -307,6 +443,86 @@ impl Two5dFill {
             layers,
             figures: fig,
             freeform: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 20 × 30 mm rectangle as a section cuts it, with a point where the plane crosses each
+    /// side face's diagonal at `t` of the way along.
+    fn cut_box(t: f64) -> Vec<Region> {
+        let ring = vec![
+            [0.0, -30.0 * t],
+            [0.0, -30.0],
+            [20.0 * (1.0 - t), -30.0],
+            [20.0, -30.0],
+            [20.0, -30.0 * (1.0 - t)],
+            [20.0, 0.0],
+            [20.0 * t, 0.0],
+            [0.0, 0.0],
+        ];
+        regions_from_loops(&[ring])
+    }
+
+    #[test]
+    fn sections_of_one_polygon_share_a_key_and_others_do_not() {
+        let (a, b) = (
+            SectionKey::new(&cut_box(0.01)),
+            SectionKey::new(&cut_box(0.37)),
+        );
+        assert_eq!(a, b);
+        assert_eq!(
+            a.rings[0].len(),
+            1 + 4,
+            "the outer ring's mark and its four corners"
+        );
+        // Wider by a micrometre: another section.
+        let mut wider = cut_box(0.01);
+        for p in &mut wider[0].outer {
+            if p[0] == 20.0 {
+                p[0] += 1e-3;
+            }
+        }
+        assert_ne!(SectionKey::new(&wider), a);
+        // A hole makes another section too.
+        let mut holed = cut_box(0.01);
+        holed[0]
+            .holes
+            .push(vec![[5.0, -5.0], [5.0, -10.0], [10.0, -10.0], [10.0, -5.0]]);
+        assert_ne!(SectionKey::new(&holed), a);
+    }
+
+    /// Layers taking an earlier layer's fill get what filling their own section gives, for
+    /// every path mode: the fill depends on the layer only through its parity.
+    #[test]
+    fn a_repeated_section_gets_the_fill_its_own_would_give() {
+        for mode in [
+            PathMode::Raster,
+            PathMode::Zigzag,
+            PathMode::Contour,
+            PathMode::ContourZigzag,
+        ] {
+            let params = LayerParams {
+                path_mode: mode,
+                ..LayerParams::default()
+            };
+            let (width, spacing) = (0.45, 0.4);
+            let sections: Vec<Vec<Region>> =
+                (0..6).map(|l| cut_box(0.05 + 0.1 * l as f64)).collect();
+            let shared = fill_sections(sections.clone(), &params, width, spacing);
+            let n = sections.len();
+            for (layer, regions) in sections.into_iter().enumerate() {
+                let own = solid_on_skins(
+                    fill_regions(regions, &params, layer, width, spacing),
+                    layer,
+                    n,
+                );
+                assert!(!own.is_empty());
+                assert_eq!(shared[layer], own, "{mode:?}, layer {layer}");
+            }
         }
     }
 }

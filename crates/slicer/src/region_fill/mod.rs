@@ -24,7 +24,7 @@ pub(crate) use spurs::corner_spurs;
 
 /// One path of a curved layer in chart coordinates (or of a planar layer in its plane's),
 /// with the bead width at each point and what it is for.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FillPath {
     /// Bead centre line.
     pub points: Vec<Point2>,
