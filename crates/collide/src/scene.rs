@@ -89,10 +89,20 @@ impl Scene {
         let n = ((norm(sub(b, a)).max(turn)) / SWEEP_STEP)
             .ceil()
             .clamp(1.0, 1e5) as usize;
+        // One tool axis all along, and no material the head may meet anywhere on the move:
+        // only the table is asked at each position.
+        let clear = aa == ab
+            && unit(aa)
+                .is_some_and(|u| !self.deposit.may_meet_along(&self.shape, a, b, u, TOLERANCE));
         (1..=n).find_map(|k| {
             let t = k as f64 / n as f64;
             let tip = add(a, scale(sub(b, a), t));
             let axis = add(scale(aa, 1.0 - t), scale(ab, t));
+            if clear {
+                return self
+                    .hits_table(tip, unit(axis)?)
+                    .then_some((tip, Obstacle::Table));
+            }
             self.at(tip, axis).map(|o| (tip, o))
         })
     }
