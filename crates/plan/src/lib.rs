@@ -298,7 +298,12 @@ pub fn plan(
     // Orientation smoothing between planning and posting; the planned axes are kept for the
     // tilt that clears the head (inside the same cone about them).
     tell(Progress::Stage(STAGES[0]));
-    let planned_axes: Vec<_> = toolpath.points.iter().map(|q| q.axis).collect();
+    // (Only where the head may tilt: a 3-axis printer's axes stay +Z.)
+    let limits = collisions::tilt_limits(machine, &process.orientation);
+    let planned_axes: Vec<_> = match limits {
+        Some(_) => toolpath.points.iter().map(|q| q.axis).collect(),
+        None => vec![],
+    };
     let orientation = smooth(&mut toolpath, &process.orientation);
     // A B/C bed: axes that curved layers tip past the B limit are tilted back to it, inside
     // the orientation's tolerance cone (half its opening); farther, the post refuses them.
@@ -323,7 +328,6 @@ pub fn plan(
     }
     // The head against what is built before each move and the table (issue 18).
     tell(Progress::Stage(STAGES[1]));
-    let limits = collisions::tilt_limits(machine, &process.orientation);
     let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &reports, limits);
     let collided = collisions::entries(&avoided);
     let points = collisions::points(&toolpath);
