@@ -80,12 +80,12 @@ impl Hasher for KeyHasher {
 
 type Fast = BuildHasherDefault<KeyHasher>;
 
-/// A finest cell: its index, which quarter cells hold material, their lowest and highest index
-/// per axis, and the first feature that laid any.
+/// A finest cell: which quarter cells hold material (a 64-bit mask in two halves, so a leaf
+/// takes 20 bytes: its index is the path to it), their lowest and highest index per axis, and
+/// the first feature that laid any.
 #[derive(Debug, Clone, Copy)]
 struct Leaf {
-    key: Key,
-    mask: u64,
+    mask: [u32; 2],
     lo: [u8; 3],
     hi: [u8; 3],
     feature: u32,
@@ -93,6 +93,18 @@ struct Leaf {
 
 /// No child.
 const NONE: u32 = u32::MAX;
+
+impl Leaf {
+    /// Its quarter cells, bit `x + 4·y + 16·z`.
+    fn mask(&self) -> u64 {
+        u64::from(self.mask[0]) | u64::from(self.mask[1]) << 32
+    }
+}
+
+/// The index of child `slot` of the cell `cell` one level up.
+fn child_cell(cell: Key, slot: usize) -> Key {
+    std::array::from_fn(|i| cell[i] << 1 | ((slot >> i) & 1) as i32)
+}
 
 /// A cell of the hierarchy above the finest: the tight box of the quarter-cell centres under
 /// it and its occupied children (nodes, or at level 1 leaves).
@@ -110,8 +122,8 @@ pub struct Deposit {
     leaves: Vec<Leaf>,
     /// Top cells (side `CELL · 2^LEVELS`) by index.
     top: HashMap<Key, u32, Fast>,
-    /// The top cells' nodes, in the order they were first occupied.
-    roots: Vec<u32>,
+    /// The top cells' indices and nodes, in the order they were first occupied.
+    roots: Vec<(Key, u32)>,
     /// The last leaf written and the nodes above it (top first): beads run on, so the next
     /// grain mostly falls in the same leaf.
     last: Option<(Key, u32, [u32; LEVELS])>,
@@ -119,7 +131,7 @@ pub struct Deposit {
     z_max: f64,
     /// The last leaf found inside the head: asked first next time, since the moves after a
     /// colliding one mostly meet the same material.
-    hint: Cell<u32>,
+    hint: Cell<(u32, Key)>,
 }
 
 impl Deposit {
@@ -127,7 +139,7 @@ impl Deposit {
     pub fn new() -> Deposit {
         Deposit {
             z_max: f64::NEG_INFINITY,
-            hint: Cell::new(NONE),
+            hint: Cell::new((NONE, [0; 3])),
             ..Deposit::default()
         }
     }
@@ -166,7 +178,7 @@ impl Deposit {
                     None => {
                         let n = self.node();
                         self.top.insert(top, n);
-                        self.roots.push(n);
+                        self.roots.push((top, n));
                         n
                     }
                 };
@@ -182,8 +194,7 @@ impl Deposit {
                 child
             } else if level == 1 {
                 self.leaves.push(Leaf {
-                    key,
-                    mask: 0,
+                    mask: [0; 2],
                     lo: [SPLIT as u8; 3],
                     hi: [0; 3],
                     feature: feature as u32,
@@ -214,8 +225,9 @@ impl Deposit {
         };
         let bit = 1u64 << (sub[0] + SPLIT * sub[1] + SPLIT * SPLIT * sub[2]);
         let l = &mut self.leaves[leaf as usize];
-        if l.mask & bit == 0 {
-            l.mask |= bit;
+        if l.mask() & bit == 0 {
+            let mask = l.mask() | bit;
+            l.mask = [mask as u32, (mask >> 32) as u32];
             let (lo, hi) = (l.lo, l.hi);
             l.lo = std::array::from_fn(|k| l.lo[k].min(sub[k] as u8));
             l.hi = std::array::from_fn(|k| l.hi[k].max(sub[k] as u8));
@@ -259,13 +271,16 @@ impl Deposit {
             axis,
             tol,
         };
-        let hint = self.hint.get();
+        let (hint, key) = self.hint.get();
         if hint != NONE {
-            if let Some(f) = q.leaf(hint) {
+            if let Some(f) = q.leaf(hint, key) {
                 return Some(f);
             }
         }
-        let found = self.roots.iter().find_map(|&n| q.visit(n, LEVELS));
+        let found = self
+            .roots
+            .iter()
+            .find_map(|&(cell, n)| q.visit(n, LEVELS, cell));
         if let Some((f, leaf)) = found {
             self.hint.set(leaf);
             return Some(f);
@@ -297,7 +312,9 @@ impl Deposit {
             top: shape.top(),
             widest: shape.widest(),
         };
-        self.roots.iter().any(|&n| s.visit(self, n, LEVELS))
+        self.roots
+            .iter()
+            .any(|&(cell, n)| s.visit(self, n, LEVELS, cell))
     }
 }
 
@@ -338,18 +355,24 @@ impl Sweep {
         norm(sub(off, scale(self.across, t))) - norm(half) < self.widest + SWEEP_SLACK
     }
 
-    /// Whether node `n` (of `level`, 1 and up) may hold a cell inside the head.
-    fn visit(&self, d: &Deposit, n: u32, level: usize) -> bool {
+    /// Whether node `n` (of `level`, 1 and up, cell index `cell` there) may hold a cell
+    /// inside the head.
+    fn visit(&self, d: &Deposit, n: u32, level: usize, cell: Key) -> bool {
         let node = &d.nodes[n as usize];
         let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
         let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
         if !self.may_hold(centre, half) {
             return false;
         }
-        node.children.iter().filter(|&&c| c != NONE).any(|&c| {
+        (0..8).any(|slot| {
+            let c = node.children[slot];
+            if c == NONE {
+                return false;
+            }
+            let key = child_cell(cell, slot);
             if level == 1 {
                 let l = &d.leaves[c as usize];
-                let origin = l.key.map(|i| f64::from(i) * CELL);
+                let origin = key.map(|i| f64::from(i) * CELL);
                 let centre: V3 = std::array::from_fn(|k| {
                     origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
                 });
@@ -357,7 +380,7 @@ impl Sweep {
                     std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB + 1e-9);
                 self.may_hold(centre, half)
             } else {
-                self.visit(d, c, level - 1)
+                self.visit(d, c, level - 1, key)
             }
         })
     }
@@ -403,12 +426,12 @@ impl Query<'_> {
         self.shape.distance(h, r) - rho < -depth
     }
 
-    /// The feature of leaf `n` if one of its quarter cells lies wholly deeper than the
-    /// tolerance inside the head.
-    fn leaf(&self, n: u32) -> Option<usize> {
+    /// The feature of leaf `n` (of index `key`) if one of its quarter cells lies wholly deeper
+    /// than the tolerance inside the head.
+    fn leaf(&self, n: u32, key: Key) -> Option<usize> {
         let l = &self.d.leaves[n as usize];
         let depth = self.tol + GRAIN_SLACK;
-        let origin = l.key.map(|i| f64::from(i) * CELL);
+        let origin = key.map(|i| f64::from(i) * CELL);
         // The box of its quarter-cell centres.
         let centre: V3 = std::array::from_fn(|k| {
             origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
@@ -417,7 +440,7 @@ impl Query<'_> {
         if !self.may_hold(centre, half, depth) {
             return None;
         }
-        let mut mask = l.mask;
+        let mut mask = l.mask();
         while mask != 0 {
             let b = mask.trailing_zeros() as i32;
             mask &= mask - 1;
@@ -430,9 +453,10 @@ impl Query<'_> {
         None
     }
 
-    /// The first quarter cell under node `n` (of `level`, 1 and up) wholly deeper than the
-    /// tolerance inside the head: its feature and its leaf.
-    fn visit(&self, n: u32, level: usize) -> Option<(usize, u32)> {
+    /// The first quarter cell under node `n` (of `level`, 1 and up, cell index `cell` there)
+    /// wholly deeper than the tolerance inside the head: its feature, and its leaf with the
+    /// leaf's index.
+    fn visit(&self, n: u32, level: usize, cell: Key) -> Option<(usize, (u32, Key))> {
         let node = &self.d.nodes[n as usize];
         let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
         // Half the box of the quarter-cell centres, with their slack (and a little for the
@@ -441,11 +465,16 @@ impl Query<'_> {
         if !self.may_hold(centre, half, self.tol + GRAIN_SLACK) {
             return None;
         }
-        node.children.iter().filter(|&&c| c != NONE).find_map(|&c| {
+        (0..8).find_map(|slot| {
+            let c = node.children[slot];
+            if c == NONE {
+                return None;
+            }
+            let key = child_cell(cell, slot);
             if level == 1 {
-                self.leaf(c).map(|f| (f, c))
+                self.leaf(c, key).map(|f| (f, (c, key)))
             } else {
-                self.visit(c, level - 1)
+                self.visit(c, level - 1, key)
             }
         })
     }
