@@ -44,8 +44,10 @@ fn floor_i32(x: f64) -> i32 {
 fn fract(x: f64) -> f64 {
     if x.abs() < 4_503_599_627_370_496.0 {
         x - (x as i64) as f64
+    } else if x.is_finite() {
+        0.0
     } else {
-        x - x
+        f64::NAN
     }
 }
 

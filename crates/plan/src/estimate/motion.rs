@@ -39,9 +39,9 @@ pub fn time_of(n: usize, move_at: impl Fn(usize) -> Move, jerk: f64) -> f64 {
     // passed at.
     let mut node = vec![0.0f64; n + 1];
     let mut before: Option<Move> = None;
-    for i in 0..=n {
+    for (i, node) in node.iter_mut().enumerate() {
         let m = (i < n).then(|| move_at(i));
-        node[i] = match (before, m) {
+        *node = match (before, m) {
             (Some(a), Some(b)) if !b.stop_before => junction_speed(&a, &b, jerk),
             _ => {
                 let v = m.map_or(f64::INFINITY, |m| m.speed);
