@@ -23,7 +23,7 @@ use features::{extract_all, ExtractOptions};
 use rayon::prelude::*;
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
-use robot_post::{Job, PostFigures, ProgramFile};
+use robot_post::{InMemory, Job, PostFigures, ProgramFile, ProgramSink};
 use slicer::orient::{limit_tilt, smooth, OrientationFigures};
 
 use slicer::params::{LayerParams, LayerStrategy};
@@ -110,7 +110,8 @@ pub struct Plan {
     pub report: PlanReport,
     /// The tool path every feature is printed along, in build order.
     pub toolpath: ToolPath,
-    /// The machine program's files, in the order they are written.
+    /// The machine program's files, in the order they are written ([`plan`]; empty from
+    /// [`plan_into`], which writes them into its sink).
     pub program: Vec<ProgramFile>,
     /// The features the part was planned as (one tree per solid), for previews.
     pub assembly: features::Assembly,
@@ -129,12 +130,30 @@ impl Plan {
 }
 
 /// Plans `part` for `machine` with the settings of `process`: every feature in build order,
-/// then smoothing, the post and the self-check.
+/// then smoothing, the post and the self-check; the program's files are held in the plan
+/// ([`Plan::program`]).
 pub fn plan(
     part: &brep::StepPart,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,
+) -> Result<Plan, PlanError> {
+    let mut files = InMemory::default();
+    let mut plan = plan_into(part, process, machine, options, &mut files)?;
+    plan.program = files.files;
+    Ok(plan)
+}
+
+/// [`plan`], the program's files written into `sink` as the post makes them (the Marlin
+/// program a megabyte at a time), not held: [`Plan::program`] is left empty. When the plan
+/// fails its self-check or meets collisions (and the options do not allow that), the error
+/// comes after the files were written: the sink's owner discards them.
+pub fn plan_into(
+    part: &brep::StepPart,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    sink: &mut dyn ProgramSink,
 ) -> Result<Plan, PlanError> {
     let tell = |p: Progress| {
         if let Some(f) = options.progress {
@@ -353,7 +372,7 @@ pub fn plan(
         stem: &options.stem,
         notes: &notes,
     };
-    let program = machine.post().post(&toolpath, &job)?;
+    let program = machine.post().post_to(&toolpath, &job, sink)?;
     for r in &mut reports {
         r.post = program.figures.get(&r.feature.id).map(|k| match k {
             PostFigures::Delta5(k) => PostEntry::delta5(k),
@@ -393,7 +412,7 @@ pub fn plan(
     Ok(Plan {
         report,
         toolpath,
-        program: program.files,
+        program: vec![],
         assembly,
     })
 }

@@ -33,6 +33,6 @@ pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;
 pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
-pub use marlin::marlin;
-pub use post::{Job, Post, PostFigures, Program, ProgramFile};
+pub use marlin::{marlin, marlin_to};
+pub use post::{InMemory, Job, Post, PostFigures, Program, ProgramFile, ProgramSink};
 pub use toolpath::{MoveKind, PathPoint, ToolPath};
