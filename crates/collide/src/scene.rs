@@ -90,10 +90,20 @@ impl Scene {
             .ceil()
             .clamp(1.0, 1e5) as usize;
         // One tool axis all along, and no material the head may meet anywhere on the move:
-        // only the table is asked at each position.
-        let clear = aa == ab
-            && unit(aa)
-                .is_some_and(|u| !self.deposit.may_meet_along(&self.shape, a, b, u, TOLERANCE));
+        // only the table is asked at each position, and not even that when the head stays
+        // above it all along.
+        let along = (aa == ab).then(|| unit(aa)).flatten();
+        let clear =
+            along.is_some_and(|u| !self.deposit.may_meet_along(&self.shape, a, b, u, TOLERANCE));
+        if let (true, Some(u)) = (clear, along) {
+            let above = self
+                .table
+                .as_ref()
+                .is_none_or(|t| t.clear_along(&self.shape, a, b, u, TOLERANCE));
+            if above {
+                return None;
+            }
+        }
         (1..=n).find_map(|k| {
             let t = k as f64 / n as f64;
             let tip = add(a, scale(sub(b, a), t));
