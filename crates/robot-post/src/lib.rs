@@ -27,6 +27,7 @@ pub mod machine;
 pub mod marlin;
 pub mod placement;
 pub mod post;
+pub mod sink;
 pub use toolpath;
 
 pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
@@ -34,5 +35,6 @@ pub use error::PostError;
 pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
 pub use marlin::{marlin, marlin_to};
-pub use post::{InMemory, Job, Post, PostFigures, Program, ProgramFile, ProgramSink};
+pub use post::{Job, Post, PostFigures, Program};
+pub use sink::{InMemory, ProgramFile, ProgramSink};
 pub use toolpath::{MoveKind, PathPoint, ToolPath};

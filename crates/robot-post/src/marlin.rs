@@ -17,7 +17,7 @@ use crate::gcode::{comment_text, e_text, mergeable, push_line, Extrusion, Fan, L
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
-use crate::post::{insert_notes, write_error, InMemory, ProgramSink};
+use crate::sink::{insert_notes, write_error, InMemory, ProgramSink};
 use crate::PostError;
 use std::io::Write as _;
 use toolpath::fixed;
