@@ -12,6 +12,7 @@ mod plan;
 mod preview;
 mod profiles;
 mod settings;
+mod staged;
 
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;

@@ -81,6 +81,11 @@ impl TempFile {
         Ok((TempFile { tmp, done: false }, file))
     }
 
+    /// Where it is being written.
+    pub(crate) fn path(&self) -> &Path {
+        &self.tmp
+    }
+
     pub(crate) fn persist(mut self, dest: &Path) -> std::io::Result<()> {
         std::fs::rename(&self.tmp, dest)?;
         self.done = true;

@@ -3,6 +3,7 @@
 use crate::mesh::write_atomic;
 use crate::outputs::Outputs;
 use crate::settings::settings;
+use crate::staged::Staged;
 use crate::{emit, Failure, PlanArgs};
 use plan::{Options, PlanError, Progress};
 use std::io::Write as _;
@@ -82,7 +83,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         allow_collisions: args.allow_collisions,
         progress: Some(&progress),
     };
-    let result = plan::plan(&part, &process, &machine, &options);
+    // The program goes to its files as the post makes it, under temporary names until every
+    // check below has passed (dropped on any failure: nothing written).
+    let mut staged = Staged::new(&outputs);
+    let result = plan::plan_into(&part, &process, &machine, &options, &mut staged);
     bar.0.inc(1);
     bar.0.set_prefix("writing");
     bar.0.set_message("outputs");
@@ -136,11 +140,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     }
     plan.report.placement = placement;
     let csv = outputs.name("toolpath.csv");
-    let program: Vec<(String, &[u8])> = plan
-        .program
-        .iter()
-        .map(|f| (outputs.name(&f.name), f.bytes.as_slice()))
-        .collect();
+    let program = staged.names();
     // The preview: the features and the path, in one page that opens offline.
     let preview_name = outputs.name("preview.html");
     let page = crate::preview::plan_page(&plan, &path.display().to_string());
@@ -148,7 +148,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let collisions_name =
         (!plan.collisions.left.is_empty()).then(|| outputs.name("collisions.csv"));
     plan.report.outputs = std::iter::once(csv.clone())
-        .chain(program.iter().map(|(n, _)| n.clone()))
+        .chain(program)
         .chain(std::iter::once(preview_name.clone()))
         .chain(collisions_name.clone())
         .collect();
@@ -161,9 +161,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         &csv,
         write_atomic(&dir.join(&csv), |w| plan.toolpath.write_csv(w)),
     )?;
-    for (name, bytes) in &program {
-        written(name, write_atomic(&dir.join(name), |w| w.write_all(bytes)))?;
-    }
+    staged
+        .commit()
+        .map_err(|e| Failure::new(dir, format!("cannot write the program: {e}")))?;
     written(
         &preview_name,
         write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),

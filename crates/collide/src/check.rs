@@ -170,19 +170,30 @@ pub(crate) fn walk(
             }
         }
     }
-    if !detours.is_empty() {
-        let old = std::mem::take(&mut path.points);
-        let mut points = Vec::with_capacity(old.len() + 2 * detours.len());
-        let mut from = 0;
-        for (i, via) in detours {
-            points.extend_from_slice(&old[from..i]);
-            points.extend(via);
-            from = i;
-        }
-        points.extend_from_slice(&old[from..]);
-        path.points = points;
-    }
+    // What was deposited is not needed any more: its memory goes before the path grows.
+    drop(scene);
+    insert_detours(&mut path.points, &detours);
     out
+}
+
+/// Puts each detour's two points before the point of its index (`detours` in increasing index
+/// order), in place: the path grows by their count and its points move back once each, from
+/// the end, so no second copy of the path is held.
+fn insert_detours(points: &mut Vec<PathPoint>, detours: &[(usize, [PathPoint; 2])]) {
+    let Some(&(_, filler)) = detours.first() else {
+        return;
+    };
+    let old = points.len();
+    points.reserve_exact(2 * detours.len());
+    points.resize(old + 2 * detours.len(), filler[0]);
+    let mut end = old;
+    for (k, (i, via)) in detours.iter().enumerate().rev() {
+        // The points from `i` to `end` move back by the detours up to this one.
+        let shift = 2 * (k + 1);
+        points.copy_within(*i..end, i + shift);
+        points[i + shift - 2..i + shift].copy_from_slice(via);
+        end = *i;
+    }
 }
 
 /// The runs of `points` the walk tilts on their own, as index ranges covering every point once,
@@ -255,6 +266,25 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
 mod tests {
     use super::*;
     use crate::scene::{check, test_point as pt, Obstacle};
+
+    #[test]
+    fn detours_go_in_place_before_their_points() {
+        let p = |x: f64| pt(0, 0, MoveKind::Travel, [x, 0.0, 0.0]);
+        let mut points: Vec<PathPoint> = (0..6).map(|x| p(x as f64)).collect();
+        let detours = [
+            (1, [p(10.0), p(11.0)]),
+            (4, [p(40.0), p(41.0)]),
+            (6, [p(60.0), p(61.0)]),
+        ];
+        insert_detours(&mut points, &detours);
+        let xs: Vec<f64> = points.iter().map(|q| q.p[0]).collect();
+        assert_eq!(
+            xs,
+            [0.0, 10.0, 11.0, 1.0, 2.0, 3.0, 40.0, 41.0, 4.0, 5.0, 60.0, 61.0]
+        );
+        insert_detours(&mut points, &[]);
+        assert_eq!(points.len(), 12);
+    }
 
     /// A wall 5 mm tall (feature 0, lower than the head's body is above its tip), then travels
     /// from its top down to the plate 15 mm beside it and across, through the wall.

@@ -10,7 +10,7 @@ use crate::head::HeadShape;
 use std::cell::Cell;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
-use toolpath::vec3::{dot, norm, sub, V3};
+use toolpath::vec3::{dot, norm, scale, sub, V3};
 
 /// Side of the finest cells (one mask each), mm.
 const CELL: f64 = 1.0;
@@ -28,6 +28,33 @@ pub const GRAIN_SLACK: f64 = SUB * 0.866_025_403_784_438_6;
 
 /// A cell index at some level.
 type Key = [i32; 3];
+
+/// `x.floor() as i32` without a call into libm (saturating alike).
+fn floor_i32(x: f64) -> i32 {
+    let i = x as i32;
+    if f64::from(i) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
+}
+
+/// `x.fract()` without a call into libm: `x` less its integer part (a NaN stays NaN; a
+/// magnitude of 2^52 or more is whole already).
+fn fract(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        x - (x as i64) as f64
+    } else if x.is_finite() {
+        0.0
+    } else {
+        f64::NAN
+    }
+}
+
+/// The centre of quarter cell `sub` of the finest cell `key`.
+fn centre(key: Key, sub: [i32; 3]) -> [f32; 3] {
+    std::array::from_fn(|k| (f64::from(key[k]) * CELL + (f64::from(sub[k]) + 0.5) * SUB) as f32)
+}
 
 /// A multiplicative hash for cell keys (the std SipHash dominates the lookups otherwise).
 #[derive(Default, Clone, Copy)]
@@ -55,12 +82,12 @@ impl Hasher for KeyHasher {
 
 type Fast = BuildHasherDefault<KeyHasher>;
 
-/// A finest cell: its index, which quarter cells hold material, their lowest and highest index
-/// per axis, and the first feature that laid any.
+/// A finest cell: which quarter cells hold material (a 64-bit mask in two halves, so a leaf
+/// takes 20 bytes: its index is the path to it), their lowest and highest index per axis, and
+/// the first feature that laid any.
 #[derive(Debug, Clone, Copy)]
 struct Leaf {
-    key: Key,
-    mask: u64,
+    mask: [u32; 2],
     lo: [u8; 3],
     hi: [u8; 3],
     feature: u32,
@@ -68,6 +95,18 @@ struct Leaf {
 
 /// No child.
 const NONE: u32 = u32::MAX;
+
+impl Leaf {
+    /// Its quarter cells, bit `x + 4·y + 16·z`.
+    fn mask(&self) -> u64 {
+        u64::from(self.mask[0]) | u64::from(self.mask[1]) << 32
+    }
+}
+
+/// The index of child `slot` of the cell `cell` one level up.
+fn child_cell(cell: Key, slot: usize) -> Key {
+    std::array::from_fn(|i| cell[i] << 1 | ((slot >> i) & 1) as i32)
+}
 
 /// A cell of the hierarchy above the finest: the tight box of the quarter-cell centres under
 /// it and its occupied children (nodes, or at level 1 leaves).
@@ -85,8 +124,8 @@ pub struct Deposit {
     leaves: Vec<Leaf>,
     /// Top cells (side `CELL · 2^LEVELS`) by index.
     top: HashMap<Key, u32, Fast>,
-    /// The top cells' nodes, in the order they were first occupied.
-    roots: Vec<u32>,
+    /// The top cells' indices and nodes, in the order they were first occupied.
+    roots: Vec<(Key, u32)>,
     /// The last leaf written and the nodes above it (top first): beads run on, so the next
     /// grain mostly falls in the same leaf.
     last: Option<(Key, u32, [u32; LEVELS])>,
@@ -94,7 +133,7 @@ pub struct Deposit {
     z_max: f64,
     /// The last leaf found inside the head: asked first next time, since the moves after a
     /// colliding one mostly meet the same material.
-    hint: Cell<u32>,
+    hint: Cell<(u32, Key)>,
 }
 
 impl Deposit {
@@ -102,7 +141,7 @@ impl Deposit {
     pub fn new() -> Deposit {
         Deposit {
             z_max: f64::NEG_INFINITY,
-            hint: Cell::new(NONE),
+            hint: Cell::new((NONE, [0; 3])),
             ..Deposit::default()
         }
     }
@@ -112,29 +151,43 @@ impl Deposit {
         self.z_max
     }
 
-    fn node(&mut self, c: [f32; 3]) -> u32 {
+    /// A node with an empty box (the grain that makes it widens it at once).
+    fn node(&mut self) -> u32 {
         self.nodes.push(Node {
-            lo: c,
-            hi: c,
+            lo: [f32::INFINITY; 3],
+            hi: [f32::NEG_INFINITY; 3],
             children: [NONE; 8],
         });
         (self.nodes.len() - 1) as u32
     }
 
-    /// The leaf of `key` and the nodes above it, made where missing.
-    fn find(&mut self, key: Key, c: [f32; 3], feature: usize) -> (u32, [u32; LEVELS]) {
-        let top = key.map(|i| i >> LEVELS);
-        let mut at = match self.top.get(&top) {
-            Some(&n) => n,
+    /// The leaf of `key` and the nodes above it, made where missing. The descent starts at the
+    /// lowest node the last leaf written shares with it (beads run on: mostly its parent),
+    /// else at the top cell.
+    fn find(&mut self, key: Key, feature: usize) -> (u32, [u32; LEVELS]) {
+        let mut path = [NONE; LEVELS];
+        let shared = self.last.and_then(|(k, _, above)| {
+            let level = (1..=LEVELS).find(|&l| (0..3).all(|i| k[i] >> l == key[i] >> l))?;
+            path[..=LEVELS - level].copy_from_slice(&above[..=LEVELS - level]);
+            Some((level, above[LEVELS - level]))
+        });
+        let (from, mut at) = match shared {
+            Some(s) => s,
             None => {
-                let n = self.node(c);
-                self.top.insert(top, n);
-                self.roots.push(n);
-                n
+                let top = key.map(|i| i >> LEVELS);
+                let n = match self.top.get(&top) {
+                    Some(&n) => n,
+                    None => {
+                        let n = self.node();
+                        self.top.insert(top, n);
+                        self.roots.push((top, n));
+                        n
+                    }
+                };
+                (LEVELS, n)
             }
         };
-        let mut path = [NONE; LEVELS];
-        for level in (1..=LEVELS).rev() {
+        for level in (1..=from).rev() {
             path[LEVELS - level] = at;
             let bit = |i: i32| ((i >> (level - 1)) & 1) as usize;
             let slot = bit(key[0]) | bit(key[1]) << 1 | bit(key[2]) << 2;
@@ -143,15 +196,14 @@ impl Deposit {
                 child
             } else if level == 1 {
                 self.leaves.push(Leaf {
-                    key,
-                    mask: 0,
+                    mask: [0; 2],
                     lo: [SPLIT as u8; 3],
                     hi: [0; 3],
                     feature: feature as u32,
                 });
                 (self.leaves.len() - 1) as u32
             } else {
-                self.node(c)
+                self.node()
             };
             self.nodes[at as usize].children[slot] = child;
             at = child;
@@ -161,31 +213,40 @@ impl Deposit {
 
     /// Deposits one grain at `p`, laid by `feature`: its quarter cell is occupied.
     pub fn add(&mut self, p: V3, feature: usize) {
-        let key = p.map(|x| (x / CELL).floor() as i32);
+        let key = p.map(|x| floor_i32(x / CELL));
         let sub: [i32; 3] =
-            std::array::from_fn(|k| (((p[k] / CELL).fract() + 1.0).fract() * SPLIT as f64) as i32);
+            std::array::from_fn(|k| ((fract(fract(p[k] / CELL) + 1.0)) * SPLIT as f64) as i32);
         let sub = sub.map(|s| s.clamp(0, SPLIT - 1));
-        let c: [f32; 3] = std::array::from_fn(|k| {
-            (f64::from(key[k]) * CELL + (f64::from(sub[k]) + 0.5) * SUB) as f32
-        });
         let (leaf, path) = match self.last {
             Some((k, leaf, path)) if k == key => (leaf, path),
             _ => {
-                let (leaf, path) = self.find(key, c, feature);
+                let (leaf, path) = self.find(key, feature);
                 self.last = Some((key, leaf, path));
                 (leaf, path)
             }
         };
         let bit = 1u64 << (sub[0] + SPLIT * sub[1] + SPLIT * SPLIT * sub[2]);
         let l = &mut self.leaves[leaf as usize];
-        if l.mask & bit == 0 {
-            l.mask |= bit;
+        if l.mask() & bit == 0 {
+            let mask = l.mask() | bit;
+            l.mask = [mask as u32, (mask >> 32) as u32];
+            let (lo, hi) = (l.lo, l.hi);
             l.lo = std::array::from_fn(|k| l.lo[k].min(sub[k] as u8));
             l.hi = std::array::from_fn(|k| l.hi[k].max(sub[k] as u8));
-            for &n in &path {
-                let node = &mut self.nodes[n as usize];
-                node.lo = std::array::from_fn(|k| node.lo[k].min(c[k]));
-                node.hi = std::array::from_fn(|k| node.hi[k].max(c[k]));
+            // A quarter cell inside the leaf's box of quarter cells already lies in every box
+            // above it (each holds the centres of its leaves' lowest and highest quarter cell
+            // per axis); otherwise the boxes grow from the bottom up, as far as one changes.
+            if (l.lo, l.hi) != (lo, hi) {
+                let c = centre(key, sub);
+                for &n in path.iter().rev() {
+                    let node = &mut self.nodes[n as usize];
+                    let (lo, hi) = (node.lo, node.hi);
+                    node.lo = std::array::from_fn(|k| node.lo[k].min(c[k]));
+                    node.hi = std::array::from_fn(|k| node.hi[k].max(c[k]));
+                    if (node.lo, node.hi) == (lo, hi) {
+                        break;
+                    }
+                }
             }
         }
         self.z_max = self.z_max.max(p[2]);
@@ -212,18 +273,118 @@ impl Deposit {
             axis,
             tol,
         };
-        let hint = self.hint.get();
+        let (hint, key) = self.hint.get();
         if hint != NONE {
-            if let Some(f) = q.leaf(hint) {
+            if let Some(f) = q.leaf(hint, key) {
                 return Some(f);
             }
         }
-        let found = self.roots.iter().find_map(|&n| q.visit(n, LEVELS));
+        let found = self
+            .roots
+            .iter()
+            .find_map(|&(cell, n)| q.visit(n, LEVELS, cell));
         if let Some((f, leaf)) = found {
             self.hint.set(leaf);
             return Some(f);
         }
         None
+    }
+}
+
+/// Slack (mm) of [`Deposit::may_meet_along`]'s tests, for the rounding of the positions a sweep
+/// interpolates between its ends.
+const SWEEP_SLACK: f64 = 1e-6;
+
+impl Deposit {
+    /// Whether a quarter cell may lie wholly more than `tol` inside the head anywhere along
+    /// the tip's move from `a` to `b` with the unit tool axis `axis` all along: when not,
+    /// [`Deposit::first_inside`] finds nothing at any tip on that segment. Box by box it tests
+    /// what a cell inside needs at some tip of the segment (the head's distance bound is at
+    /// least `−h` and `r −` [`HeadShape::widest`], and inside only below its top): a height up
+    /// the axis over `tol` plus the cell's slack, under the body's top, and a distance from
+    /// the axis under the widest radius.
+    pub fn may_meet_along(&self, shape: &HeadShape, a: V3, b: V3, axis: V3, tol: f64) -> bool {
+        let along = sub(b, a);
+        let s = Sweep {
+            a,
+            b,
+            axis,
+            across: sub(along, scale(axis, dot(along, axis))),
+            depth: tol + GRAIN_SLACK,
+            top: shape.top(),
+            widest: shape.widest(),
+        };
+        self.roots
+            .iter()
+            .any(|&(cell, n)| s.visit(self, n, LEVELS, cell))
+    }
+}
+
+/// A head swept along a segment with one tool axis, asked of a [`Deposit`].
+struct Sweep {
+    a: V3,
+    b: V3,
+    axis: V3,
+    /// The segment across the axis.
+    across: V3,
+    depth: f64,
+    top: f64,
+    widest: f64,
+}
+
+impl Sweep {
+    /// Whether the box of `centre` ± `half` may hold a point inside the head at some tip of the
+    /// segment (see [`Deposit::may_meet_along`]).
+    fn may_hold(&self, centre: V3, half: V3) -> bool {
+        let (da, db) = (sub(centre, self.a), sub(centre, self.b));
+        let (ha, hb) = (dot(da, self.axis), dot(db, self.axis));
+        let reach = half[0] * self.axis[0].abs()
+            + half[1] * self.axis[1].abs()
+            + half[2] * self.axis[2].abs();
+        if ha.max(hb) + reach <= self.depth - SWEEP_SLACK
+            || ha.min(hb) - reach >= self.top + SWEEP_SLACK
+        {
+            return false;
+        }
+        // The centre's distance from the axis at the nearest tip: from the segment across it.
+        let off = sub(da, scale(self.axis, ha));
+        let len = dot(self.across, self.across);
+        let t = if len > 0.0 {
+            (dot(off, self.across) / len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        norm(sub(off, scale(self.across, t))) - norm(half) < self.widest + SWEEP_SLACK
+    }
+
+    /// Whether node `n` (of `level`, 1 and up, cell index `cell` there) may hold a cell
+    /// inside the head.
+    fn visit(&self, d: &Deposit, n: u32, level: usize, cell: Key) -> bool {
+        let node = &d.nodes[n as usize];
+        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
+        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        if !self.may_hold(centre, half) {
+            return false;
+        }
+        (0..8).any(|slot| {
+            let c = node.children[slot];
+            if c == NONE {
+                return false;
+            }
+            let key = child_cell(cell, slot);
+            if level == 1 {
+                let l = &d.leaves[c as usize];
+                let origin = key.map(|i| f64::from(i) * CELL);
+                let centre: V3 = std::array::from_fn(|k| {
+                    origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
+                });
+                let half: V3 =
+                    std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB + 1e-9);
+                self.may_hold(centre, half)
+            } else {
+                self.visit(d, c, level - 1, key)
+            }
+        })
     }
 }
 
@@ -267,12 +428,12 @@ impl Query<'_> {
         self.shape.distance(h, r) - rho < -depth
     }
 
-    /// The feature of leaf `n` if one of its quarter cells lies wholly deeper than the
-    /// tolerance inside the head.
-    fn leaf(&self, n: u32) -> Option<usize> {
+    /// The feature of leaf `n` (of index `key`) if one of its quarter cells lies wholly deeper
+    /// than the tolerance inside the head.
+    fn leaf(&self, n: u32, key: Key) -> Option<usize> {
         let l = &self.d.leaves[n as usize];
         let depth = self.tol + GRAIN_SLACK;
-        let origin = l.key.map(|i| f64::from(i) * CELL);
+        let origin = key.map(|i| f64::from(i) * CELL);
         // The box of its quarter-cell centres.
         let centre: V3 = std::array::from_fn(|k| {
             origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
@@ -281,7 +442,7 @@ impl Query<'_> {
         if !self.may_hold(centre, half, depth) {
             return None;
         }
-        let mut mask = l.mask;
+        let mut mask = l.mask();
         while mask != 0 {
             let b = mask.trailing_zeros() as i32;
             mask &= mask - 1;
@@ -294,9 +455,10 @@ impl Query<'_> {
         None
     }
 
-    /// The first quarter cell under node `n` (of `level`, 1 and up) wholly deeper than the
-    /// tolerance inside the head: its feature and its leaf.
-    fn visit(&self, n: u32, level: usize) -> Option<(usize, u32)> {
+    /// The first quarter cell under node `n` (of `level`, 1 and up, cell index `cell` there)
+    /// wholly deeper than the tolerance inside the head: its feature, and its leaf with the
+    /// leaf's index.
+    fn visit(&self, n: u32, level: usize, cell: Key) -> Option<(usize, (u32, Key))> {
         let node = &self.d.nodes[n as usize];
         let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
         // Half the box of the quarter-cell centres, with their slack (and a little for the
@@ -305,11 +467,16 @@ impl Query<'_> {
         if !self.may_hold(centre, half, self.tol + GRAIN_SLACK) {
             return None;
         }
-        node.children.iter().filter(|&&c| c != NONE).find_map(|&c| {
+        (0..8).find_map(|slot| {
+            let c = node.children[slot];
+            if c == NONE {
+                return None;
+            }
+            let key = child_cell(cell, slot);
             if level == 1 {
-                self.leaf(c).map(|f| (f, c))
+                self.leaf(c, key).map(|f| (f, (c, key)))
             } else {
-                self.visit(c, level - 1)
+                self.visit(c, level - 1, key)
             }
         })
     }
@@ -359,6 +526,32 @@ mod tests {
                 "{tip:?}"
             );
         }
+        // A sweep the whole-move test clears meets nothing at any position along it; those
+        // it does not clear include every sweep that meets the wall.
+        let mut cleared = 0;
+        for (a, b) in [
+            ([-30.0, 0.0, 0.4], [30.0, 0.0, 0.4]),
+            ([-30.0, -30.0, 12.6], [30.0, 30.0, 12.6]),
+            ([-30.0, 20.0, 0.4], [30.0, 20.0, 0.4]),
+            ([-30.0, 40.0, 0.4], [30.0, 40.0, 0.4]),
+            ([-20.0, 3.0, 0.4], [5.0, 3.0, 0.4]),
+            ([0.0, 0.0, 30.0], [20.0, 0.0, 30.0]),
+            ([0.0, 0.0, 80.0], [20.0, 0.0, 80.0]),
+            ([40.0, -40.0, 2.0], [40.0, 40.0, 2.0]),
+        ] {
+            let may = d.may_meet_along(&shape, a, b, up, 0.1);
+            let meets = (0..=600).any(|k| {
+                let t = k as f64 / 600.0;
+                let tip = std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t);
+                d.first_inside(&shape, tip, up, 0.1).is_some()
+            });
+            assert!(may || !meets, "{a:?} -> {b:?}");
+            cleared += usize::from(!may);
+        }
+        assert!(
+            cleared >= 3,
+            "the test clears sweeps far from the wall: {cleared}"
+        );
         // The wall's side under the body: the tip at 0.4 beside it has the wall 10 mm away.
         assert_eq!(d.first_inside(&shape, [0.0, 0.0, 0.4], up, 0.1), Some(1));
     }

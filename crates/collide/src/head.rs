@@ -142,6 +142,14 @@ impl HeadShape {
         self.body.hypot(self.body_radius)
     }
 
+    /// Radius of the widest circle across the tool axis that holds the head: no point farther
+    /// from the axis is inside it.
+    pub fn widest(&self) -> f64 {
+        self.body_radius
+            .max(self.tip)
+            .max(self.tip + self.nozzle * self.tan)
+    }
+
     /// Top of the body, from the tip up the tool axis.
     pub fn top(&self) -> f64 {
         self.body

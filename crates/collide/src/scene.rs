@@ -89,10 +89,30 @@ impl Scene {
         let n = ((norm(sub(b, a)).max(turn)) / SWEEP_STEP)
             .ceil()
             .clamp(1.0, 1e5) as usize;
+        // One tool axis all along, and no material the head may meet anywhere on the move:
+        // only the table is asked at each position, and not even that when the head stays
+        // above it all along.
+        let along = (aa == ab).then(|| unit(aa)).flatten();
+        let clear =
+            along.is_some_and(|u| !self.deposit.may_meet_along(&self.shape, a, b, u, TOLERANCE));
+        if let (true, Some(u)) = (clear, along) {
+            let above = self
+                .table
+                .as_ref()
+                .is_none_or(|t| t.clear_along(&self.shape, a, b, u, TOLERANCE));
+            if above {
+                return None;
+            }
+        }
         (1..=n).find_map(|k| {
             let t = k as f64 / n as f64;
             let tip = add(a, scale(sub(b, a), t));
             let axis = add(scale(aa, 1.0 - t), scale(ab, t));
+            if clear {
+                return self
+                    .hits_table(tip, unit(axis)?)
+                    .then_some((tip, Obstacle::Table));
+            }
             self.at(tip, axis).map(|o| (tip, o))
         })
     }

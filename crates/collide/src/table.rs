@@ -25,6 +25,17 @@ pub enum Table {
     },
 }
 
+/// The height of the lowest point of the head with its tip at height `tip_z` and unit tool
+/// axis `axis`: on one of its rims ([`HeadShape::rims`]).
+fn lowest(shape: &HeadShape, tip_z: f64, axis: V3) -> f64 {
+    let side = (1.0 - axis[2] * axis[2]).max(0.0).sqrt();
+    shape
+        .rims()
+        .iter()
+        .map(|&(h, r)| tip_z + h * axis[2] - r * side)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Points sampled around a rim of the head when it reaches below the table surface.
 const RIM_SAMPLES: usize = 32;
 
@@ -45,19 +56,34 @@ impl Table {
     /// (the circles of [`HeadShape::rims`]); those are checked exactly against the plane, and,
     /// for a disc, sampled where they are below it.
     pub fn hits(&self, shape: &HeadShape, tip: V3, axis: V3, tol: f64) -> bool {
+        let z = self.surface();
+        if lowest(shape, tip[2], axis) >= z - tol {
+            return false;
+        }
+        self.hits_below(shape, tip, axis, tol)
+    }
+
+    /// Whether the head with its tip anywhere on the segment from `a` to `b` and the unit tool
+    /// axis `axis` all along stays more than a hair above `tol` below the table surface (its
+    /// lowest point rises and falls with the tip's height): then [`Table::hits`] is false at
+    /// every tip on it.
+    pub fn clear_along(&self, shape: &HeadShape, a: V3, b: V3, axis: V3, tol: f64) -> bool {
+        lowest(shape, a[2].min(b[2]), axis) >= self.surface() - tol + 1e-5
+    }
+
+    /// The table surface's height, mm.
+    fn surface(&self) -> f64 {
+        match *self {
+            Table::Plane { z } | Table::Disc { z, .. } => z,
+        }
+    }
+
+    /// [`Table::hits`] once the head's lowest point is below the surface by more than `tol`.
+    fn hits_below(&self, shape: &HeadShape, tip: V3, axis: V3, tol: f64) -> bool {
         let (z, disc) = match *self {
             Table::Plane { z } => (z, None),
             Table::Disc { centre, z, radius } => (z, Some((centre, radius))),
         };
-        let side = (1.0 - axis[2] * axis[2]).max(0.0).sqrt();
-        let lowest = shape
-            .rims()
-            .iter()
-            .map(|&(h, r)| tip[2] + h * axis[2] - r * side)
-            .fold(f64::INFINITY, f64::min);
-        if lowest >= z - tol {
-            return false;
-        }
         let Some((centre, radius)) = disc else {
             return true;
         };
@@ -109,5 +135,23 @@ mod tests {
         assert!(disc.hits(&s, [0.0, 0.0, 0.2], tilted, 0.1));
         // Far beyond the disc's edge the same tilt is clear.
         assert!(!disc.hits(&s, [300.0, 0.0, 0.2], tilted, 0.1));
+        // A segment cleared whole has no tip on it that hits; one dipping under is not cleared.
+        for (a, b, axis) in [
+            ([0.0, 0.0, 0.2], [50.0, 0.0, 0.2], up),
+            ([0.0, 0.0, 0.2], [50.0, 0.0, -0.5], up),
+            ([0.0, 0.0, 30.0], [50.0, 0.0, 20.0], tilted),
+            ([0.0, 0.0, 1.0], [50.0, 0.0, 0.5], tilted),
+        ] {
+            for table in [plane, disc] {
+                let hits = (1..=100).any(|k| {
+                    let t = k as f64 / 100.0;
+                    let tip = std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t);
+                    table.hits(&s, tip, axis, 0.1)
+                });
+                assert!(!(hits && table.clear_along(&s, a, b, axis, 0.1)));
+            }
+        }
+        assert!(plane.clear_along(&s, [0.0, 0.0, 0.2], [50.0, 0.0, 0.2], up, 0.1));
+        assert!(!plane.clear_along(&s, [0.0, 0.0, 0.2], [50.0, 0.0, -0.5], up, 0.1));
     }
 }

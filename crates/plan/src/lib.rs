@@ -23,7 +23,7 @@ use features::{extract_all, ExtractOptions};
 use rayon::prelude::*;
 use report::{round, FreeformEntry, PostEntry, PLAN_SCHEMA};
 use robot_post::machine::MachineProfile;
-use robot_post::{Job, PostFigures, ProgramFile};
+use robot_post::{InMemory, Job, PostFigures, ProgramFile, ProgramSink};
 use slicer::orient::{limit_tilt, smooth, OrientationFigures};
 
 use slicer::params::{LayerParams, LayerStrategy};
@@ -110,7 +110,8 @@ pub struct Plan {
     pub report: PlanReport,
     /// The tool path every feature is printed along, in build order.
     pub toolpath: ToolPath,
-    /// The machine program's files, in the order they are written.
+    /// The machine program's files, in the order they are written ([`plan`]; empty from
+    /// [`plan_into`], which writes them into its sink).
     pub program: Vec<ProgramFile>,
     /// The features the part was planned as (one tree per solid), for previews.
     pub assembly: features::Assembly,
@@ -131,12 +132,30 @@ impl Plan {
 }
 
 /// Plans `part` for `machine` with the settings of `process`: every feature in build order,
-/// then smoothing, the post and the self-check.
+/// then smoothing, the post and the self-check; the program's files are held in the plan
+/// ([`Plan::program`]).
 pub fn plan(
     part: &brep::StepPart,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,
+) -> Result<Plan, PlanError> {
+    let mut files = InMemory::default();
+    let mut plan = plan_into(part, process, machine, options, &mut files)?;
+    plan.program = files.files;
+    Ok(plan)
+}
+
+/// [`plan`], the program's files written into `sink` as the post makes them (the Marlin
+/// program a megabyte at a time), not held: [`Plan::program`] is left empty. When the plan
+/// fails its self-check or meets collisions (and the options do not allow that), the error
+/// comes after the files were written: the sink's owner discards them.
+pub fn plan_into(
+    part: &brep::StepPart,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    sink: &mut dyn ProgramSink,
 ) -> Result<Plan, PlanError> {
     let tell = |p: Progress| {
         if let Some(f) = options.progress {
@@ -300,7 +319,12 @@ pub fn plan(
     // Orientation smoothing between planning and posting; the planned axes are kept for the
     // tilt that clears the head (inside the same cone about them).
     tell(Progress::Stage(STAGES[0]));
-    let planned_axes: Vec<_> = toolpath.points.iter().map(|q| q.axis).collect();
+    // (Only where the head may tilt: a 3-axis printer's axes stay +Z.)
+    let limits = collisions::tilt_limits(machine, &process.orientation);
+    let planned_axes: Vec<_> = match limits {
+        Some(_) => toolpath.points.iter().map(|q| q.axis).collect(),
+        None => vec![],
+    };
     let orientation = smooth(&mut toolpath, &process.orientation);
     // A B/C bed: axes that curved layers tip past the B limit are tilted back to it, inside
     // the orientation's tolerance cone (half its opening); farther, the post refuses them.
@@ -325,7 +349,6 @@ pub fn plan(
     }
     // The head against what is built before each move and the table (issue 18).
     tell(Progress::Stage(STAGES[1]));
-    let limits = collisions::tilt_limits(machine, &process.orientation);
     let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &reports, limits);
     let collided = collisions::entries(&avoided);
     let points = collisions::points(&toolpath);
@@ -351,7 +374,7 @@ pub fn plan(
         stem: &options.stem,
         notes: &notes,
     };
-    let program = machine.post().post(&toolpath, &job)?;
+    let program = machine.post().post_to(&toolpath, &job, sink)?;
     for r in &mut reports {
         r.post = program.figures.get(&r.feature.id).map(|k| match k {
             PostFigures::Delta5(k) => PostEntry::delta5(k),
@@ -391,7 +414,7 @@ pub fn plan(
     Ok(Plan {
         report,
         toolpath,
-        program: program.files,
+        program: vec![],
         assembly,
         collisions: avoided,
     })

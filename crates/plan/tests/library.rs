@@ -102,3 +102,43 @@ fn the_report_reads_back_as_the_plan_schema_with_post_figures() {
         .iter()
         .any(|f| f["kind"] == "freeform" && f["chart"].is_string())));
 }
+
+/// `plan_into` writes into its sink the files `plan` holds, byte for byte, and holds none
+/// itself; a sink that cannot write fails the plan with the file's name.
+#[test]
+fn a_plan_written_into_a_sink_is_the_plan_held() {
+    struct Refusing;
+    impl robot_post::ProgramSink for Refusing {
+        fn file(&mut self, name: &str) -> std::io::Result<Box<dyn std::io::Write + '_>> {
+            Err(std::io::Error::other(format!("no room for {name}")))
+        }
+    }
+    for (name, machine) in [
+        ("plate_boss_boss.step", MachineKind::Marlin),
+        ("sphere_boss.step", MachineKind::Delta5),
+    ] {
+        let held = planned(name, machine);
+        let options = Options {
+            source: name.into(),
+            stem: "part".into(),
+            allow_collisions: true,
+            ..Default::default()
+        };
+        let part = fixture(name);
+        let m = MachineProfile::builtin(machine);
+        let mut sink = robot_post::InMemory::default();
+        let streamed = plan::plan_into(&part, &Process::default(), &m, &options, &mut sink)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(streamed.program.is_empty(), "{name}");
+        assert!(!sink.files.is_empty(), "{name}");
+        assert_eq!(sink.files, held.program, "{name}");
+        assert_eq!(streamed.toolpath, held.toolpath, "{name}");
+        match plan::plan_into(&part, &Process::default(), &m, &options, &mut Refusing) {
+            Err(e) => assert!(
+                e.to_string().contains("cannot write program.gcode"),
+                "{name}: {e}"
+            ),
+            Ok(_) => panic!("{name}: planned into a sink that cannot write"),
+        }
+    }
+}

@@ -29,6 +29,14 @@ pub enum PostError {
         /// The kind the post writes for.
         expected: MachineKind,
     },
+    /// A program file could not be written where the post was told to write it.
+    #[error("cannot write {name}: {reason}")]
+    Write {
+        /// The file's name.
+        name: String,
+        /// Why not.
+        reason: String,
+    },
     /// The tool path is unreadable or holds non-finite numbers.
     #[error(transparent)]
     ToolPath(#[from] toolpath::ToolPathError),

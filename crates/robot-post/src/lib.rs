@@ -27,12 +27,14 @@ pub mod machine;
 pub mod marlin;
 pub mod placement;
 pub mod post;
+pub mod sink;
 pub use toolpath;
 
 pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;
 pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
-pub use marlin::marlin;
-pub use post::{Job, Post, PostFigures, Program, ProgramFile};
+pub use marlin::{marlin, marlin_to};
+pub use post::{Job, Post, PostFigures, Program};
+pub use sink::{InMemory, ProgramFile, ProgramSink};
 pub use toolpath::{MoveKind, PathPoint, ToolPath};

@@ -17,7 +17,9 @@ use crate::gcode::{comment_text, e_text, mergeable, push_line, Extrusion, Fan, L
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
+use crate::sink::{insert_notes, write_error, InMemory, ProgramSink};
 use crate::PostError;
+use std::io::Write as _;
 use toolpath::fixed;
 use toolpath::{MoveKind, PathPoint, ToolPath};
 
@@ -43,6 +45,39 @@ const END_LIFT: f64 = 10.0;
 /// on the plate and `print_speed` otherwise. A path that starts with a print point first
 /// travels to it.
 pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<String, PostError> {
+    let mut files = InMemory::default();
+    marlin_to(path, m, source, &[], &mut files)?;
+    let bytes = files.files.pop().map(|f| f.bytes).unwrap_or_default();
+    // The program is made of `str`s.
+    Ok(String::from_utf8(bytes).unwrap_or_default())
+}
+
+/// Text of the program held before it is passed on to the file, bytes.
+const CHUNK: usize = 1 << 20;
+
+/// [`marlin`]'s program, with `notes` (comment lines after the one naming the source, see
+/// [`crate::Job::notes`]), written into `sink`'s `program.gcode` as it is made, a megabyte at
+/// a time. The file is opened once the path passed the checks [`marlin`] makes; an error
+/// writing it is [`PostError::Write`].
+pub fn marlin_to(
+    path: &ToolPath,
+    m: &MachineProfile,
+    source: &str,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+) -> Result<(), PostError> {
+    write_marlin(path, m, source, notes, sink, CHUNK)
+}
+
+/// [`marlin_to`], passing the text on whenever `chunk` bytes or more are held.
+fn write_marlin(
+    path: &ToolPath,
+    m: &MachineProfile,
+    source: &str,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+    chunk: usize,
+) -> Result<(), PostError> {
     m.check_for(MachineKind::Marlin)?;
     path.check_finite()?;
     if let Some(q) = path.points.iter().find(|q| !is_plus_z(q.axis)) {
@@ -55,11 +90,13 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
         });
     }
     let offset = bed_offset(path, m)?;
+    const NAME: &str = "program.gcode";
+    let failed = |e: std::io::Error| write_error(NAME, &e);
+    let mut file = sink.file(NAME).map_err(failed)?;
 
     let mut w = Writer::new(m);
-    // About 45 bytes a point: the program is not grown by doubling (a copy of it at each step).
-    w.out.reserve(48 * path.points.len());
     w.header(m, source, offset);
+    insert_notes(&mut w.out, notes);
     for q in &path.points {
         // Machine coordinates as written (0.001 mm).
         let t = [0, 1, 2].map(|k| ((q.p[k] + offset[k]) * 1e3).round() / 1e3);
@@ -73,9 +110,16 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
                 w.print(t, q);
             }
         }
+        if w.out.len() >= chunk {
+            // All but the last character, which the writer may look back at.
+            let keep = w.out.char_indices().next_back().map_or(0, |(i, _)| i);
+            file.write_all(&w.out.as_bytes()[..keep]).map_err(failed)?;
+            w.out.drain(..keep);
+        }
     }
     w.footer(m);
-    Ok(w.out)
+    file.write_all(w.out.as_bytes()).map_err(failed)?;
+    file.flush().map_err(failed)
 }
 
 /// Whether `axis` is +Z within [`AXIS_TOLERANCE`].
@@ -337,6 +381,60 @@ impl Writer {
         self.out.push_str(&m.end_gcode_text());
         if !self.out.ends_with('\n') {
             self.out.push('\n');
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use toolpath::Role;
+
+    /// Passed on in pieces of any size, the program is the same text: the writer's look back
+    /// at the last character (the end G-code's line break) survives the cuts.
+    #[test]
+    fn the_program_is_the_same_in_pieces_of_any_size() {
+        let mut m = MachineProfile::builtin(MachineKind::Marlin);
+        let mut points = vec![];
+        for layer in 0..4 {
+            let z = 0.2 * (layer + 1) as f64;
+            for k in 0..60 {
+                let kind = if k % 20 == 0 {
+                    MoveKind::Travel
+                } else {
+                    MoveKind::Print
+                };
+                points.push(PathPoint {
+                    feature: layer / 2,
+                    layer,
+                    kind,
+                    p: [50.0 + k as f64, 50.0 + (k % 7) as f64, z],
+                    axis: [0.0, 0.0, 1.0],
+                    e: if kind == MoveKind::Print { 0.03 } else { 0.0 },
+                    thickness: 0.2,
+                    width: 0.45,
+                    role: Role::Perimeter,
+                });
+            }
+        }
+        let path = ToolPath { points };
+        let notes = ["a note".to_string()];
+        for end in [None, Some(String::new()), Some("M84".to_string())] {
+            m.end_gcode = end;
+            let texts: Vec<Vec<u8>> = [1, 100, usize::MAX]
+                .iter()
+                .map(|&chunk| {
+                    let mut files = InMemory::default();
+                    write_marlin(&path, &m, "part.step", &notes, &mut files, chunk).unwrap();
+                    assert_eq!(files.files.len(), 1);
+                    files.files.remove(0).bytes
+                })
+                .collect();
+            assert!(texts[0].len() > 2_000);
+            assert_eq!(texts[0], texts[2]);
+            assert_eq!(texts[1], texts[2]);
+            let text = String::from_utf8_lossy(&texts[0]);
+            assert!(text.contains("; a note\n") && text.ends_with('\n'));
         }
     }
 }

@@ -91,6 +91,7 @@ impl FeaturePlan {
 /// is already in its plan (planned from the previous plan's [`FeaturePlan::exit`]).
 pub fn sequence(plans: Vec<(usize, FeaturePlan)>) -> ToolPath {
     let mut points: Vec<PathPoint> = vec![];
+    let total: usize = plans.iter().map(|(_, p)| p.points.len()).sum();
     for (id, plan) in plans {
         let mut own = plan.points;
         for q in &mut own {
@@ -99,10 +100,13 @@ pub fn sequence(plans: Vec<(usize, FeaturePlan)>) -> ToolPath {
         // The first plan's points become the path's (no copy); the others are appended.
         if points.is_empty() {
             points = own;
+            // Room for the rest once; none to spare (a plan's points grew by doubling).
+            points.reserve_exact(total - points.len());
         } else {
             points.append(&mut own);
         }
     }
+    points.shrink_to_fit();
     ToolPath { points }
 }
 

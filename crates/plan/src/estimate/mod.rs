@@ -13,7 +13,7 @@ pub mod motion;
 
 use motion::Move;
 use robot_post::machine::{MachineProfile, DEFAULT_JERK};
-use slicer::toolpath::{MoveKind, ToolPath};
+use slicer::toolpath::{MoveKind, PathPoint, ToolPath};
 
 /// PLA's density, g/cm³, for profiles without `filament_density`.
 pub const PLA_DENSITY: f64 = 1.24;
@@ -46,14 +46,10 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
     let travel_accel = machine.travel_acceleration.unwrap_or(print_accel);
     let jerk = machine.max_jerk.unwrap_or(DEFAULT_JERK);
     let retracts = machine.retraction_length > 0.0;
-    let mut moves = Vec::with_capacity(pts.len());
-    let mut retraction_time = 0.0;
-    let mut filament = 0.0;
-    let mut printing = false;
-    // A retraction (or its return) waits before the next move.
-    let mut stop = true;
-    for w in pts.windows(2) {
-        let (a, q) = (&w[0], &w[1]);
+    // A move from the point before to `q`, at the speed and acceleration of its kind: made
+    // again from the points whenever the motion planning asks (the moves of a long plan
+    // would outweigh its points).
+    let move_to = |a: &PathPoint, q: &PathPoint, stop_before: bool| {
         let d = [q.p[0] - a.p[0], q.p[1] - a.p[1], q.p[2] - a.p[2]];
         let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let (speed, accel) = match q.kind {
@@ -64,12 +60,35 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
                 } else {
                     machine.print_speed
                 };
+                (v, print_accel)
+            }
+            MoveKind::Travel => (machine.travel_speed, travel_accel),
+        };
+        Move {
+            length,
+            dir: [d[0] / length, d[1] / length, d[2] / length],
+            speed: speed.min(cap),
+            accel,
+            stop_before,
+        }
+    };
+    // Each move as the index of the point it ends at, times two, plus one where the machine
+    // stops before it.
+    let mut moves: Vec<usize> = vec![];
+    let mut retraction_time = 0.0;
+    let mut filament = 0.0;
+    let mut printing = false;
+    // A retraction (or its return) waits before the next move.
+    let mut stop = true;
+    for (i, w) in pts.windows(2).enumerate() {
+        let (a, q) = (&w[0], &w[1]);
+        match q.kind {
+            MoveKind::Print => {
                 filament += q.e;
                 if !printing && retracts && !moves.is_empty() {
                     stop = true;
                 }
                 printing = true;
-                (v, print_accel)
             }
             MoveKind::Travel => {
                 if printing && retracts {
@@ -77,24 +96,22 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
                     stop = true;
                 }
                 printing = false;
-                (machine.travel_speed, travel_accel)
             }
-        };
-        if length < MIN_MOVE {
+        }
+        let d = [q.p[0] - a.p[0], q.p[1] - a.p[1], q.p[2] - a.p[2]];
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() < MIN_MOVE {
             continue;
         }
-        moves.push(Move {
-            length,
-            dir: [d[0] / length, d[1] / length, d[2] / length],
-            speed: speed.min(cap),
-            accel,
-            stop_before: std::mem::take(&mut stop),
-        });
+        moves.push(2 * (i + 1) + usize::from(std::mem::take(&mut stop)));
     }
+    let move_at = |k: usize| {
+        let (end, stop) = (moves[k] / 2, moves[k] % 2 == 1);
+        move_to(&pts[end - 1], &pts[end], stop)
+    };
     let area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
     let density = machine.filament_density.unwrap_or(PLA_DENSITY) / 1000.0;
     Estimate {
-        time_s: motion::time(&moves, jerk) + retraction_time,
+        time_s: motion::time_of(moves.len(), move_at, jerk) + retraction_time,
         filament_mm: filament,
         filament_g: filament * area * density,
     }

@@ -25,40 +25,47 @@ pub struct Move {
 /// The time (s) of the moves one after another, the last ending at a stop, with velocity
 /// jumps of at most `jerk` (mm/s).
 pub fn time(moves: &[Move], jerk: f64) -> f64 {
-    let n = moves.len();
+    time_of(moves.len(), |i| moves[i], jerk)
+}
+
+/// [`time`] of `n` moves made one at a time by `move_at` (move `i` each time it is asked, the
+/// same each time), so a long plan's moves need not be held all at once: only the speed
+/// where each one starts is kept.
+pub fn time_of(n: usize, move_at: impl Fn(usize) -> Move, jerk: f64) -> f64 {
     if n == 0 {
         return 0.0;
     }
     // Node i is where move i starts (node n where the last ends): the fastest each may be
     // passed at.
     let mut node = vec![0.0f64; n + 1];
-    for i in 0..=n {
-        node[i] = if i == 0 || i == n || moves[i].stop_before {
-            let v = if i < n { moves[i].speed } else { f64::INFINITY };
-            let u = if i > 0 {
-                moves[i - 1].speed
-            } else {
-                f64::INFINITY
-            };
-            jerk.min(v).min(u)
-        } else {
-            junction_speed(&moves[i - 1], &moves[i], jerk)
+    let mut before: Option<Move> = None;
+    for (i, node) in node.iter_mut().enumerate() {
+        let m = (i < n).then(|| move_at(i));
+        *node = match (before, m) {
+            (Some(a), Some(b)) if !b.stop_before => junction_speed(&a, &b, jerk),
+            _ => {
+                let v = m.map_or(f64::INFINITY, |m| m.speed);
+                let u = before.map_or(f64::INFINITY, |a| a.speed);
+                jerk.min(v).min(u)
+            }
         };
+        before = m;
     }
     // Backward: each move can slow down from its start node to its end node.
     for i in (0..n).rev() {
-        let m = &moves[i];
+        let m = move_at(i);
         node[i] = node[i].min(reachable(node[i + 1], m.accel, m.length));
     }
     // Forward: each move can speed up from its start node to its end node.
     for i in 0..n {
-        let m = &moves[i];
+        let m = move_at(i);
         node[i + 1] = node[i + 1].min(reachable(node[i], m.accel, m.length));
     }
-    moves
-        .iter()
-        .enumerate()
-        .map(|(i, m)| trapezoid_time(m.length, m.speed, m.accel, node[i], node[i + 1]))
+    (0..n)
+        .map(|i| {
+            let m = move_at(i);
+            trapezoid_time(m.length, m.speed, m.accel, node[i], node[i + 1])
+        })
         .sum()
 }
 

@@ -1,0 +1,73 @@
+//! The machine program's files as the post writes them ([`plan::plan_into`]): each under a
+//! temporary name in the output folder, renamed into place only when the whole plan passed
+//! its checks ([`Staged::commit`]), removed otherwise (dropped uncommitted), with the folder
+//! when it was made for them. So a program of hundreds of megabytes is never held in memory,
+//! and a failed plan still leaves nothing that looks complete.
+
+use crate::mesh::TempFile;
+use crate::outputs::Outputs;
+use robot_post::ProgramSink;
+use std::io::Write;
+
+/// Bytes each file's writer gathers before a write.
+const BUFFER: usize = 1 << 20;
+
+/// The program's files written so far, not yet in place.
+pub(crate) struct Staged<'a> {
+    outputs: &'a Outputs,
+    /// The output folder did not exist and was made for these files.
+    made_dir: bool,
+    /// Each file's name in the folder and its temporary file.
+    files: Vec<(String, TempFile)>,
+}
+
+impl<'a> Staged<'a> {
+    /// Nothing written yet into `outputs`' folder.
+    pub(crate) fn new(outputs: &'a Outputs) -> Staged<'a> {
+        Staged {
+            outputs,
+            made_dir: false,
+            files: vec![],
+        }
+    }
+
+    /// The files' names in the output folder, in the order written.
+    pub(crate) fn names(&self) -> Vec<String> {
+        self.files.iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// Syncs every file and renames it into place.
+    pub(crate) fn commit(mut self) -> std::io::Result<()> {
+        for (name, tmp) in std::mem::take(&mut self.files) {
+            let dest = self.outputs.dir.join(&name);
+            std::fs::File::open(tmp.path())?.sync_all()?;
+            tmp.persist(&dest)?;
+        }
+        self.made_dir = false;
+        Ok(())
+    }
+}
+
+impl ProgramSink for Staged<'_> {
+    fn file(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>> {
+        let dir = &self.outputs.dir;
+        if !dir.is_dir() {
+            std::fs::create_dir_all(dir)?;
+            self.made_dir = true;
+        }
+        let name = self.outputs.name(name);
+        let (tmp, file) = TempFile::create(&dir.join(&name))?;
+        self.files.push((name, tmp));
+        Ok(Box::new(std::io::BufWriter::with_capacity(BUFFER, file)))
+    }
+}
+
+impl Drop for Staged<'_> {
+    fn drop(&mut self) {
+        // The temporary files go first (each removes itself), then the folder made for them.
+        self.files.clear();
+        if self.made_dir {
+            let _ = std::fs::remove_dir(&self.outputs.dir);
+        }
+    }
+}
