@@ -153,7 +153,13 @@ pub fn avoid(
         _ => Travels::Route,
     };
     let walk = |path: &mut ToolPath, planned: &[V3], limits: Option<&TiltLimits>| {
-        let before: Vec<V3> = path.points.iter().map(|q| q.p).collect();
+        // Where the points were before travel was lifted, to find their planned axes after;
+        // without planned axes (a 3-axis printer) each point's own axis is its planned one.
+        let before: Vec<V3> = if planned.is_empty() {
+            vec![]
+        } else {
+            path.points.iter().map(|q| q.p).collect()
+        };
         let r = tilt_and_route(path, planned, &head, Some(table), travels, limits);
         Avoided {
             planned: planned_at(path, &before, planned, &r.left),
