@@ -113,6 +113,11 @@ pub(crate) fn walk(
             scene.deposit(pts, group..r.start);
             group = r.start;
         }
+        // The beads before are needed unless every move of the run (from the point before
+        // it) stays above them with the axis up, untilted.
+        if tilt.is_some() || !scene.above_pending(&pts[r.start.saturating_sub(1)..r.end]) {
+            scene.flush(pts);
+        }
         let mut found: Vec<Option<Collision>> = r
             .clone()
             .map(|i| (!skip(&pts[i])).then(|| move_collision(&scene, pts, i))?)
@@ -232,7 +237,7 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
     if scene.at(a.p, ua).is_some() || scene.at(b.p, ub).is_some() {
         return None;
     }
-    let above = scene.deposit.z_max() - a.p[2].max(b.p[2]);
+    let above = scene.z_max() - a.p[2].max(b.p[2]);
     let lifts = LIFTS
         .iter()
         .map(|f| f * head.body_length)
@@ -265,7 +270,7 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{check, test_point as pt, Obstacle};
+    use crate::scene::{check, test_point as pt, Obstacle, Scene};
 
     #[test]
     fn detours_go_in_place_before_their_points() {
@@ -300,6 +305,72 @@ mod tests {
         points.push(pt(1, 0, MoveKind::Travel, [15.0, 0.0, 0.2]));
         points.push(pt(1, 0, MoveKind::Print, [25.0, 0.0, 0.2]));
         ToolPath { points }
+    }
+
+    /// Layers of a 12 mm wall (feature 0), then a second wall (feature 1) 15 mm beside it from
+    /// the plate up, inside the reach of the head's body: its low layers hit the first wall.
+    fn two_walls() -> ToolPath {
+        let mut points = vec![];
+        for (feature, x) in [(0, 0.0), (1, 15.0)] {
+            for layer in 0..60 {
+                let z = 0.2 * (layer + 1) as f64;
+                points.push(pt(feature, layer, MoveKind::Travel, [x, -10.0, z]));
+                points.push(pt(feature, layer, MoveKind::Print, [x, 10.0, z]));
+                points.push(pt(feature, layer, MoveKind::Print, [x + 0.4, 10.0, z]));
+                points.push(pt(feature, layer, MoveKind::Print, [x + 0.4, -10.0, z]));
+            }
+        }
+        ToolPath { points }
+    }
+
+    /// The walk leaves beads pending while the head stays above them with its axis up (each
+    /// layer of a wall over the last) and deposits them when a move may reach them: it finds
+    /// exactly the collisions of the check that deposits every group at once.
+    #[test]
+    fn pending_beads_are_deposited_before_any_move_that_may_meet_them() {
+        let head = Head::default();
+        let table = Some(Table::Plane { z: 0.0 });
+        let path = two_walls();
+        let eager = check(&path, &head, table);
+        assert!(eager
+            .iter()
+            .any(|c| c.feature == 1 && c.hits == Obstacle::Feature(0)));
+        let mut walked = path.clone();
+        let lazy = check_and_route(&mut walked, &head, table, Travels::Skip);
+        assert_eq!(
+            lazy,
+            eager
+                .iter()
+                .filter(|c| c.kind == MoveKind::Print)
+                .copied()
+                .collect::<Vec<_>>()
+        );
+        // The first wall alone: nothing collides, and nothing had to be deposited.
+        let first = ToolPath {
+            points: path
+                .points
+                .iter()
+                .filter(|q| q.feature == 0)
+                .copied()
+                .collect(),
+        };
+        let mut scene = Scene::new(&head, table);
+        let pts = &first.points;
+        for layer in 1..60 {
+            scene.deposit(pts, 4 * (layer - 1)..4 * layer);
+            assert!(scene.above_pending(&pts[4 * layer - 1..4 * (layer + 1)]));
+        }
+        assert_eq!(scene.deposit.z_max(), f64::NEG_INFINITY);
+        assert!((scene.z_max() - 0.2 * 59.0).abs() < 1e-12);
+        // A tilted axis, or a tip below the top, needs them.
+        let mut tilted = pts[4 * 59..].to_vec();
+        tilted[1].axis = [0.0, 0.1, 0.995];
+        assert!(!scene.above_pending(&tilted));
+        let mut low = pts[4 * 59..].to_vec();
+        low[2].p[2] = 5.0;
+        assert!(!scene.above_pending(&low));
+        scene.flush(pts);
+        assert_eq!(scene.deposit.z_max(), scene.z_max());
     }
 
     #[test]

@@ -252,10 +252,24 @@ impl Deposit {
         self.z_max = self.z_max.max(p[2]);
     }
 
+    /// The highest of the grains [`Deposit::add_bead`] puts from `a` to `b`, exactly: their
+    /// heights `a + (b − a)·k/n` rise (or fall) with `k` in floating point too, so the top
+    /// is the last grain's or the first's.
+    pub fn bead_top(a: V3, b: V3) -> f64 {
+        let n = Self::bead_grains(a, b);
+        let at = |k: usize| a[2] + (b[2] - a[2]) * (k as f64 / n as f64);
+        at(n).max(at(1))
+    }
+
+    /// How many grains [`Deposit::add_bead`] puts from `a` to `b`.
+    fn bead_grains(a: V3, b: V3) -> usize {
+        (norm(sub(b, a)) / GRAIN_SPACING).ceil().clamp(1.0, 1e5) as usize
+    }
+
     /// Deposits the bead from `a` to `b` as grains at most [`GRAIN_SPACING`] apart (`b`
     /// included, `a` not: it ends the bead before).
     pub fn add_bead(&mut self, a: V3, b: V3, feature: usize) {
-        let n = (norm(sub(b, a)) / GRAIN_SPACING).ceil().clamp(1.0, 1e5) as usize;
+        let n = Self::bead_grains(a, b);
         for k in 1..=n {
             let t = k as f64 / n as f64;
             self.add(std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t), feature);

@@ -48,8 +48,13 @@ pub struct Collision {
 pub struct Scene {
     shape: HeadShape,
     table: Option<Table>,
-    /// What lies before the move being checked.
+    /// What lies before the move being checked, but for [`Scene::pending`].
     pub deposit: Deposit,
+    /// Ranges of the path whose beads lie before the move too but are not in `deposit` yet
+    /// ([`Scene::deposit`], [`Scene::flush`]): a head above them all cannot meet them.
+    pending: Vec<std::ops::Range<usize>>,
+    /// The top of their grains (−∞: none).
+    pending_top: f64,
 }
 
 impl Scene {
@@ -59,6 +64,36 @@ impl Scene {
             shape: head.shape(),
             table,
             deposit: Deposit::new(),
+            pending: vec![],
+            pending_top: f64::NEG_INFINITY,
+        }
+    }
+
+    /// The top of every grain before the move: deposited and pending alike.
+    pub fn z_max(&self) -> f64 {
+        self.deposit.z_max().max(self.pending_top)
+    }
+
+    /// Whether moves between `points` (each from the point before it) may be checked without
+    /// the pending beads: every tool axis exactly +Z and every tip at or above the pending
+    /// grains' top. Such a head lies wholly at or above its tip's level (the nozzle cone starts
+    /// at the tip), and a cell counts only with its centre deeper inside than the tolerance
+    /// and the grain's slack, i.e. higher than the tip by that: above every pending grain.
+    pub(crate) fn above_pending(&self, points: &[PathPoint]) -> bool {
+        self.pending.is_empty()
+            || points
+                .iter()
+                .all(|q| q.axis == [0.0, 0.0, 1.0] && q.p[2] >= self.pending_top)
+    }
+
+    /// Deposits the pending beads, in the order they were laid: the deposit is then what
+    /// depositing each at once would have made.
+    pub(crate) fn flush(&mut self, points: &[PathPoint]) {
+        for r in std::mem::take(&mut self.pending) {
+            grains(points, r, &mut |g| match g {
+                Grain::Point(p, f) => self.deposit.add(p, f),
+                Grain::Bead(a, b, f) => self.deposit.add_bead(a, b, f),
+            });
         }
     }
 
@@ -120,26 +155,50 @@ impl Scene {
     /// Deposits the beads of the print points `points[range]` (each from the point before it):
     /// along each run of beads, grains at most [`GRAIN_SPACING`] apart and, where the planned
     /// points lie closer, at least half that apart (every point of a bead is then within a
-    /// quarter of the spacing of a grain), the run's ends always.
+    /// quarter of the spacing of a grain), the run's ends always. They are kept pending (only
+    /// the top of their grains taken) until a move needs them ([`Scene::flush`]): a part
+    /// printed layer on layer with the tool axis up never does.
     pub(crate) fn deposit(&mut self, points: &[PathPoint], range: std::ops::Range<usize>) {
-        let mut last: Option<V3> = None;
-        for j in range {
-            let q = &points[j];
-            if j == 0 || q.kind != MoveKind::Print {
-                last = None;
-                continue;
-            }
-            let from = last.unwrap_or(points[j - 1].p);
-            if last.is_none() {
-                self.deposit.add(from, q.feature);
-            }
-            let ends = points.get(j + 1).is_none_or(|n| n.kind != MoveKind::Print);
-            if ends || norm(sub(q.p, from)) >= GRAIN_SPACING / 2.0 {
-                self.deposit.add_bead(from, q.p, q.feature);
-                last = Some(q.p);
-            } else {
-                last = Some(from);
-            }
+        let mut top = self.pending_top;
+        grains(points, range.clone(), &mut |g| {
+            top = top.max(match g {
+                Grain::Point(p, _) => p[2],
+                Grain::Bead(a, b, _) => Deposit::bead_top(a, b),
+            })
+        });
+        self.pending_top = top;
+        self.pending.push(range);
+    }
+}
+
+/// A grain, or a bead of grains, of [`grains`].
+enum Grain {
+    /// A grain at this point, of this feature.
+    Point(V3, usize),
+    /// A bead of grains from the first point (not included) to the second, of this feature
+    /// ([`Deposit::add_bead`]).
+    Bead(V3, V3, usize),
+}
+
+/// The grains of the beads of the print points `points[range]` (see [`Scene::deposit`]).
+fn grains(points: &[PathPoint], range: std::ops::Range<usize>, out: &mut impl FnMut(Grain)) {
+    let mut last: Option<V3> = None;
+    for j in range {
+        let q = &points[j];
+        if j == 0 || q.kind != MoveKind::Print {
+            last = None;
+            continue;
+        }
+        let from = last.unwrap_or(points[j - 1].p);
+        if last.is_none() {
+            out(Grain::Point(from, q.feature));
+        }
+        let ends = points.get(j + 1).is_none_or(|n| n.kind != MoveKind::Print);
+        if ends || norm(sub(q.p, from)) >= GRAIN_SPACING / 2.0 {
+            out(Grain::Bead(from, q.p, q.feature));
+            last = Some(q.p);
+        } else {
+            last = Some(from);
         }
     }
 }
@@ -158,6 +217,7 @@ pub fn check(path: &ToolPath, head: &Head, table: Option<Table>) -> Vec<Collisio
     for i in 0..pts.len() {
         if i > 0 && !same_group(&pts[i - 1], &pts[i]) {
             scene.deposit(pts, group..i);
+            scene.flush(pts);
             group = i;
         }
         if let Some(c) = move_collision(&scene, pts, i) {
