@@ -70,21 +70,40 @@ fn scaled(x: f64, decimals: usize) -> Option<(bool, u128)> {
 fn push_scaled(out: &mut String, negative: bool, n: u128, decimals: usize) {
     let mut digits = [0u8; 40];
     let mut len = 0;
-    let mut v = n;
-    while v > 0 || len <= decimals {
-        digits[len] = b'0' + (v % 10) as u8;
-        v /= 10;
-        len += 1;
+    // In 64 bits where it fits (always, below MAX_MAGNITUDE with MAX_DECIMALS): a division by
+    // ten is then a multiplication, where a 128-bit one is a library call.
+    match u64::try_from(n) {
+        Ok(mut v) => {
+            while v > 0 || len <= decimals {
+                digits[len] = b'0' + (v % 10) as u8;
+                v /= 10;
+                len += 1;
+            }
+        }
+        Err(_) => {
+            let mut v = n;
+            while v > 0 || len <= decimals {
+                digits[len] = b'0' + (v % 10) as u8;
+                v /= 10;
+                len += 1;
+            }
+        }
     }
     if negative && n != 0 {
         out.push('-');
     }
+    // The digits, most significant first, with the point before the last `decimals`: ASCII.
+    let mut text = [0u8; 41];
+    let mut k = 0;
     for i in (0..len).rev() {
-        out.push(digits[i] as char);
+        text[k] = digits[i];
+        k += 1;
         if i == decimals && decimals > 0 {
-            out.push('.');
+            text[k] = b'.';
+            k += 1;
         }
     }
+    out.push_str(std::str::from_utf8(&text[..k]).unwrap_or_default());
 }
 
 /// The standard formatter, with `-0` written `0`.

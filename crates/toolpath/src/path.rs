@@ -94,32 +94,28 @@ impl ToolPath {
         String::from_utf8(out).unwrap_or_default()
     }
 
-    /// Writes [`ToolPath::to_csv`]'s text to `w` line by line, without holding it in memory.
+    /// Writes [`ToolPath::to_csv`]'s text to `w` a block of lines at a time, without holding
+    /// it in memory: the lines of a few blocks are made in parallel, then written in order.
     pub fn write_csv(&self, w: &mut impl std::io::Write) -> std::io::Result<()> {
-        use std::fmt::Write as _;
+        use rayon::prelude::*;
+        /// Points a block of lines holds.
+        const BLOCK: usize = 1 << 14;
         writeln!(w, "{CSV_HEADER}")?;
-        let mut line = String::with_capacity(128);
-        for q in &self.points {
-            line.clear();
-            let _ = write!(line, "{},{},{}", q.feature, q.layer, q.kind.as_str());
-            for (x, decimals) in [
-                (q.p[0], 6),
-                (q.p[1], 6),
-                (q.p[2], 6),
-                (q.axis[0], 6),
-                (q.axis[1], 6),
-                (q.axis[2], 6),
-                (q.e, 6),
-                (q.thickness, 4),
-                (q.width, 4),
-            ] {
-                line.push(',');
-                push_fixed(&mut line, x, decimals);
+        let at_once = BLOCK * rayon::current_num_threads().max(1);
+        for points in self.points.chunks(at_once) {
+            let blocks: Vec<String> = points
+                .par_chunks(BLOCK)
+                .map(|block| {
+                    let mut text = String::with_capacity(96 * block.len());
+                    for q in block {
+                        csv_line(&mut text, q);
+                    }
+                    text
+                })
+                .collect();
+            for text in &blocks {
+                w.write_all(text.as_bytes())?;
             }
-            line.push(',');
-            line.push_str(q.role.as_str());
-            line.push('\n');
-            w.write_all(line.as_bytes())?;
         }
         Ok(())
     }
@@ -237,6 +233,29 @@ fn clip(s: &str) -> String {
         out.push('…');
     }
     out
+}
+
+/// Appends the line of `q` in toolpath.csv ([`ToolPath::to_csv`]), with its `\n`.
+fn csv_line(line: &mut String, q: &PathPoint) {
+    use std::fmt::Write as _;
+    let _ = write!(line, "{},{},{}", q.feature, q.layer, q.kind.as_str());
+    for (x, decimals) in [
+        (q.p[0], 6),
+        (q.p[1], 6),
+        (q.p[2], 6),
+        (q.axis[0], 6),
+        (q.axis[1], 6),
+        (q.axis[2], 6),
+        (q.e, 6),
+        (q.thickness, 4),
+        (q.width, 4),
+    ] {
+        line.push(',');
+        push_fixed(line, x, decimals);
+    }
+    line.push(',');
+    line.push_str(q.role.as_str());
+    line.push('\n');
 }
 
 #[cfg(test)]
