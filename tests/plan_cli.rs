@@ -882,3 +882,32 @@ fn robot_post_profile() -> toml::Table {
         .unwrap();
     String::from_utf8_lossy(&o.stdout).parse().unwrap()
 }
+
+/// A part modelled in metres where millimetres were meant (the box fixture's unit changed):
+/// thousands of cubic metres, refused in one line before any layer is made, nothing written,
+/// where planning it ran the machine out of memory.
+#[test]
+fn a_part_too_big_to_plan_is_refused_before_any_layer() {
+    let s = Scratch::new("too_big");
+    let text = std::fs::read_to_string(fixture("box.step")).unwrap();
+    assert!(text.contains("SI_UNIT(.MILLI.,.METRE.)"));
+    let metres = s.path("box_in_metres.step");
+    std::fs::write(
+        &metres,
+        text.replace("SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)"),
+    )
+    .unwrap();
+    let out = s.path("out");
+    let o = plan_file(&metres, &["-o", out.to_str().unwrap()]);
+    assert_refused(
+        &o,
+        &["box_in_metres.step", "m^3", "km of bead", "length unit"],
+    );
+    assert!(!out.exists(), "nothing written");
+    // The same box in millimetres plans.
+    let o = plan_file(
+        &fixture("box.step"),
+        &["-o", s.path("mm").to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -54,7 +54,22 @@ pub enum PlanError {
     /// [`Options::allow_collisions`] is off): one line per feature.
     #[error("the head collides in {} feature(s)", .0.len())]
     Collisions(Vec<String>),
+    /// The part needs more bead than one plan holds ([`MAX_BEAD_KM`]), estimated before any
+    /// layer is made: nothing planned.
+    #[error("the part's features hold {volume_m3:.3} m^3: at these layer heights and bead spacings that is at least {bead_km:.0} km of bead, more than the {MAX_BEAD_KM} km one plan holds (is the file's length unit right?); nothing planned")]
+    TooBig {
+        /// The features' volume, m³.
+        volume_m3: f64,
+        /// The bead they need at the least, km.
+        bead_km: f64,
+    },
 }
+
+/// The most bead one plan lays, km: some 60 million path points, gigabytes of path and
+/// program (NIST CTC-05, half a metre across, lays 141 km). A part past it is refused before
+/// any layer is made rather than planned until memory runs out (a building's model in
+/// millimetres: thousands of cubic metres).
+pub const MAX_BEAD_KM: f64 = 1000.0;
 
 /// Where a plan is: reported to [`Options::progress`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -192,6 +207,37 @@ pub fn plan_into(
             order.push((ti, k, offset));
         }
         offset += t.features.len();
+    }
+    // The bead the features need at the least (volume over the thickest layer and the widest
+    // spacing their parameters allow), before any of it is made.
+    let (mut volume, mut bead_mm) = (0.0, 0.0);
+    for &(ti, k, offset) in &order {
+        let f = &trees[ti].features[k];
+        let params = process.params_for(&base, offset + f.id)?;
+        let thickest = params
+            .adaptive_layer_height
+            .iter()
+            .copied()
+            .chain([params.uniform_layer_height, params.max_layer_height])
+            .filter(|h| h.is_finite() && *h > 0.0)
+            .fold(0.0f64, f64::max);
+        let widest = params
+            .adaptive_offset
+            .iter()
+            .copied()
+            .chain([params.spacing(bead.width)])
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .fold(0.0f64, f64::max);
+        if f.volume.is_finite() && thickest > 0.0 && widest > 0.0 {
+            volume += f.volume;
+            bead_mm += f.volume / (thickest * widest);
+        }
+    }
+    if bead_mm > MAX_BEAD_KM * 1e6 {
+        return Err(PlanError::TooBig {
+            volume_m3: volume * 1e-9,
+            bead_km: bead_mm * 1e-6,
+        });
     }
     // Features are filled (sectioned and filled layer by layer: the bulk of the work) a few
     // at a time in parallel, as many as there are threads, so memory holds no more than that
