@@ -101,6 +101,17 @@ impl Leaf {
     fn mask(&self) -> u64 {
         u64::from(self.mask[0]) | u64::from(self.mask[1]) << 32
     }
+
+    /// The centre and half extents of the box of its occupied quarter cells' centres, for the
+    /// leaf of finest-cell index `key`.
+    fn centres_box(&self, key: Key) -> (V3, V3) {
+        let origin = key.map(|i| f64::from(i) * CELL);
+        let centre = std::array::from_fn(|k| {
+            origin[k] + (0.5 * (f64::from(self.lo[k]) + f64::from(self.hi[k])) + 0.5) * SUB
+        });
+        let half = std::array::from_fn(|k| 0.5 * f64::from(self.hi[k] - self.lo[k]) * SUB);
+        (centre, half)
+    }
 }
 
 /// The index of child `slot` of the cell `cell` one level up.
@@ -115,6 +126,16 @@ struct Node {
     lo: [f32; 3],
     hi: [f32; 3],
     children: [u32; 8],
+}
+
+impl Node {
+    /// The centre and half extents of its box of quarter-cell centres, the half extents grown
+    /// by a little for the single-precision corners.
+    fn centres_box(&self) -> (V3, V3) {
+        let centre = std::array::from_fn(|k| 0.5 * f64::from(self.lo[k] + self.hi[k]));
+        let half = std::array::from_fn(|k| 0.5 * f64::from(self.hi[k] - self.lo[k]) + 1e-4);
+        (centre, half)
+    }
 }
 
 /// The material deposited so far.
@@ -375,8 +396,7 @@ impl Sweep {
     /// inside the head.
     fn visit(&self, d: &Deposit, n: u32, level: usize, cell: Key) -> bool {
         let node = &d.nodes[n as usize];
-        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
-        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        let (centre, half) = node.centres_box();
         if !self.may_hold(centre, half) {
             return false;
         }
@@ -387,14 +407,8 @@ impl Sweep {
             }
             let key = child_cell(cell, slot);
             if level == 1 {
-                let l = &d.leaves[c as usize];
-                let origin = key.map(|i| f64::from(i) * CELL);
-                let centre: V3 = std::array::from_fn(|k| {
-                    origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
-                });
-                let half: V3 =
-                    std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB + 1e-9);
-                self.may_hold(centre, half)
+                let (centre, half) = d.leaves[c as usize].centres_box(key);
+                self.may_hold(centre, half.map(|x| x + 1e-9))
             } else {
                 self.visit(d, c, level - 1, key)
             }
@@ -447,15 +461,11 @@ impl Query<'_> {
     fn leaf(&self, n: u32, key: Key) -> Option<usize> {
         let l = &self.d.leaves[n as usize];
         let depth = self.tol + GRAIN_SLACK;
-        let origin = key.map(|i| f64::from(i) * CELL);
-        // The box of its quarter-cell centres.
-        let centre: V3 = std::array::from_fn(|k| {
-            origin[k] + (0.5 * (f64::from(l.lo[k]) + f64::from(l.hi[k])) + 0.5) * SUB
-        });
-        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(l.hi[k] - l.lo[k]) * SUB);
+        let (centre, half) = l.centres_box(key);
         if !self.may_hold(centre, half, depth) {
             return None;
         }
+        let origin = key.map(|i| f64::from(i) * CELL);
         let mut mask = l.mask();
         while mask != 0 {
             let b = mask.trailing_zeros() as i32;
@@ -474,10 +484,7 @@ impl Query<'_> {
     /// leaf's index.
     fn visit(&self, n: u32, level: usize, cell: Key) -> Option<(usize, (u32, Key))> {
         let node = &self.d.nodes[n as usize];
-        let centre: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.lo[k] + node.hi[k]));
-        // Half the box of the quarter-cell centres, with their slack (and a little for the
-        // single-precision corners).
-        let half: V3 = std::array::from_fn(|k| 0.5 * f64::from(node.hi[k] - node.lo[k]) + 1e-4);
+        let (centre, half) = node.centres_box();
         if !self.may_hold(centre, half, self.tol + GRAIN_SLACK) {
             return None;
         }

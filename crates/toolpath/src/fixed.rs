@@ -28,7 +28,7 @@ const MAX_DECIMALS: usize = 9;
 const MAX_MAGNITUDE: f64 = 9.0e9;
 
 /// `(sign, round(|x|·10^decimals))`, rounded half to even, where the integer path applies.
-fn scaled(x: f64, decimals: usize) -> Option<(bool, u128)> {
+fn scaled(x: f64, decimals: usize) -> Option<(bool, u64)> {
     if decimals > MAX_DECIMALS || !x.is_finite() || x.abs() >= MAX_MAGNITUDE {
         return None;
     }
@@ -63,31 +63,20 @@ fn scaled(x: f64, decimals: usize) -> Option<(bool, u128)> {
             }
         }
     };
-    Some((negative, q))
+    // Below 9e9 · 10^9 < 2^64: the digits are made in 64 bits (a 128-bit division by ten is
+    // a library call).
+    u64::try_from(q).ok().map(|q| (negative, q))
 }
 
 /// Writes the integer `n` as a fixed-point number with `decimals` places.
-fn push_scaled(out: &mut String, negative: bool, n: u128, decimals: usize) {
+fn push_scaled(out: &mut String, negative: bool, n: u64, decimals: usize) {
     let mut digits = [0u8; 40];
     let mut len = 0;
-    // In 64 bits where it fits (always, below MAX_MAGNITUDE with MAX_DECIMALS): a division by
-    // ten is then a multiplication, where a 128-bit one is a library call.
-    match u64::try_from(n) {
-        Ok(mut v) => {
-            while v > 0 || len <= decimals {
-                digits[len] = b'0' + (v % 10) as u8;
-                v /= 10;
-                len += 1;
-            }
-        }
-        Err(_) => {
-            let mut v = n;
-            while v > 0 || len <= decimals {
-                digits[len] = b'0' + (v % 10) as u8;
-                v /= 10;
-                len += 1;
-            }
-        }
+    let mut v = n;
+    while v > 0 || len <= decimals {
+        digits[len] = b'0' + (v % 10) as u8;
+        v /= 10;
+        len += 1;
     }
     if negative && n != 0 {
         out.push('-');
