@@ -5,6 +5,7 @@
 
 mod extract;
 mod inspect;
+mod memory;
 mod mesh;
 mod outputs;
 mod placement;

@@ -64,7 +64,11 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             .0
             .set_length(1 + features + plan::STAGES.len() as u64 + 1),
         Progress::Feature { id } => bar.0.set_message(format!("feature {id}")),
-        Progress::FeatureDone => bar.0.inc(1),
+        Progress::FeatureDone => {
+            // The feature's fills are freed: their pages go back before the next is laid.
+            crate::memory::release_freed();
+            bar.0.inc(1)
+        }
         Progress::Planned => {}
         Progress::Stage(name) => {
             if name != plan::STAGES[0] {

@@ -99,17 +99,33 @@ pub fn write_csv(avoided: &Avoided, w: &mut impl std::io::Write) -> std::io::Res
 /// over the material put between some: a point of `path` at the position of the next point
 /// of `before` is that point; a lifted travel point takes its own axis.
 fn planned_at(path: &ToolPath, before: &[V3], planned: &[V3], left: &[Collision]) -> Vec<[V3; 2]> {
-    let mut of = Vec::with_capacity(path.points.len());
+    // The indices asked for, in order; each one's planned axis found in one walk along the
+    // path (no list of every point's planned axis: 32 bytes a point of a long path).
+    let mut wanted: Vec<usize> = left
+        .iter()
+        .flat_map(|c| [c.index.saturating_sub(1), c.index])
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let mut found: Vec<(usize, V3)> = Vec::with_capacity(wanted.len());
+    let mut next = wanted.iter().copied().peekable();
     let mut i = 0;
-    for q in &path.points {
-        if i < before.len() && q.p == before[i] {
-            of.push(planned.get(i).copied());
+    for (k, q) in path.points.iter().enumerate() {
+        let Some(&w) = next.peek() else { break };
+        let own = i < before.len() && q.p == before[i];
+        if k == w {
+            let axis = own.then(|| planned.get(i).copied()).flatten();
+            found.push((k, axis.unwrap_or(q.axis)));
+            next.next();
+        }
+        if own {
             i += 1;
-        } else {
-            of.push(None);
         }
     }
-    let at = |i: usize| of.get(i).copied().flatten().unwrap_or(path.points[i].axis);
+    let at = |k: usize| match found.binary_search_by_key(&k, |f| f.0) {
+        Ok(j) => found[j].1,
+        Err(_) => path.points.get(k).map_or([0.0, 0.0, 1.0], |q| q.axis),
+    };
     left.iter()
         .map(|c| [at(c.index.saturating_sub(1)), at(c.index)])
         .collect()

@@ -26,7 +26,7 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
     let placed = placed_points(path);
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for q in &placed {
+    for q in placed.clone() {
         let bottom = match q.kind {
             MoveKind::Print => q.p[2] - q.thickness.max(0.0),
             MoveKind::Travel => q.p[2],
@@ -37,7 +37,7 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
         }
         lo[2] = lo[2].min(bottom);
     }
-    let offset = if placed.is_empty() {
+    let offset = if placed.clone().next().is_none() {
         [centre[0], centre[1], 0.0]
     } else {
         [
@@ -93,17 +93,13 @@ fn round3(v: f64) -> f64 {
 
 /// The points a post places the part by: the print points, or every point of a path without
 /// any (travel only).
-pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
-    let prints: Vec<&PathPoint> = path
-        .points
+pub(crate) fn placed_points(path: &ToolPath) -> impl Iterator<Item = &PathPoint> + Clone {
+    // Walked, not collected: a list of references would take 8 bytes a point of a path that
+    // may hold millions.
+    let any_print = path.points.iter().any(|q| q.kind == MoveKind::Print);
+    path.points
         .iter()
-        .filter(|q| q.kind == MoveKind::Print)
-        .collect();
-    if prints.is_empty() {
-        path.points.iter().collect()
-    } else {
-        prints
-    }
+        .filter(move |q| !any_print || q.kind == MoveKind::Print)
 }
 
 /// The offset (mm, rounded to 0.001) from part to table coordinates: the XY bounding-box
@@ -112,12 +108,12 @@ pub(crate) fn placed_points(path: &ToolPath) -> Vec<&PathPoint> {
 /// points; an empty path gets no offset.
 pub fn table_offset(path: &ToolPath) -> [f64; 3] {
     let placed = placed_points(path);
-    if placed.is_empty() {
+    if placed.clone().next().is_none() {
         return [0.0; 3];
     }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 2];
-    for q in &placed {
+    for q in placed {
         let bottom = match (q.kind, unit(q.axis)) {
             (MoveKind::Print, Some(a)) => q.p[2] - q.thickness.max(0.0) * a[2],
             _ => q.p[2],
