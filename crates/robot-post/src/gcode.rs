@@ -158,9 +158,38 @@ pub(crate) fn mergeable(xyz: f64, rotary: f64) -> bool {
 
 /// `units` hundred-thousandths of a millimetre as fixed-point text with 5 decimals.
 pub(crate) fn e_text(units: i64) -> String {
-    let sign = if units < 0 { "-" } else { "" };
+    let mut s = String::new();
+    push_e_text(&mut s, units);
+    s
+}
+
+/// Appends [`e_text`]`(units)` to `out` without a new allocation.
+pub(crate) fn push_e_text(out: &mut String, units: i64) {
+    if units < 0 {
+        out.push('-');
+    }
     let a = units.unsigned_abs();
-    format!("{sign}{}.{:05}", a / 100_000, a % 100_000)
+    let mut digits = [0u8; 20];
+    let mut n = a / 100_000;
+    let mut k = digits.len();
+    loop {
+        k -= 1;
+        digits[k] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    // ASCII digits.
+    out.extend(digits[k..].iter().map(|&d| d as char));
+    out.push('.');
+    let mut frac = a % 100_000;
+    let mut five = [b'0'; 5];
+    for d in five.iter_mut().rev() {
+        *d = b'0' + (frac % 10) as u8;
+        frac /= 10;
+    }
+    out.extend(five.iter().map(|&d| d as char));
 }
 
 #[cfg(test)]
@@ -173,6 +202,29 @@ mod tests {
         assert_eq!(e_text(123_456), "1.23456");
         assert_eq!(e_text(-80_000), "-0.80000");
         assert_eq!(e_text(7), "0.00007");
+    }
+
+    /// The digits made by hand read back as the number of units, whatever its size and sign.
+    #[test]
+    fn e_text_reads_back_as_its_units() {
+        let mut x: i64 = 1;
+        let mut values = vec![0, 1, -1, 99_999, 100_000, -100_001, i64::MAX, i64::MIN + 1];
+        for _ in 0..2000 {
+            // A spread of magnitudes from a simple generator.
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            values.push(x >> (x.unsigned_abs() % 60));
+        }
+        for units in values {
+            let text = e_text(units);
+            let (int, frac) = text.split_once('.').expect("a decimal point");
+            assert_eq!(frac.len(), 5, "{text}");
+            let back = int.trim_start_matches('-').parse::<i128>().expect("digits") * 100_000
+                + frac.parse::<i128>().expect("digits");
+            let back = if text.starts_with('-') { -back } else { back };
+            assert_eq!(back, i128::from(units), "{text}");
+        }
     }
 
     #[test]

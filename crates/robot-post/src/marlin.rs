@@ -13,14 +13,16 @@
 //! that goes nowhere once rounded (X, Y and Z as written) is not written, its filament going
 //! with the next move, nor one whose E rounds to 0 over less than 0.01 mm.
 
-use crate::gcode::{comment_text, e_text, mergeable, push_line, Extrusion, Fan, LayerMarks};
+use crate::gcode::{
+    comment_text, e_text, mergeable, push_e_text, push_line, Extrusion, Fan, LayerMarks,
+};
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
 use crate::sink::{insert_notes, write_error, InMemory, ProgramSink};
 use crate::PostError;
 use std::io::Write as _;
-use toolpath::fixed;
+use toolpath::{fixed, push_fixed};
 use toolpath::{MoveKind, PathPoint, ToolPath};
 
 /// Largest deviation of a tool axis component from +Z (0, 0, 1) that Marlin accepts.
@@ -319,14 +321,17 @@ impl Writer {
             self.hopped = true;
         }
         let z = if self.hopped { self.hop_z(t[2]) } else { t[2] };
-        let line = format!(
-            "G0 X{} Y{} Z{} F{}",
-            fixed(t[0], 3),
-            fixed(t[1], 3),
-            fixed(z, 3),
-            self.travel_f
-        );
-        self.line(&line);
+        // Straight into the text: a plan writes millions of these lines.
+        let out = &mut self.out;
+        out.push_str("G0 X");
+        push_fixed(out, t[0], 3);
+        out.push_str(" Y");
+        push_fixed(out, t[1], 3);
+        out.push_str(" Z");
+        push_fixed(out, z, 3);
+        out.push_str(" F");
+        out.push_str(&self.travel_f);
+        out.push('\n');
         self.at = Some(t);
     }
 
@@ -350,19 +355,21 @@ impl Writer {
         } else {
             &self.print_f
         };
-        let e = if de == 0 {
-            String::new()
-        } else {
-            format!(" E{}", e_text(de))
-        };
-        let line = format!(
-            "G1 X{} Y{} Z{}{e} F{}",
-            fixed(t[0], 3),
-            fixed(t[1], 3),
-            fixed(t[2], 3),
-            f
-        );
-        self.line(&line);
+        // Straight into the text: a plan writes millions of these lines.
+        let out = &mut self.out;
+        out.push_str("G1 X");
+        push_fixed(out, t[0], 3);
+        out.push_str(" Y");
+        push_fixed(out, t[1], 3);
+        out.push_str(" Z");
+        push_fixed(out, t[2], 3);
+        if de != 0 {
+            out.push_str(" E");
+            push_e_text(out, de);
+        }
+        out.push_str(" F");
+        out.push_str(f);
+        out.push('\n');
         self.extrusion.written(de);
         self.printing = true;
         self.at = Some(t);
