@@ -90,7 +90,19 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     // The program goes to its files as the post makes it, under temporary names until every
     // check below has passed (dropped on any failure: nothing written).
     let mut staged = Staged::new(&outputs);
-    let result = plan::plan_into(&part, &process, &machine, &options, &mut staged);
+    // toolpath.csv likewise, written beside the program as the plan ends.
+    let mut csv = staged
+        .open("toolpath.csv")
+        .map_err(|e| Failure::new(&outputs.dir, format!("cannot write toolpath.csv: {e}")))?;
+    let result = plan::plan_into(
+        &part,
+        &process,
+        &machine,
+        &options,
+        &mut staged,
+        Some(&mut csv),
+    );
+    drop(csv);
     bar.0.inc(1);
     bar.0.set_prefix("writing");
     bar.0.set_message("outputs");
@@ -143,16 +155,16 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         outputs.clear_earlier()?;
     }
     plan.report.placement = placement;
-    let csv = outputs.name("toolpath.csv");
-    let program = staged.names();
+    // toolpath.csv and the program, as staged.
+    let staged_names = staged.names();
     // The preview: the features and the path, in one page that opens offline.
     let preview_name = outputs.name("preview.html");
     let page = crate::preview::plan_page(&plan, &path.display().to_string());
     // The colliding moves left, one line each, where there are any.
     let collisions_name =
         (!plan.collisions.left.is_empty()).then(|| outputs.name("collisions.csv"));
-    plan.report.outputs = std::iter::once(csv.clone())
-        .chain(program)
+    plan.report.outputs = staged_names
+        .into_iter()
         .chain(std::iter::once(preview_name.clone()))
         .chain(collisions_name.clone())
         .collect();
@@ -160,11 +172,6 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let written = |name: &str, r: std::io::Result<()>| {
         r.map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))
     };
-    // The tool path is written point by point, not built as one text first.
-    written(
-        &csv,
-        write_atomic(&dir.join(&csv), |w| plan.toolpath.write_csv(w)),
-    )?;
     staged
         .commit()
         .map_err(|e| Failure::new(dir, format!("cannot write the program: {e}")))?;

@@ -1,5 +1,5 @@
-//! The machine program's files as the post writes them ([`plan::plan_into`]): each under a
-//! temporary name in the output folder, renamed into place only when the whole plan passed
+//! The machine program's files as the post writes them ([`plan::plan_into`]), and
+//! `toolpath.csv` as it is written beside them: each under a temporary name in the output folder, renamed into place only when the whole plan passed
 //! its checks ([`Staged::commit`]), removed otherwise (dropped uncommitted), with the folder
 //! when it was made for them. So a program of hundreds of megabytes is never held in memory,
 //! and a failed plan still leaves nothing that looks complete.
@@ -7,6 +7,7 @@
 use crate::mesh::TempFile;
 use crate::outputs::Outputs;
 use robot_post::ProgramSink;
+use std::fs::File;
 use std::io::Write;
 
 /// Bytes each file's writer gathers before a write.
@@ -48,8 +49,10 @@ impl<'a> Staged<'a> {
     }
 }
 
-impl ProgramSink for Staged<'_> {
-    fn file(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>> {
+impl Staged<'_> {
+    /// A writer for the output `name` (a name without a folder, the `-o` stem put before it
+    /// as for every output), staged like the program's files.
+    pub(crate) fn open(&mut self, name: &str) -> std::io::Result<std::io::BufWriter<File>> {
         let dir = &self.outputs.dir;
         if !dir.is_dir() {
             std::fs::create_dir_all(dir)?;
@@ -58,7 +61,13 @@ impl ProgramSink for Staged<'_> {
         let name = self.outputs.name(name);
         let (tmp, file) = TempFile::create(&dir.join(&name))?;
         self.files.push((name, tmp));
-        Ok(Box::new(std::io::BufWriter::with_capacity(BUFFER, file)))
+        Ok(std::io::BufWriter::with_capacity(BUFFER, file))
+    }
+}
+
+impl ProgramSink for Staged<'_> {
+    fn file(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>> {
+        Ok(Box::new(self.open(name)?))
     }
 }
 

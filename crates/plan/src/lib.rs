@@ -46,6 +46,9 @@ pub enum PlanError {
     /// The post could not write the program.
     #[error(transparent)]
     Post(#[from] robot_post::PostError),
+    /// `toolpath.csv` could not be written ([`plan_into`]'s `csv`).
+    #[error("cannot write toolpath.csv: {0}")]
+    Csv(#[source] std::io::Error),
     /// The plan fails its self-check (and [`Options::keep_going`] is off): a feature has no
     /// layer, or its extruded volume is off its volume × fill.
     #[error("the plan fails its self-check for {} feature(s)", .0.len())]
@@ -156,21 +159,24 @@ pub fn plan(
     options: &Options,
 ) -> Result<Plan, PlanError> {
     let mut files = InMemory::default();
-    let mut plan = plan_into(part, process, machine, options, &mut files)?;
+    let mut plan = plan_into(part, process, machine, options, &mut files, None)?;
     plan.program = files.files;
     Ok(plan)
 }
 
 /// [`plan`], the program's files written into `sink` as the post makes them (the Marlin
-/// program a megabyte at a time), not held: [`Plan::program`] is left empty. When the plan
+/// program a megabyte at a time), not held: [`Plan::program`] is left empty. With `csv`, the
+/// tool path's `toolpath.csv` ([`ToolPath::write_csv`]) is written into it at the same time,
+/// on another thread (the two texts are the bulk of a large plan's writing). When the plan
 /// fails its self-check or meets collisions (and the options do not allow that), the error
-/// comes after the files were written: the sink's owner discards them.
+/// comes after the files were written: the sink's owner discards them, and `csv`'s.
 pub fn plan_into(
     part: &brep::StepPart,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,
     sink: &mut dyn ProgramSink,
+    csv: Option<&mut (dyn std::io::Write + Send)>,
 ) -> Result<Plan, PlanError> {
     let tell = |p: Progress| {
         if let Some(f) = options.progress {
@@ -420,7 +426,23 @@ pub fn plan_into(
         stem: &options.stem,
         notes: &notes,
     };
-    let program = machine.post().post_to(&toolpath, &job, sink)?;
+    let post = machine.post();
+    let (program, csv) = match csv {
+        // The program on this thread, toolpath.csv on another (its blocks of lines made by
+        // the thread pool, idle while the post writes).
+        Some(w) => std::thread::scope(|scope| {
+            let path = &toolpath;
+            let lines = scope.spawn(move || path.write_csv(&mut &mut *w).and_then(|()| w.flush()));
+            let program = post.post_to(&toolpath, &job, sink);
+            let csv = lines
+                .join()
+                .unwrap_or_else(|_| Err(std::io::Error::other("toolpath.csv's writer panicked")));
+            (program, csv)
+        }),
+        None => (post.post_to(&toolpath, &job, sink), Ok(())),
+    };
+    let program = program?;
+    csv.map_err(PlanError::Csv)?;
     for r in &mut reports {
         r.post = program.figures.get(&r.feature.id).map(|k| match k {
             PostFigures::Delta5(k) => PostEntry::delta5(k),

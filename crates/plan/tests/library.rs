@@ -104,7 +104,9 @@ fn the_report_reads_back_as_the_plan_schema_with_post_figures() {
 }
 
 /// `plan_into` writes into its sink the files `plan` holds, byte for byte, and holds none
-/// itself; a sink that cannot write fails the plan with the file's name.
+/// itself, and into its CSV writer (beside the post, on another thread) exactly the held tool
+/// path's `toolpath.csv`; a sink or a CSV writer that cannot write fails the plan with the
+/// file's name.
 #[test]
 fn a_plan_written_into_a_sink_is_the_plan_held() {
     struct Refusing;
@@ -127,13 +129,58 @@ fn a_plan_written_into_a_sink_is_the_plan_held() {
         let part = fixture(name);
         let m = MachineProfile::builtin(machine);
         let mut sink = robot_post::InMemory::default();
-        let streamed = plan::plan_into(&part, &Process::default(), &m, &options, &mut sink)
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut csv: Vec<u8> = vec![];
+        let streamed = plan::plan_into(
+            &part,
+            &Process::default(),
+            &m,
+            &options,
+            &mut sink,
+            Some(&mut csv),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(streamed.program.is_empty(), "{name}");
         assert!(!sink.files.is_empty(), "{name}");
         assert_eq!(sink.files, held.program, "{name}");
         assert_eq!(streamed.toolpath, held.toolpath, "{name}");
-        match plan::plan_into(&part, &Process::default(), &m, &options, &mut Refusing) {
+        assert!(
+            csv == held.toolpath.to_csv().as_bytes(),
+            "{name}: toolpath.csv written beside the post differs from the held path's"
+        );
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::other("disk full"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut full = Full;
+        let mut sink = robot_post::InMemory::default();
+        match plan::plan_into(
+            &part,
+            &Process::default(),
+            &m,
+            &options,
+            &mut sink,
+            Some(&mut full),
+        ) {
+            Err(e) => assert!(
+                e.to_string()
+                    .contains("cannot write toolpath.csv: disk full"),
+                "{name}: {e}"
+            ),
+            Ok(_) => panic!("{name}: planned with a toolpath.csv that cannot be written"),
+        }
+        match plan::plan_into(
+            &part,
+            &Process::default(),
+            &m,
+            &options,
+            &mut Refusing,
+            None,
+        ) {
             Err(e) => assert!(
                 e.to_string().contains("cannot write program.gcode"),
                 "{name}: {e}"
