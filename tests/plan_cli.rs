@@ -897,13 +897,15 @@ fn a_part_too_big_to_plan_is_refused_before_any_layer() {
         text.replace("SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)"),
     )
     .unwrap();
-    let out = s.path("out");
+    // Into folders that do not exist yet, three deep: none is left behind.
+    let top = s.path("new");
+    let out = top.join("deeper").join("out");
     let o = plan_file(&metres, &["-o", out.to_str().unwrap()]);
     assert_refused(
         &o,
         &["box_in_metres.step", "m^3", "km of bead", "length unit"],
     );
-    assert!(!out.exists(), "nothing written");
+    assert!(!top.exists(), "nothing written, no folder made");
     // The same box in millimetres plans.
     let o = plan_file(
         &fixture("box.step"),

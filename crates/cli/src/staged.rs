@@ -16,8 +16,9 @@ const BUFFER: usize = 1 << 20;
 /// The program's files written so far, not yet in place.
 pub(crate) struct Staged<'a> {
     outputs: &'a Outputs,
-    /// The output folder did not exist and was made for these files.
-    made_dir: bool,
+    /// The folders made for these files (the output folder and those of its parents that did
+    /// not exist), innermost first.
+    made_dirs: Vec<std::path::PathBuf>,
     /// Each file's name in the folder and its temporary file.
     files: Vec<(String, TempFile)>,
 }
@@ -27,7 +28,7 @@ impl<'a> Staged<'a> {
     pub(crate) fn new(outputs: &'a Outputs) -> Staged<'a> {
         Staged {
             outputs,
-            made_dir: false,
+            made_dirs: vec![],
             files: vec![],
         }
     }
@@ -44,7 +45,7 @@ impl<'a> Staged<'a> {
             std::fs::File::open(tmp.path())?.sync_all()?;
             tmp.persist(&dest)?;
         }
-        self.made_dir = false;
+        self.made_dirs.clear();
         Ok(())
     }
 }
@@ -55,8 +56,14 @@ impl Staged<'_> {
     pub(crate) fn open(&mut self, name: &str) -> std::io::Result<std::io::BufWriter<File>> {
         let dir = &self.outputs.dir;
         if !dir.is_dir() {
+            // The folders about to be made: the output folder and its missing parents.
+            let missing: Vec<_> = dir
+                .ancestors()
+                .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+                .map(|d| d.to_path_buf())
+                .collect();
             std::fs::create_dir_all(dir)?;
-            self.made_dir = true;
+            self.made_dirs = missing;
         }
         let name = self.outputs.name(name);
         let (tmp, file) = TempFile::create(&dir.join(&name))?;
@@ -73,10 +80,12 @@ impl ProgramSink for Staged<'_> {
 
 impl Drop for Staged<'_> {
     fn drop(&mut self) {
-        // The temporary files go first (each removes itself), then the folder made for them.
+        // The temporary files go first (each removes itself), then the folders made for them.
         self.files.clear();
-        if self.made_dir {
-            let _ = std::fs::remove_dir(&self.outputs.dir);
+        for d in &self.made_dirs {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
         }
     }
 }
