@@ -72,46 +72,65 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
             stop_before,
         }
     };
-    // Each move as the index of the point it ends at, times two, plus one where the machine
-    // stops before it.
-    let mut moves: Vec<usize> = vec![];
+    let long = |a: &PathPoint, q: &PathPoint| {
+        let d = [q.p[0] - a.p[0], q.p[1] - a.p[1], q.p[2] - a.p[2]];
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() >= MIN_MOVE
+    };
+    // The moves, first to last, each made again from its points whenever the motion planning
+    // walks them (a list of a long plan's moves would outweigh its points). A retraction (or
+    // its return) waits before the next move: the machine stops before it.
+    let moves = || {
+        let (mut printing, mut stop, mut any) = (false, true, false);
+        pts.windows(2).filter_map(move |w| {
+            let (a, q) = (&w[0], &w[1]);
+            match q.kind {
+                MoveKind::Print => {
+                    if !printing && retracts && any {
+                        stop = true;
+                    }
+                    printing = true;
+                }
+                MoveKind::Travel => {
+                    if printing && retracts {
+                        stop = true;
+                    }
+                    printing = false;
+                }
+            }
+            long(a, q).then(|| {
+                any = true;
+                move_to(a, q, std::mem::take(&mut stop))
+            })
+        })
+    };
+    // The same moves last to first (where the machine stops matters only going forward).
+    let reversed = pts
+        .windows(2)
+        .rev()
+        .filter(|w| long(&w[0], &w[1]))
+        .map(|w| move_to(&w[0], &w[1], false));
+    // The filament, and a retraction and its return around each travel that follows printing.
     let mut retraction_time = 0.0;
     let mut filament = 0.0;
     let mut printing = false;
-    // A retraction (or its return) waits before the next move.
-    let mut stop = true;
-    for (i, w) in pts.windows(2).enumerate() {
-        let (a, q) = (&w[0], &w[1]);
+    for q in pts.iter().skip(1) {
         match q.kind {
             MoveKind::Print => {
                 filament += q.e;
-                if !printing && retracts && !moves.is_empty() {
-                    stop = true;
-                }
                 printing = true;
             }
             MoveKind::Travel => {
                 if printing && retracts {
                     retraction_time += 2.0 * machine.retraction_length / machine.retraction_speed;
-                    stop = true;
                 }
                 printing = false;
             }
         }
-        let d = [q.p[0] - a.p[0], q.p[1] - a.p[1], q.p[2] - a.p[2]];
-        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() < MIN_MOVE {
-            continue;
-        }
-        moves.push(2 * (i + 1) + usize::from(std::mem::take(&mut stop)));
     }
-    let move_at = |k: usize| {
-        let (end, stop) = (moves[k] / 2, moves[k] % 2 == 1);
-        move_to(&pts[end - 1], &pts[end], stop)
-    };
     let area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
     let density = machine.filament_density.unwrap_or(PLA_DENSITY) / 1000.0;
     Estimate {
-        time_s: motion::time_of(moves.len(), move_at, jerk) + retraction_time,
+        time_s: motion::time_of(moves, reversed, jerk) + retraction_time,
         filament_mm: filament,
         filament_g: filament * area * density,
     }

@@ -25,48 +25,48 @@ pub struct Move {
 /// The time (s) of the moves one after another, the last ending at a stop, with velocity
 /// jumps of at most `jerk` (mm/s).
 pub fn time(moves: &[Move], jerk: f64) -> f64 {
-    time_of(moves.len(), |i| moves[i], jerk)
+    time_of(|| moves.iter().copied(), moves.iter().rev().copied(), jerk)
 }
 
-/// [`time`] of `n` moves made one at a time by `move_at` (move `i` each time it is asked, the
-/// same each time), so a long plan's moves need not be held all at once: only the speed
-/// where each one starts is kept.
-pub fn time_of(n: usize, move_at: impl Fn(usize) -> Move, jerk: f64) -> f64 {
-    if n == 0 {
-        return 0.0;
-    }
+/// [`time`] of the moves `moves` makes (each call the same moves, first to last) and
+/// `reversed` gives (the same, last to first), so a long plan's moves need not be held at
+/// once: only the speed where each one starts is kept.
+pub fn time_of<I: Iterator<Item = Move>>(
+    moves: impl Fn() -> I,
+    reversed: impl Iterator<Item = Move>,
+    jerk: f64,
+) -> f64 {
     // Node i is where move i starts (node n where the last ends): the fastest each may be
     // passed at.
-    let mut node = vec![0.0f64; n + 1];
+    let mut node: Vec<f64> = vec![];
     let mut before: Option<Move> = None;
-    for (i, node) in node.iter_mut().enumerate() {
-        let m = (i < n).then(|| move_at(i));
-        *node = match (before, m) {
+    for m in moves().map(Some).chain([None]) {
+        node.push(match (before, m) {
             (Some(a), Some(b)) if !b.stop_before => junction_speed(&a, &b, jerk),
             _ => {
                 let v = m.map_or(f64::INFINITY, |m| m.speed);
                 let u = before.map_or(f64::INFINITY, |a| a.speed);
                 jerk.min(v).min(u)
             }
-        };
+        });
         before = m;
     }
+    let n = node.len() - 1;
+    if n == 0 {
+        return 0.0;
+    }
     // Backward: each move can slow down from its start node to its end node.
-    for i in (0..n).rev() {
-        let m = move_at(i);
+    for (i, m) in (0..n).rev().zip(reversed) {
         node[i] = node[i].min(reachable(node[i + 1], m.accel, m.length));
     }
-    // Forward: each move can speed up from its start node to its end node.
-    for i in 0..n {
-        let m = move_at(i);
+    // Forward: each move can speed up from its start node to its end node, which is then
+    // final (no later move changes it), and the move is timed.
+    let mut total = 0.0;
+    for (i, m) in moves().enumerate() {
         node[i + 1] = node[i + 1].min(reachable(node[i], m.accel, m.length));
+        total += trapezoid_time(m.length, m.speed, m.accel, node[i], node[i + 1]);
     }
-    (0..n)
-        .map(|i| {
-            let m = move_at(i);
-            trapezoid_time(m.length, m.speed, m.accel, node[i], node[i + 1])
-        })
-        .sum()
+    total
 }
 
 /// The fastest speed where move `a` runs into move `b`: at most either's cruise speed, and
