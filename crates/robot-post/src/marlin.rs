@@ -17,9 +17,8 @@ use crate::gcode::{comment_text, e_text, mergeable, push_line, Extrusion, Fan, L
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
-use crate::sink::{insert_notes, write_error, InMemory, ProgramSink};
+use crate::sink::{insert_notes, Chunked, InMemory, ProgramSink, CHUNK};
 use crate::PostError;
-use std::io::Write as _;
 use toolpath::fixed;
 use toolpath::{MoveKind, PathPoint, ToolPath};
 
@@ -51,9 +50,6 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
     // The program is made of `str`s.
     Ok(String::from_utf8(bytes).unwrap_or_default())
 }
-
-/// Text of the program held before it is passed on to the file, bytes.
-const CHUNK: usize = 1 << 20;
 
 /// [`marlin`]'s program, with `notes` (comment lines after the one naming the source, see
 /// [`crate::Job::notes`]), written into `sink`'s `program.gcode` as it is made, a megabyte at
@@ -90,9 +86,7 @@ fn write_marlin(
         });
     }
     let offset = bed_offset(path, m)?;
-    const NAME: &str = "program.gcode";
-    let failed = |e: std::io::Error| write_error(NAME, &e);
-    let mut file = sink.file(NAME).map_err(failed)?;
+    let mut file = Chunked::open(sink, "program.gcode", chunk)?;
 
     let mut w = Writer::new(m);
     w.header(m, source, offset);
@@ -110,16 +104,10 @@ fn write_marlin(
                 w.print(t, q);
             }
         }
-        if w.out.len() >= chunk {
-            // All but the last character, which the writer may look back at.
-            let keep = w.out.char_indices().next_back().map_or(0, |(i, _)| i);
-            file.write_all(&w.out.as_bytes()[..keep]).map_err(failed)?;
-            w.out.drain(..keep);
-        }
+        file.pass_on(&mut w.out)?;
     }
     w.footer(m);
-    file.write_all(w.out.as_bytes()).map_err(failed)?;
-    file.flush().map_err(failed)
+    file.finish(&w.out)
 }
 
 /// Whether `axis` is +Z within [`AXIS_TOLERANCE`].

@@ -3,12 +3,11 @@
 //! feature, warnings) for a tool path, so a caller never matches on machine kinds.
 
 use std::collections::BTreeMap;
-use std::io::Write;
 
-use crate::sink::{insert_notes, write_error};
+use crate::sink::{insert_notes, write_file};
 pub use crate::sink::{InMemory, ProgramFile, ProgramSink};
 
-use crate::delta5::{delta5, KinematicFigures};
+use crate::delta5::{delta5_to, KinematicFigures};
 use crate::kind::MachineKind;
 use crate::kuka::{kuka, KukaFigures};
 use crate::machine::MachineProfile;
@@ -45,11 +44,7 @@ pub trait Post {
     ) -> Result<Program, PostError> {
         let mut program = self.post(path, job)?;
         for f in std::mem::take(&mut program.files) {
-            let wrote = sink.file(&f.name).and_then(|mut w| {
-                w.write_all(&f.bytes)?;
-                w.flush()
-            });
-            wrote.map_err(|e| write_error(&f.name, &e))?;
+            write_file(sink, &f.name, &f.bytes)?;
         }
         Ok(program)
     }
@@ -80,14 +75,20 @@ pub enum PostFigures {
 #[derive(Debug, Clone, Copy)]
 pub struct MarlinPost<'a>(pub &'a MachineProfile);
 
+/// [`Post::post`] of a post that writes its files as it makes them: its
+/// [`Post::post_to`] into memory, the files put in the program.
+fn held(post: &dyn Post, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+    let mut files = InMemory::default();
+    let program = post.post_to(path, job, &mut files)?;
+    Ok(Program {
+        files: files.files,
+        ..program
+    })
+}
+
 impl Post for MarlinPost<'_> {
     fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut files = InMemory::default();
-        self.post_to(path, job, &mut files)?;
-        Ok(Program {
-            files: files.files,
-            ..Program::default()
-        })
+        held(self, path, job)
     }
 
     fn post_to(
@@ -108,13 +109,18 @@ pub struct Delta5Post<'a>(pub &'a MachineProfile);
 
 impl Post for Delta5Post<'_> {
     fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut program = delta5(path, self.0, job.source)?;
-        insert_notes(&mut program.gcode, job.notes);
+        held(self, path, job)
+    }
+
+    fn post_to(
+        &self,
+        path: &ToolPath,
+        job: &Job,
+        sink: &mut dyn ProgramSink,
+    ) -> Result<Program, PostError> {
+        let program = delta5_to(path, self.0, job.source, job.notes, sink)?;
         Ok(Program {
-            files: vec![
-                ProgramFile::text("program.gcode", program.gcode),
-                ProgramFile::text("kinematic_error.svg", program.error_plot_svg),
-            ],
+            files: vec![],
             figures: program
                 .figures
                 .into_iter()
