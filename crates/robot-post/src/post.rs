@@ -4,12 +4,12 @@
 
 use std::collections::BTreeMap;
 
-use crate::sink::{insert_notes, write_file};
+use crate::sink::write_file;
 pub use crate::sink::{InMemory, ProgramFile, ProgramSink};
 
 use crate::delta5::{delta5_to, KinematicFigures};
 use crate::kind::MachineKind;
-use crate::kuka::{kuka, KukaFigures};
+use crate::kuka::{kuka_to, KukaFigures};
 use crate::machine::MachineProfile;
 use crate::marlin::marlin_to;
 use crate::PostError;
@@ -86,6 +86,20 @@ fn held(post: &dyn Post, path: &ToolPath, job: &Job) -> Result<Program, PostErro
     })
 }
 
+/// A program holding no file: what a post measured, `figures` per feature (each made a
+/// [`PostFigures`] by `kind`), and its `warnings`.
+fn measured<K>(
+    figures: BTreeMap<usize, K>,
+    kind: fn(K) -> PostFigures,
+    warnings: Vec<String>,
+) -> Program {
+    Program {
+        files: vec![],
+        figures: figures.into_iter().map(|(id, k)| (id, kind(k))).collect(),
+        warnings,
+    }
+}
+
 impl Post for MarlinPost<'_> {
     fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
         held(self, path, job)
@@ -119,15 +133,11 @@ impl Post for Delta5Post<'_> {
         sink: &mut dyn ProgramSink,
     ) -> Result<Program, PostError> {
         let program = delta5_to(path, self.0, job.source, job.notes, sink)?;
-        Ok(Program {
-            files: vec![],
-            figures: program
-                .figures
-                .into_iter()
-                .map(|(id, k)| (id, PostFigures::Delta5(k)))
-                .collect(),
-            warnings: program.warnings,
-        })
+        Ok(measured(
+            program.figures,
+            PostFigures::Delta5,
+            program.warnings,
+        ))
     }
 }
 
@@ -138,27 +148,21 @@ pub struct KukaPost<'a>(pub &'a MachineProfile);
 
 impl Post for KukaPost<'_> {
     fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut program = kuka(path, self.0, job.stem, job.source)?;
-        // The main module (the first file) carries them.
-        if let Some((_, text)) = program.files.first_mut() {
-            insert_notes(text, job.notes);
-        }
-        Ok(Program {
-            files: program
-                .files
-                .into_iter()
-                .map(|(name, text)| ProgramFile {
-                    name,
-                    bytes: text.into_bytes(),
-                })
-                .collect(),
-            figures: program
-                .figures
-                .into_iter()
-                .map(|(id, k)| (id, PostFigures::Kuka(k)))
-                .collect(),
-            warnings: program.warnings,
-        })
+        held(self, path, job)
+    }
+
+    fn post_to(
+        &self,
+        path: &ToolPath,
+        job: &Job,
+        sink: &mut dyn ProgramSink,
+    ) -> Result<Program, PostError> {
+        let program = kuka_to(path, self.0, job.stem, job.source, job.notes, sink)?;
+        Ok(measured(
+            program.figures,
+            PostFigures::Kuka,
+            program.warnings,
+        ))
     }
 }
 

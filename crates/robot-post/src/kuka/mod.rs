@@ -77,6 +77,7 @@ pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 
 use crate::machine::MachineProfile;
+use crate::sink::{InMemory, ProgramSink, CHUNK};
 use crate::PostError;
 use checks::check;
 use krl_text::write_files;
@@ -117,6 +118,42 @@ pub fn kuka(
     program_name: &str,
     source: &str,
 ) -> Result<KrlProgram, PostError> {
+    let mut files = InMemory::default();
+    let mut program = kuka_to(path, m, program_name, source, &[], &mut files)?;
+    program.files = files
+        .files
+        .into_iter()
+        // The program is made of `str`s.
+        .map(|f| (f.name, String::from_utf8(f.bytes).unwrap_or_default()))
+        .collect();
+    Ok(program)
+}
+
+/// [`kuka`]'s program, with `notes` (comment lines after the one naming the source in the
+/// main `.src`, see [`crate::Job::notes`]), written into `sink` in the order of
+/// [`KrlProgram::files`], each `.src` as its lines are made, a megabyte at a time; the
+/// returned program holds no file. The files are opened once the motions are planned and
+/// checked; an error writing them is [`PostError::Write`].
+pub fn kuka_to(
+    path: &ToolPath,
+    m: &MachineProfile,
+    program_name: &str,
+    source: &str,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+) -> Result<KrlProgram, PostError> {
+    write_kuka(path, m, (program_name, source, notes), sink, CHUNK)
+}
+
+/// [`kuka_to`] (`job`: the program's name, the source and the notes), passing the text on
+/// whenever `chunk` bytes or more are held.
+fn write_kuka(
+    path: &ToolPath,
+    m: &MachineProfile,
+    job: (&str, &str, &[String]),
+    sink: &mut dyn ProgramSink,
+    chunk: usize,
+) -> Result<KrlProgram, PostError> {
     let cell = m.kuka_table()?;
     path.check_finite()?;
     let mut axes = Vec::with_capacity(path.points.len());
@@ -138,18 +175,19 @@ pub fn kuka(
     let base = cell.base.pose();
     let steps = plan_motion(path, &axes, offset, m, cell, &base);
     let checked = check(path, &steps, cell, &base, &mut warnings);
-    let files = write_files(
+    write_files(
         m,
         cell,
         &steps,
         &checked,
         offset,
-        program_name,
-        source,
+        job,
+        sink,
+        chunk,
         &mut warnings,
-    );
+    )?;
     Ok(KrlProgram {
-        files,
+        files: vec![],
         figures: checked.figures,
         warnings,
     })
