@@ -17,7 +17,7 @@ use crate::gcode::{comment_text, e_text, mergeable, push_line, Extrusion, Fan, L
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
-use crate::sink::{insert_notes, Chunked, InMemory, ProgramSink, CHUNK};
+use crate::sink::{insert_notes, Chunked, InMemory, ProgramSink};
 use crate::PostError;
 use toolpath::fixed;
 use toolpath::{MoveKind, PathPoint, ToolPath};
@@ -53,7 +53,7 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
 
 /// [`marlin`]'s program, with `notes` (comment lines after the one naming the source, see
 /// [`crate::Job::notes`]), written into `sink`'s `program.gcode` as it is made, a megabyte at
-/// a time. The file is opened once the path passed the checks [`marlin`] makes; an error
+/// a time ([`ProgramSink::chunk`]). The file is opened once the path passed the checks [`marlin`] makes; an error
 /// writing it is [`PostError::Write`].
 pub fn marlin_to(
     path: &ToolPath,
@@ -61,18 +61,6 @@ pub fn marlin_to(
     source: &str,
     notes: &[String],
     sink: &mut dyn ProgramSink,
-) -> Result<(), PostError> {
-    write_marlin(path, m, source, notes, sink, CHUNK)
-}
-
-/// [`marlin_to`], passing the text on whenever `chunk` bytes or more are held.
-fn write_marlin(
-    path: &ToolPath,
-    m: &MachineProfile,
-    source: &str,
-    notes: &[String],
-    sink: &mut dyn ProgramSink,
-    chunk: usize,
 ) -> Result<(), PostError> {
     m.check_for(MachineKind::Marlin)?;
     path.check_finite()?;
@@ -86,7 +74,7 @@ fn write_marlin(
         });
     }
     let offset = bed_offset(path, m)?;
-    let mut file = Chunked::open(sink, "program.gcode", chunk)?;
+    let mut file = Chunked::open(sink, "program.gcode")?;
 
     let mut w = Writer::new(m);
     w.header(m, source, offset);
@@ -412,8 +400,8 @@ mod tests {
             let texts: Vec<Vec<u8>> = [1, 100, usize::MAX]
                 .iter()
                 .map(|&chunk| {
-                    let mut files = InMemory::default();
-                    write_marlin(&path, &m, "part.step", &notes, &mut files, chunk).unwrap();
+                    let mut files = InMemory::chunked(chunk);
+                    marlin_to(&path, &m, "part.step", &notes, &mut files).unwrap();
                     assert_eq!(files.files.len(), 1);
                     files.files.remove(0).bytes
                 })

@@ -34,8 +34,9 @@ pub trait Post {
 
     /// [`Post::post`], its files written into `sink` (the returned program holds none of
     /// them, only the figures and warnings). A file is opened only once the path passed the
-    /// post's checks; the Marlin post writes its program as it makes it, the others theirs
-    /// whole once made.
+    /// post's checks. The built-in posts write their programs as they make them, a
+    /// [`ProgramSink::chunk`] of text at a time (a megabyte); this default writes
+    /// [`Post::post`]'s files whole.
     fn post_to(
         &self,
         path: &ToolPath,

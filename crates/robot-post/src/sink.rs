@@ -37,6 +37,13 @@ pub trait ProgramSink {
     /// once, in the order the program's files are written, and its writer dropped before the
     /// next is opened.
     fn file(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>>;
+
+    /// How much text (bytes) a post gathers before handing it on to a file's writer: it
+    /// writes this much or more at a time, and at most this much and what one path point
+    /// makes, [`CHUNK`] unless the sink says otherwise.
+    fn chunk(&self) -> usize {
+        CHUNK
+    }
 }
 
 /// A [`ProgramSink`] that keeps the files in memory, in the order written.
@@ -44,9 +51,26 @@ pub trait ProgramSink {
 pub struct InMemory {
     /// The files written.
     pub files: Vec<ProgramFile>,
+    /// The text a post gathers before handing it on, if not [`CHUNK`].
+    chunk: Option<usize>,
+}
+
+impl InMemory {
+    /// A sink in memory to which posts hand their text `bytes` or more at a time (at least
+    /// one byte), not [`CHUNK`]: the program is the same whatever the size.
+    pub fn chunked(bytes: usize) -> InMemory {
+        InMemory {
+            files: vec![],
+            chunk: Some(bytes.max(1)),
+        }
+    }
 }
 
 impl ProgramSink for InMemory {
+    fn chunk(&self) -> usize {
+        self.chunk.unwrap_or(CHUNK)
+    }
+
     fn file(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>> {
         self.files.push(ProgramFile {
             name: name.to_string(),
@@ -65,9 +89,10 @@ pub(crate) fn write_error(name: &str, e: &std::io::Error) -> PostError {
     }
 }
 
-/// Text of a program held before it is passed on to its file, bytes: a post holds about this
-/// much of its text (and one line more) whatever the length of the program.
-pub(crate) const CHUNK: usize = 1 << 20;
+/// Text of a program a post gathers before handing it on to its file, bytes (by default,
+/// [`ProgramSink::chunk`]): a post holds about this much of its text (and what one path point
+/// makes) whatever the length of the program.
+pub const CHUNK: usize = 1 << 20;
 
 /// Writes the file `name` whole into `sink`: `text`, made at once (a header file, a plot).
 pub(crate) fn write_file(
@@ -91,12 +116,13 @@ pub(crate) struct Chunked<'s> {
 }
 
 impl<'s> Chunked<'s> {
-    /// Opens the file `name` of `sink`, to be written `chunk` bytes or more at a time.
+    /// Opens the file `name` of `sink`, to be written [`ProgramSink::chunk`] bytes or more at
+    /// a time.
     pub(crate) fn open(
         sink: &'s mut dyn ProgramSink,
         name: &str,
-        chunk: usize,
     ) -> Result<Chunked<'s>, PostError> {
+        let chunk = sink.chunk();
         let file = sink.file(name).map_err(|e| write_error(name, &e))?;
         Ok(Chunked {
             name: name.to_string(),

@@ -76,7 +76,7 @@ pub use motion::MAX_SUBDIVISION;
 
 use crate::machine::MachineProfile;
 use crate::placement::table_offset;
-use crate::sink::{insert_notes, write_file, Chunked, InMemory, ProgramSink, CHUNK};
+use crate::sink::{insert_notes, write_file, Chunked, InMemory, ProgramSink};
 use crate::PostError;
 use figures::error_plot;
 use geometry::FIT_TOLERANCE;
@@ -144,7 +144,7 @@ pub fn delta5(
 
 /// [`delta5`]'s program, with `notes` (comment lines after the one naming the source, see
 /// [`crate::Job::notes`]), written into `sink`: `program.gcode` as it is made, a megabyte at a
-/// time, then `kinematic_error.svg`; the returned program holds neither
+/// time ([`ProgramSink::chunk`]), then `kinematic_error.svg`; the returned program holds neither
 /// ([`Delta5Program::gcode`] and [`Delta5Program::error_plot_svg`] are empty).
 ///
 /// The header gives the kinematic figures of every feature, known once every print segment
@@ -157,18 +157,6 @@ pub fn delta5_to(
     source: &str,
     notes: &[String],
     sink: &mut dyn ProgramSink,
-) -> Result<Delta5Program, PostError> {
-    write_delta5(path, m, source, notes, sink, CHUNK)
-}
-
-/// [`delta5_to`], passing the text on whenever `chunk` bytes or more are held.
-fn write_delta5(
-    path: &ToolPath,
-    m: &MachineProfile,
-    source: &str,
-    notes: &[String],
-    sink: &mut dyn ProgramSink,
-    chunk: usize,
 ) -> Result<Delta5Program, PostError> {
     let g = m.delta5_table()?;
     if g.z_min >= m.bed_size[2] {
@@ -235,7 +223,7 @@ fn write_delta5(
         })
         .collect();
 
-    let mut file = Chunked::open(sink, "program.gcode", chunk)?;
+    let mut file = Chunked::open(sink, "program.gcode")?;
     let mut text = Writer::new(m, g, offset, safe_z, w.replay());
     text.out = header(m, g, source, offset, safe_z, wanted_safe, &figures);
     insert_notes(&mut text.out, notes);

@@ -206,7 +206,7 @@ impl Steps<'_> {
     }
 
     /// Writes the lines of `steps` after `text` (what the file starts with) into the file
-    /// `name` of `sink` as they are made, `chunk` bytes or more at a time, then `end`.
+    /// `name` of `sink` as they are made ([`Chunked`]), then `end`.
     fn write(
         &mut self,
         steps: &[Step],
@@ -214,9 +214,8 @@ impl Steps<'_> {
         end: &str,
         sink: &mut dyn ProgramSink,
         name: &str,
-        chunk: usize,
     ) -> Result<(), PostError> {
-        let mut file = Chunked::open(sink, name, chunk)?;
+        let mut file = Chunked::open(sink, name)?;
         for step in steps {
             self.push(step, &mut text);
             file.pass_on(&mut text)?;
@@ -241,8 +240,7 @@ fn through_motion(steps: &[Step], n: usize) -> usize {
     steps.len()
 }
 
-/// The `.src` and `.dat` files, written into `sink` as their lines are made (`chunk` bytes or
-/// more at a time): `<name>.src` (with `notes` after the line naming the source) and
+/// The `.src` and `.dat` files, written into `sink` as their lines are made ([`Chunked`]): `<name>.src` (with `notes` after the line naming the source) and
 /// `<name>.dat`, then the parts' `.src` and `.dat` in order when the program is split.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_files(
@@ -253,7 +251,6 @@ pub(super) fn write_files(
     offset: [f64; 3],
     job: (&str, &str, &[String]),
     sink: &mut dyn ProgramSink,
-    chunk: usize,
     warnings: &mut Vec<String>,
 ) -> Result<(), PostError> {
     let (program_name, source, notes) = job;
@@ -360,7 +357,7 @@ pub(super) fn write_files(
     };
     let main_src = format!("{name}.src");
     if parts == 0 {
-        lines.write(steps, head, &tail, sink, &main_src, chunk)?;
+        lines.write(steps, head, &tail, sink, &main_src)?;
         write_file(sink, &format!("{name}.dat"), dat.as_bytes())?;
     } else {
         head.push_str(&tail);
@@ -391,7 +388,7 @@ pub(super) fn write_files(
             if let (Some(v), false) = (lines.vel, sets_vel) {
                 push_line(&mut text, &format!("$VEL.CP = {}", fixed(v, 4)));
             }
-            lines.write(part, text, "END\n", sink, &format!("{pname}.src"), chunk)?;
+            lines.write(part, text, "END\n", sink, &format!("{pname}.src"))?;
             let dat = join(&[
                 "&ACCESS RVP".into(),
                 "&REL 1".into(),

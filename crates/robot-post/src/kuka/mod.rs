@@ -77,7 +77,7 @@ pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 
 use crate::machine::MachineProfile;
-use crate::sink::{InMemory, ProgramSink, CHUNK};
+use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
 use checks::check;
 use krl_text::write_files;
@@ -131,7 +131,7 @@ pub fn kuka(
 
 /// [`kuka`]'s program, with `notes` (comment lines after the one naming the source in the
 /// main `.src`, see [`crate::Job::notes`]), written into `sink` in the order of
-/// [`KrlProgram::files`], each `.src` as its lines are made, a megabyte at a time; the
+/// [`KrlProgram::files`], each `.src` as its lines are made, a megabyte at a time ([`ProgramSink::chunk`]); the
 /// returned program holds no file. The files are opened once the motions are planned and
 /// checked; an error writing them is [`PostError::Write`].
 pub fn kuka_to(
@@ -141,18 +141,6 @@ pub fn kuka_to(
     source: &str,
     notes: &[String],
     sink: &mut dyn ProgramSink,
-) -> Result<KrlProgram, PostError> {
-    write_kuka(path, m, (program_name, source, notes), sink, CHUNK)
-}
-
-/// [`kuka_to`] (`job`: the program's name, the source and the notes), passing the text on
-/// whenever `chunk` bytes or more are held.
-fn write_kuka(
-    path: &ToolPath,
-    m: &MachineProfile,
-    job: (&str, &str, &[String]),
-    sink: &mut dyn ProgramSink,
-    chunk: usize,
 ) -> Result<KrlProgram, PostError> {
     let cell = m.kuka_table()?;
     path.check_finite()?;
@@ -181,9 +169,8 @@ fn write_kuka(
         &steps,
         &checked,
         offset,
-        job,
+        (program_name, source, notes),
         sink,
-        chunk,
         &mut warnings,
     )?;
     Ok(KrlProgram {
