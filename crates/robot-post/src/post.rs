@@ -4,7 +4,6 @@
 
 use std::collections::BTreeMap;
 
-use crate::sink::write_file;
 pub use crate::sink::{InMemory, ProgramFile, ProgramSink};
 
 use crate::delta5::{delta5_to, KinematicFigures};
@@ -29,25 +28,26 @@ pub struct Job<'a> {
 
 /// A post: writes a machine's program for a tool path.
 pub trait Post {
-    /// The program for `path`, or why it cannot be written.
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError>;
-
-    /// [`Post::post`], its files written into `sink` (the returned program holds none of
-    /// them, only the figures and warnings). A file is opened only once the path passed the
-    /// post's checks. The built-in posts write their programs as they make them, a
-    /// [`ProgramSink::chunk`] of text at a time (a megabyte); this default writes
-    /// [`Post::post`]'s files whole.
+    /// The program for `path`, its files written into `sink` (the returned program holds none
+    /// of them, only the figures and warnings), or why it cannot be written. A file is opened
+    /// only once the path passed the post's checks; the built-in posts write their programs
+    /// as they make them, a [`ProgramSink::chunk`] of text at a time (a megabyte).
     fn post_to(
         &self,
         path: &ToolPath,
         job: &Job,
         sink: &mut dyn ProgramSink,
-    ) -> Result<Program, PostError> {
-        let mut program = self.post(path, job)?;
-        for f in std::mem::take(&mut program.files) {
-            write_file(sink, &f.name, &f.bytes)?;
-        }
-        Ok(program)
+    ) -> Result<Program, PostError>;
+
+    /// The program for `path`, its files held in memory ([`Post::post_to`] into an
+    /// [`InMemory`] sink), or why it cannot be written.
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+        let mut files = InMemory::default();
+        let program = self.post_to(path, job, &mut files)?;
+        Ok(Program {
+            files: files.files,
+            ..program
+        })
     }
 }
 
@@ -76,17 +76,6 @@ pub enum PostFigures {
 #[derive(Debug, Clone, Copy)]
 pub struct MarlinPost<'a>(pub &'a MachineProfile);
 
-/// [`Post::post`] of a post that writes its files as it makes them: its
-/// [`Post::post_to`] into memory, the files put in the program.
-fn held(post: &dyn Post, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-    let mut files = InMemory::default();
-    let program = post.post_to(path, job, &mut files)?;
-    Ok(Program {
-        files: files.files,
-        ..program
-    })
-}
-
 /// A program holding no file: what a post measured, `figures` per feature (each made a
 /// [`PostFigures`] by `kind`), and its `warnings`.
 fn measured<K>(
@@ -102,10 +91,6 @@ fn measured<K>(
 }
 
 impl Post for MarlinPost<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        held(self, path, job)
-    }
-
     fn post_to(
         &self,
         path: &ToolPath,
@@ -123,10 +108,6 @@ impl Post for MarlinPost<'_> {
 pub struct Delta5Post<'a>(pub &'a MachineProfile);
 
 impl Post for Delta5Post<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        held(self, path, job)
-    }
-
     fn post_to(
         &self,
         path: &ToolPath,
@@ -148,10 +129,6 @@ impl Post for Delta5Post<'_> {
 pub struct KukaPost<'a>(pub &'a MachineProfile);
 
 impl Post for KukaPost<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        held(self, path, job)
-    }
-
     fn post_to(
         &self,
         path: &ToolPath,

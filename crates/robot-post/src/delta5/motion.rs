@@ -120,8 +120,17 @@ impl<'a> Writer<'a> {
         }
     }
 
+    /// Appends the line `s` (and its line break) to the text, unless measuring: that pass
+    /// drops its text.
     fn line(&mut self, s: &str) {
-        push_line(&mut self.out, s);
+        if !self.measuring() {
+            push_line(&mut self.out, s);
+        }
+    }
+
+    /// Whether this is the measuring pass, whose text is dropped.
+    fn measuring(&self) -> bool {
+        matches!(self.pass, Pass::Measure { .. })
     }
 
     /// The pass that writes what this one measured: the same splits of the print segments.
@@ -325,6 +334,7 @@ impl<'a> Writer<'a> {
             splits.push(moves.len() as u32);
         }
         let n = moves.len();
+        let measuring = self.measuring();
 
         // Planned deposition speed along the part.
         let bottom = match unit(q.axis) {
@@ -386,26 +396,30 @@ impl<'a> Writer<'a> {
             };
             self.extrusion.written(de);
             acc.figures.max_c_step_deg = acc.figures.max_c_step_deg.max((to[4] - from[4]).abs());
-            let e = if de == 0 {
-                String::new()
-            } else {
-                format!(" E{}", e_text(de))
-            };
-            lines.push(format!(
-                "G1 X{} Y{} Z{} B{} C{}{e} F{}",
-                fixed(to[0], 3),
-                fixed(to[1], 3),
-                fixed(to[2], 3),
-                fixed(to[3], 4),
-                fixed(to[4], 4),
-                fixed(f, 3)
-            ));
+            if !measuring {
+                let e = if de == 0 {
+                    String::new()
+                } else {
+                    format!(" E{}", e_text(de))
+                };
+                lines.push(format!(
+                    "G1 X{} Y{} Z{} B{} C{}{e} F{}",
+                    fixed(to[0], 3),
+                    fixed(to[1], 3),
+                    fixed(to[2], 3),
+                    fixed(to[3], 4),
+                    fixed(to[4], 4),
+                    fixed(f, 3)
+                ));
+            }
             written.push(to);
             from = to;
         }
         acc.figures.print_moves += written.len();
-        for (to, l) in written.iter().zip(&lines) {
+        for to in &written {
             self.check([to[0], to[1], to[2]])?;
+        }
+        for l in &lines {
             self.line(l);
         }
         if let Some(&last) = written.last() {
