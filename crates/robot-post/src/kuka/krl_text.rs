@@ -2,13 +2,14 @@
 //! names and frame aggregates.
 
 use super::cell::{ExtruderSwitch, KukaCell};
-use super::checks::Checked;
+use super::checks::{KukaFigures, Reach};
 use super::motion::Step;
 use crate::gcode::{comment_text, push_line};
 use crate::machine::MachineProfile;
 use crate::sink::{insert_notes, write_file, Chunked, ProgramSink};
 use crate::PostError;
-use toolpath::fixed;
+use std::collections::BTreeMap;
+use toolpath::{fixed, ToolPath};
 
 /// Longest KRL name (identifiers and module names).
 pub const KRL_NAME_MAX: usize = 24;
@@ -146,9 +147,9 @@ pub fn frame_text(f: &[f64; 6]) -> String {
 /// The program's lines, one per step ([`Steps::push`]), and what writing them finds.
 struct Steps<'a> {
     cell: &'a KukaCell,
-    checked: &'a Checked,
-    /// Motions written so far.
-    motions: usize,
+    path: &'a ToolPath,
+    /// The reach check of the motions, as they are written.
+    reach: Reach<'a>,
     /// The `$VEL.CP` in force.
     vel: Option<f64>,
     /// Print LINs whose feed ratio is beyond the analog output's full scale, and the largest
@@ -186,16 +187,15 @@ impl Steps<'_> {
                     fixed(v.clamp(0.0, 1.0), 5)
                 )
             }
-            Step::Move { ptp, .. } => {
-                let k = self.motions;
-                self.motions += 1;
-                let f = &self.checked.frames[k];
+            Step::Move { ptp, pose, point } => {
+                let feature = self.path.points[*point].feature;
+                let (f, note) = self.reach.motion(pose, *point, feature);
                 let mut line = if *ptp {
-                    format!("PTP {}", frame_text(f))
+                    format!("PTP {}", frame_text(&f))
                 } else {
-                    format!("LIN {} C_DIS", frame_text(f))
+                    format!("LIN {} C_DIS", frame_text(&f))
                 };
-                if let Some(note) = self.checked.notes[k] {
+                if let Some(note) = note {
                     line.push_str(" ; ");
                     line.push_str(note);
                 }
@@ -206,57 +206,55 @@ impl Steps<'_> {
     }
 
     /// Writes the lines of `steps` after `text` (what the file starts with) into the file
-    /// `name` of `sink` as they are made ([`Chunked`]), then `end`.
+    /// `name` of `sink` as they are made ([`Chunked`]), up to and including the step of its
+    /// `motions`th motion (all of them when `None`), then `end`.
     fn write(
         &mut self,
-        steps: &[Step],
+        steps: impl Iterator<Item = Step>,
+        motions: Option<usize>,
         mut text: String,
         end: &str,
         sink: &mut dyn ProgramSink,
         name: &str,
     ) -> Result<(), PostError> {
         let mut file = Chunked::open(sink, name)?;
+        let mut seen = 0;
         for step in steps {
-            self.push(step, &mut text);
+            self.push(&step, &mut text);
             file.pass_on(&mut text)?;
+            if matches!(step, Step::Move { .. }) {
+                seen += 1;
+                if Some(seen) == motions {
+                    break;
+                }
+            }
         }
         text.push_str(end);
         file.finish(&text)
     }
 }
 
-/// The number of steps from the start of `steps` up to and including its `n`th motion (all
-/// of them when it has fewer).
-fn through_motion(steps: &[Step], n: usize) -> usize {
-    let mut seen = 0;
-    for (i, s) in steps.iter().enumerate() {
-        if matches!(s, Step::Move { .. }) {
-            seen += 1;
-            if seen == n {
-                return i + 1;
-            }
-        }
-    }
-    steps.len()
-}
-
-/// The `.src` and `.dat` files, written into `sink` as their lines are made ([`Chunked`]): `<name>.src` (with `notes` after the line naming the source) and
-/// `<name>.dat`, then the parts' `.src` and `.dat` in order when the program is split.
+/// The `.src` and `.dat` files of the program of `steps` (`moves` motions, each checked as its
+/// line is written: [`Reach`]), written into `sink` as their lines are made ([`Chunked`]):
+/// `<name>.src` (with `notes` after the line naming the source) and `<name>.dat`, then the
+/// parts' `.src` and `.dat` in order when the program is split. Returns the figures of the
+/// check, its warnings pushed onto `warnings`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_files(
     m: &MachineProfile,
-    cell: &KukaCell,
-    steps: &[Step],
-    checked: &Checked,
+    path: &ToolPath,
+    steps: impl Iterator<Item = Step>,
+    moves: usize,
+    reach: Reach,
     offset: [f64; 3],
     job: (&str, &str, &[String]),
     sink: &mut dyn ProgramSink,
     warnings: &mut Vec<String>,
-) -> Result<(), PostError> {
+) -> Result<BTreeMap<usize, KukaFigures>, PostError> {
     let (program_name, source, notes) = job;
+    let cell = reach.cell;
     let out = cell.extruder_output;
     let feed_out = cell.feed_output;
-    let moves = checked.frames.len();
     let per = cell.max_moves_per_file.max(1);
     let parts = if moves > per { moves.div_ceil(per) } else { 0 };
     let digits = parts.to_string().len().max(3);
@@ -350,28 +348,21 @@ pub(super) fn write_files(
     ]);
     let mut lines = Steps {
         cell,
-        checked,
-        motions: 0,
+        path,
+        reach,
         vel: None,
         beyond: (0, 0.0),
     };
     let main_src = format!("{name}.src");
+    let mut steps = steps;
     if parts == 0 {
-        lines.write(steps, head, &tail, sink, &main_src)?;
+        lines.write(steps, None, head, &tail, sink, &main_src)?;
         write_file(sink, &format!("{name}.dat"), dat.as_bytes())?;
     } else {
         head.push_str(&tail);
         write_file(sink, &main_src, head.as_bytes())?;
         write_file(sink, &format!("{name}.dat"), dat.as_bytes())?;
-        let mut rest = steps;
         for i in 0..parts {
-            // The last part takes the steps after the last motion too.
-            let end = if i + 1 == parts {
-                rest.len()
-            } else {
-                through_motion(rest, per)
-            };
-            let (part, after) = rest.split_at(end);
             let pname = part_name(i);
             let mut text = join(&[
                 "&ACCESS RVP".into(),
@@ -383,12 +374,22 @@ pub(super) fn write_files(
                 ),
             ]);
             // The speed in force, unless the part's first motion sets its own.
-            let first = &part[..through_motion(part, 1)];
+            let mut first = Vec::new();
+            for step in steps.by_ref() {
+                let motion = matches!(step, Step::Move { .. });
+                first.push(step);
+                if motion {
+                    break;
+                }
+            }
             let sets_vel = first.iter().any(|s| matches!(s, Step::Vel(_)));
             if let (Some(v), false) = (lines.vel, sets_vel) {
                 push_line(&mut text, &format!("$VEL.CP = {}", fixed(v, 4)));
             }
-            lines.write(part, text, "END\n", sink, &format!("{pname}.src"))?;
+            // The last part takes the steps after the last motion too.
+            let motions = (i + 1 < parts).then_some(per);
+            let part = first.into_iter().chain(steps.by_ref());
+            lines.write(part, motions, text, "END\n", sink, &format!("{pname}.src"))?;
             let dat = join(&[
                 "&ACCESS RVP".into(),
                 "&REL 1".into(),
@@ -397,7 +398,6 @@ pub(super) fn write_files(
                 "ENDDAT".into(),
             ]);
             write_file(sink, &format!("{pname}.dat"), dat.as_bytes())?;
-            rest = after;
         }
     }
     let (beyond, most) = lines.beyond;
@@ -408,7 +408,7 @@ pub(super) fn write_files(
             fixed(most, 5)
         ));
     }
-    Ok(())
+    Ok(lines.reach.finish(path, warnings))
 }
 
 /// Lines joined with `\n`, ending with one.

@@ -79,9 +79,9 @@ pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, P
 use crate::machine::MachineProfile;
 use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
-use checks::check;
+use checks::Reach;
 use krl_text::write_files;
-use motion::{placement, plan_motion};
+use motion::{placement, Planner, Step};
 use toolpath::vec3::{norm, scale};
 use toolpath::ToolPath;
 
@@ -161,13 +161,16 @@ pub fn kuka_to(
     let mut warnings = Vec::new();
     let offset = placement(path, m, &mut warnings)?;
     let base = cell.base.pose();
-    let steps = plan_motion(path, &axes, offset, m, cell, &base);
-    let checked = check(path, &steps, cell, &base, &mut warnings);
-    write_files(
+    // The header counts the motions: a first run of the planner counts them, the second
+    // plans them again as they are checked and written.
+    let planner = || Planner::new(path, &axes, offset, m, cell, &base);
+    let moves = planner().filter(|s| matches!(s, Step::Move { .. })).count();
+    let figures = write_files(
         m,
-        cell,
-        &steps,
-        &checked,
+        path,
+        planner(),
+        moves,
+        Reach::new(path, cell, &base),
         offset,
         (program_name, source, notes),
         sink,
@@ -175,7 +178,7 @@ pub fn kuka_to(
     )?;
     Ok(KrlProgram {
         files: vec![],
-        figures: checked.figures,
+        figures,
         warnings,
     })
 }
