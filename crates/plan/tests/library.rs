@@ -3,7 +3,8 @@
 //! points in the file-wide numbering (several solids included), and the material is conserved.
 
 use plan::{plan, Options, Process};
-use robot_post::{MachineKind, MachineProfile, MoveKind};
+use robot_post::sink::CHUNK;
+use robot_post::{InMemory, Job, MachineKind, MachineProfile, MoveKind, ProgramSink};
 use std::path::Path;
 
 fn fixture(name: &str) -> brep::StepPart {
@@ -115,9 +116,10 @@ fn a_plan_written_into_a_sink_is_the_plan_held() {
             Err(std::io::Error::other(format!("no room for {name}")))
         }
     }
-    for (name, machine) in [
-        ("plate_boss_boss.step", MachineKind::Marlin),
-        ("sphere_boss.step", MachineKind::Delta5),
+    for (name, machine, first) in [
+        ("plate_boss_boss.step", MachineKind::Marlin, "program.gcode"),
+        ("sphere_boss.step", MachineKind::Delta5, "program.gcode"),
+        ("sphere_boss.step", MachineKind::Kuka, "part.src"),
     ] {
         let held = planned(name, machine);
         let options = Options {
@@ -182,10 +184,121 @@ fn a_plan_written_into_a_sink_is_the_plan_held() {
             None,
         ) {
             Err(e) => assert!(
-                e.to_string().contains("cannot write program.gcode"),
+                e.to_string().contains(&format!("cannot write {first}")),
                 "{name}: {e}"
             ),
             Ok(_) => panic!("{name}: planned into a sink that cannot write"),
         }
     }
+}
+
+/// The program of a planned part posted into memory whole ([`Post::post`]) and streamed into
+/// sinks that take the text 1 byte, 7 bytes and 4 kB or more at a time: the same files, byte
+/// for byte (a post's look back at its text, and the KRL parts' boundaries, survive the cuts).
+fn same_in_pieces_of_any_size(plan: &plan::Plan, m: &MachineProfile) {
+    let notes = vec!["a note".to_string()];
+    let job = Job {
+        source: "part.step",
+        stem: "part",
+        notes: &notes,
+    };
+    let whole = m.post().post(&plan.toolpath, &job).expect("posted");
+    assert!(!whole.files.is_empty());
+    for chunk in [1, 7, 4096] {
+        let mut sink = InMemory::chunked(chunk);
+        let streamed = m
+            .post()
+            .post_to(&plan.toolpath, &job, &mut sink)
+            .expect("posted");
+        assert!(streamed.files.is_empty(), "{chunk}");
+        assert_eq!(sink.files, whole.files, "{chunk}");
+        assert_eq!(streamed.figures, whole.figures, "{chunk}");
+        assert_eq!(streamed.warnings, whole.warnings, "{chunk}");
+    }
+}
+
+/// A sink that keeps nothing: per file, the bytes written, the largest single write and the
+/// number of writes.
+#[derive(Default)]
+struct Counting {
+    files: Vec<(String, Count)>,
+}
+
+#[derive(Default, Clone, Copy)]
+struct Count {
+    bytes: usize,
+    largest: usize,
+    writes: usize,
+}
+
+impl std::io::Write for &mut Count {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.bytes += buf.len();
+        self.largest = self.largest.max(buf.len());
+        self.writes += 1;
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl ProgramSink for Counting {
+    fn file(&mut self, name: &str) -> std::io::Result<Box<dyn std::io::Write + '_>> {
+        self.files.push((name.to_string(), Count::default()));
+        let last = self.files.len() - 1;
+        Ok(Box::new(&mut self.files[last].1))
+    }
+}
+
+/// What a post holds of its text is bounded: streaming `file`, a program of many megabytes,
+/// it hands on about a megabyte at a time ([`CHUNK`]), never more than that and what one path
+/// point makes (a print segment split into up to 1,024 moves: under 64 kB).
+fn held_text_is_bounded(plan: &plan::Plan, m: &MachineProfile, file: &str) {
+    let job = Job {
+        source: "part.step",
+        stem: "part",
+        notes: &[],
+    };
+    let mut sink = Counting::default();
+    m.post()
+        .post_to(&plan.toolpath, &job, &mut sink)
+        .expect("posted");
+    let (_, count) = sink
+        .files
+        .iter()
+        .find(|(name, _)| name == file)
+        .unwrap_or_else(|| panic!("no {file}"));
+    assert!(count.bytes > 4 * CHUNK, "{file}: {} bytes", count.bytes);
+    assert!(
+        count.largest >= CHUNK && count.largest < CHUNK + 64 * 1024,
+        "{file}: a write of {} bytes",
+        count.largest
+    );
+    assert!(count.writes > count.bytes / (CHUNK + 64 * 1024), "{file}");
+}
+
+/// The delta5 post streams the impeller's program (about 9 MB): the same in pieces of any
+/// size, a megabyte held at a time.
+#[test]
+fn the_delta5_program_is_streamed() {
+    let p = planned("impeller.step", MachineKind::Delta5);
+    let m = MachineProfile::builtin(MachineKind::Delta5);
+    same_in_pieces_of_any_size(&p, &m);
+    held_text_is_bounded(&p, &m, "program.gcode");
+}
+
+/// The KUKA post streams sphere_boss's KRL files: the same in pieces of any size, split into
+/// parts (41 of them) or not, and a megabyte held at a time of a main program of about 15 MB.
+#[test]
+fn the_krl_program_is_streamed() {
+    let p = planned("sphere_boss.step", MachineKind::Kuka);
+    let mut m = MachineProfile::builtin(MachineKind::Kuka);
+    same_in_pieces_of_any_size(&p, &m);
+    if let Some(cell) = m.kuka.as_mut() {
+        cell.max_moves_per_file = 1_000_000;
+    }
+    same_in_pieces_of_any_size(&p, &m);
+    held_text_is_bounded(&p, &m, "part.src");
 }

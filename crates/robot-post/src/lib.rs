@@ -30,9 +30,9 @@ pub mod post;
 pub mod sink;
 pub use toolpath;
 
-pub use delta5::{delta5, Delta5Geometry, Delta5Program, KinematicFigures};
+pub use delta5::{delta5, delta5_to, Delta5Geometry, Delta5Program, KinematicFigures};
 pub use error::PostError;
-pub use kuka::{kuka, KrlProgram, KukaCell, KukaFigures};
+pub use kuka::{kuka, kuka_to, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
 pub use marlin::{marlin, marlin_to};
 pub use post::{Job, Post, PostFigures, Program};

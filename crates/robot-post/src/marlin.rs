@@ -19,9 +19,8 @@ use crate::gcode::{
 use crate::kind::MachineKind;
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
-use crate::sink::{insert_notes, write_error, InMemory, ProgramSink};
+use crate::sink::{insert_notes, Chunked, InMemory, ProgramSink};
 use crate::PostError;
-use std::io::Write as _;
 use toolpath::{fixed, push_fixed};
 use toolpath::{MoveKind, PathPoint, ToolPath};
 
@@ -54,12 +53,9 @@ pub fn marlin(path: &ToolPath, m: &MachineProfile, source: &str) -> Result<Strin
     Ok(String::from_utf8(bytes).unwrap_or_default())
 }
 
-/// Text of the program held before it is passed on to the file, bytes.
-const CHUNK: usize = 1 << 20;
-
 /// [`marlin`]'s program, with `notes` (comment lines after the one naming the source, see
 /// [`crate::Job::notes`]), written into `sink`'s `program.gcode` as it is made, a megabyte at
-/// a time. The file is opened once the path passed the checks [`marlin`] makes; an error
+/// a time ([`ProgramSink::chunk`]). The file is opened once the path passed the checks [`marlin`] makes; an error
 /// writing it is [`PostError::Write`].
 pub fn marlin_to(
     path: &ToolPath,
@@ -67,18 +63,6 @@ pub fn marlin_to(
     source: &str,
     notes: &[String],
     sink: &mut dyn ProgramSink,
-) -> Result<(), PostError> {
-    write_marlin(path, m, source, notes, sink, CHUNK)
-}
-
-/// [`marlin_to`], passing the text on whenever `chunk` bytes or more are held.
-fn write_marlin(
-    path: &ToolPath,
-    m: &MachineProfile,
-    source: &str,
-    notes: &[String],
-    sink: &mut dyn ProgramSink,
-    chunk: usize,
 ) -> Result<(), PostError> {
     m.check_for(MachineKind::Marlin)?;
     path.check_finite()?;
@@ -92,9 +76,7 @@ fn write_marlin(
         });
     }
     let offset = bed_offset(path, m)?;
-    const NAME: &str = "program.gcode";
-    let failed = |e: std::io::Error| write_error(NAME, &e);
-    let mut file = sink.file(NAME).map_err(failed)?;
+    let mut file = Chunked::open(sink, "program.gcode")?;
 
     let mut w = Writer::new(m);
     w.header(m, source, offset);
@@ -112,16 +94,10 @@ fn write_marlin(
                 w.print(t, q);
             }
         }
-        if w.out.len() >= chunk {
-            // All but the last character, which the writer may look back at.
-            let keep = w.out.char_indices().next_back().map_or(0, |(i, _)| i);
-            file.write_all(&w.out.as_bytes()[..keep]).map_err(failed)?;
-            w.out.drain(..keep);
-        }
+        file.pass_on(&mut w.out)?;
     }
     w.footer(m);
-    file.write_all(w.out.as_bytes()).map_err(failed)?;
-    file.flush().map_err(failed)
+    file.finish(&w.out)
 }
 
 /// Whether `axis` is +Z within [`AXIS_TOLERANCE`].
@@ -431,8 +407,8 @@ mod tests {
             let texts: Vec<Vec<u8>> = [1, 100, usize::MAX]
                 .iter()
                 .map(|&chunk| {
-                    let mut files = InMemory::default();
-                    write_marlin(&path, &m, "part.step", &notes, &mut files, chunk).unwrap();
+                    let mut files = InMemory::chunked(chunk);
+                    marlin_to(&path, &m, "part.step", &notes, &mut files).unwrap();
                     assert_eq!(files.files.len(), 1);
                     files.files.remove(0).bytes
                 })

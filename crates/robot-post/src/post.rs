@@ -3,14 +3,12 @@
 //! feature, warnings) for a tool path, so a caller never matches on machine kinds.
 
 use std::collections::BTreeMap;
-use std::io::Write;
 
-use crate::sink::{insert_notes, write_error};
 pub use crate::sink::{InMemory, ProgramFile, ProgramSink};
 
-use crate::delta5::{delta5, KinematicFigures};
+use crate::delta5::{delta5_to, KinematicFigures};
 use crate::kind::MachineKind;
-use crate::kuka::{kuka, KukaFigures};
+use crate::kuka::{kuka_to, KukaFigures};
 use crate::machine::MachineProfile;
 use crate::marlin::marlin_to;
 use crate::PostError;
@@ -30,28 +28,26 @@ pub struct Job<'a> {
 
 /// A post: writes a machine's program for a tool path.
 pub trait Post {
-    /// The program for `path`, or why it cannot be written.
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError>;
-
-    /// [`Post::post`], its files written into `sink` (the returned program holds none of
-    /// them, only the figures and warnings). A file is opened only once the path passed the
-    /// post's checks; the Marlin post writes its program as it makes it, the others theirs
-    /// whole once made.
+    /// The program for `path`, its files written into `sink` (the returned program holds none
+    /// of them, only the figures and warnings), or why it cannot be written. A file is opened
+    /// only once the path passed the post's checks; the built-in posts write their programs
+    /// as they make them, a [`ProgramSink::chunk`] of text at a time (a megabyte).
     fn post_to(
         &self,
         path: &ToolPath,
         job: &Job,
         sink: &mut dyn ProgramSink,
-    ) -> Result<Program, PostError> {
-        let mut program = self.post(path, job)?;
-        for f in std::mem::take(&mut program.files) {
-            let wrote = sink.file(&f.name).and_then(|mut w| {
-                w.write_all(&f.bytes)?;
-                w.flush()
-            });
-            wrote.map_err(|e| write_error(&f.name, &e))?;
-        }
-        Ok(program)
+    ) -> Result<Program, PostError>;
+
+    /// The program for `path`, its files held in memory ([`Post::post_to`] into an
+    /// [`InMemory`] sink), or why it cannot be written.
+    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
+        let mut files = InMemory::default();
+        let program = self.post_to(path, job, &mut files)?;
+        Ok(Program {
+            files: files.files,
+            ..program
+        })
     }
 }
 
@@ -80,16 +76,21 @@ pub enum PostFigures {
 #[derive(Debug, Clone, Copy)]
 pub struct MarlinPost<'a>(pub &'a MachineProfile);
 
-impl Post for MarlinPost<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut files = InMemory::default();
-        self.post_to(path, job, &mut files)?;
-        Ok(Program {
-            files: files.files,
-            ..Program::default()
-        })
+/// A program holding no file: what a post measured, `figures` per feature (each made a
+/// [`PostFigures`] by `kind`), and its `warnings`.
+fn measured<K>(
+    figures: BTreeMap<usize, K>,
+    kind: fn(K) -> PostFigures,
+    warnings: Vec<String>,
+) -> Program {
+    Program {
+        files: vec![],
+        figures: figures.into_iter().map(|(id, k)| (id, kind(k))).collect(),
+        warnings,
     }
+}
 
+impl Post for MarlinPost<'_> {
     fn post_to(
         &self,
         path: &ToolPath,
@@ -107,21 +108,18 @@ impl Post for MarlinPost<'_> {
 pub struct Delta5Post<'a>(pub &'a MachineProfile);
 
 impl Post for Delta5Post<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut program = delta5(path, self.0, job.source)?;
-        insert_notes(&mut program.gcode, job.notes);
-        Ok(Program {
-            files: vec![
-                ProgramFile::text("program.gcode", program.gcode),
-                ProgramFile::text("kinematic_error.svg", program.error_plot_svg),
-            ],
-            figures: program
-                .figures
-                .into_iter()
-                .map(|(id, k)| (id, PostFigures::Delta5(k)))
-                .collect(),
-            warnings: program.warnings,
-        })
+    fn post_to(
+        &self,
+        path: &ToolPath,
+        job: &Job,
+        sink: &mut dyn ProgramSink,
+    ) -> Result<Program, PostError> {
+        let program = delta5_to(path, self.0, job.source, job.notes, sink)?;
+        Ok(measured(
+            program.figures,
+            PostFigures::Delta5,
+            program.warnings,
+        ))
     }
 }
 
@@ -131,28 +129,18 @@ impl Post for Delta5Post<'_> {
 pub struct KukaPost<'a>(pub &'a MachineProfile);
 
 impl Post for KukaPost<'_> {
-    fn post(&self, path: &ToolPath, job: &Job) -> Result<Program, PostError> {
-        let mut program = kuka(path, self.0, job.stem, job.source)?;
-        // The main module (the first file) carries them.
-        if let Some((_, text)) = program.files.first_mut() {
-            insert_notes(text, job.notes);
-        }
-        Ok(Program {
-            files: program
-                .files
-                .into_iter()
-                .map(|(name, text)| ProgramFile {
-                    name,
-                    bytes: text.into_bytes(),
-                })
-                .collect(),
-            figures: program
-                .figures
-                .into_iter()
-                .map(|(id, k)| (id, PostFigures::Kuka(k)))
-                .collect(),
-            warnings: program.warnings,
-        })
+    fn post_to(
+        &self,
+        path: &ToolPath,
+        job: &Job,
+        sink: &mut dyn ProgramSink,
+    ) -> Result<Program, PostError> {
+        let program = kuka_to(path, self.0, job.stem, job.source, job.notes, sink)?;
+        Ok(measured(
+            program.figures,
+            PostFigures::Kuka,
+            program.warnings,
+        ))
     }
 }
 

@@ -76,11 +76,12 @@ pub use motion::MAX_SUBDIVISION;
 
 use crate::machine::MachineProfile;
 use crate::placement::table_offset;
+use crate::sink::{insert_notes, write_file, Chunked, InMemory, ProgramSink};
 use crate::PostError;
 use figures::error_plot;
 use geometry::FIT_TOLERANCE;
-use kinematics::plan_poses;
-use motion::Writer;
+use kinematics::{plan_poses, Pose};
+use motion::{Pass, Writer};
 use text::header;
 use toolpath::vec3::norm;
 use toolpath::{fixed, MoveKind, ToolPath};
@@ -129,6 +130,34 @@ pub fn delta5(
     m: &MachineProfile,
     source: &str,
 ) -> Result<Delta5Program, PostError> {
+    let mut files = InMemory::default();
+    let mut program = delta5_to(path, m, source, &[], &mut files)?;
+    let mut texts = files
+        .files
+        .into_iter()
+        // The program is made of `str`s.
+        .map(|f| String::from_utf8(f.bytes).unwrap_or_default());
+    program.gcode = texts.next().unwrap_or_default();
+    program.error_plot_svg = texts.next().unwrap_or_default();
+    Ok(program)
+}
+
+/// [`delta5`]'s program, with `notes` (comment lines after the one naming the source, see
+/// [`crate::Job::notes`]), written into `sink`: `program.gcode` as it is made, a megabyte at a
+/// time ([`ProgramSink::chunk`]), then `kinematic_error.svg`; the returned program holds neither
+/// ([`Delta5Program::gcode`] and [`Delta5Program::error_plot_svg`] are empty).
+///
+/// The header gives the kinematic figures of every feature, known once every print segment
+/// is split: a first run over the path splits them (measuring the error) and records how,
+/// the second writes the moves split as recorded. The files are opened once the path passed
+/// every check [`delta5`] makes; an error writing them is [`PostError::Write`].
+pub fn delta5_to(
+    path: &ToolPath,
+    m: &MachineProfile,
+    source: &str,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+) -> Result<Delta5Program, PostError> {
     let g = m.delta5_table()?;
     if g.z_min >= m.bed_size[2] {
         return Err(PostError::ProfileValue {
@@ -173,9 +202,66 @@ pub fn delta5(
     let wanted_safe = g.b_axis_z + swing + m.z_hop + g.reorient_clearance;
     let safe_z = wanted_safe.min(m.bed_size[2]);
 
-    let mut w = Writer::new(m, g, offset, safe_z);
-    // About 45 bytes a point: the program is not grown by doubling (a copy of it at each step).
-    w.out.reserve(48 * path.points.len());
+    // First the figures the header gives, then the text, as it is made.
+    let mut w = Writer::new(m, g, offset, safe_z, Pass::Measure { splits: Vec::new() });
+    walk(&mut w, path, &poses, g, |out| {
+        out.clear();
+        Ok(())
+    })?;
+    w.footer()?;
+    let figures: BTreeMap<usize, KinematicFigures> = w
+        .figures
+        .iter()
+        .map(|(&f, a)| {
+            let mut k = a.figures.clone();
+            k.mean_mm = if k.samples > 0 {
+                a.sum / k.samples as f64
+            } else {
+                0.0
+            };
+            (f, k)
+        })
+        .collect();
+
+    let mut file = Chunked::open(sink, "program.gcode")?;
+    let mut text = Writer::new(m, g, offset, safe_z, w.replay());
+    text.out = header(m, g, source, offset, safe_z, wanted_safe, &figures);
+    insert_notes(&mut text.out, notes);
+    walk(&mut text, path, &poses, g, |out| file.pass_on(out))?;
+    text.footer()?;
+    file.finish(&text.out)?;
+    drop(text);
+
+    let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
+    write_file(sink, "kinematic_error.svg", error_plot_svg.as_bytes())?;
+    let mut warnings = Vec::new();
+    if w.clamped.0 > 0 {
+        warnings.push(format!(
+            "{} print move(s) asked for a feed above max_feed_mm_min {} mm/min (up to F{}) and were slowed to it: the nozzle moves over the part slower than print_speed there",
+            w.clamped.0,
+            fixed(m.max_feed_mm_min(), 0),
+            fixed(w.clamped.1, 0)
+        ));
+    }
+    Ok(Delta5Program {
+        gcode: String::new(),
+        figures,
+        error_plot_svg: String::new(),
+        warnings,
+        offset,
+        safe_z,
+    })
+}
+
+/// Writes the moves of the path: every point in the path's order, through `w`; `pass_on` is
+/// handed the text made after each point (and may take it).
+fn walk(
+    w: &mut Writer,
+    path: &ToolPath,
+    poses: &[Pose],
+    g: &Delta5Geometry,
+    mut pass_on: impl FnMut(&mut String) -> Result<(), PostError>,
+) -> Result<(), PostError> {
     let mut previous: Option<usize> = None;
     // Points up to here were passed by a travel lifted to the safe height.
     let mut passed = 0;
@@ -198,6 +284,7 @@ pub fn delta5(
                     w.travel(&path.points[end - 1], &poses[end - 1], true)?;
                     passed = end;
                     previous = Some(end - 1);
+                    pass_on(&mut w.out)?;
                     continue;
                 }
                 w.comments(q);
@@ -216,40 +303,7 @@ pub fn delta5(
             }
         }
         previous = Some(i);
+        pass_on(&mut w.out)?;
     }
-    w.footer()?;
-
-    let figures: BTreeMap<usize, KinematicFigures> = w
-        .figures
-        .iter()
-        .map(|(&f, a)| {
-            let mut k = a.figures.clone();
-            k.mean_mm = if k.samples > 0 {
-                a.sum / k.samples as f64
-            } else {
-                0.0
-            };
-            (f, k)
-        })
-        .collect();
-    let mut gcode = header(m, g, source, offset, safe_z, wanted_safe, &figures);
-    gcode.push_str(&w.out);
-    let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
-    let mut warnings = Vec::new();
-    if w.clamped.0 > 0 {
-        warnings.push(format!(
-            "{} print move(s) asked for a feed above max_feed_mm_min {} mm/min (up to F{}) and were slowed to it: the nozzle moves over the part slower than print_speed there",
-            w.clamped.0,
-            fixed(m.max_feed_mm_min(), 0),
-            fixed(w.clamped.1, 0)
-        ));
-    }
-    Ok(Delta5Program {
-        gcode,
-        figures,
-        error_plot_svg,
-        warnings,
-        offset,
-        safe_z,
-    })
+    Ok(())
 }

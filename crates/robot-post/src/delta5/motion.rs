@@ -27,6 +27,10 @@ fn rounded(xyz: [f64; 3], b: f64, c: f64) -> Joints {
     [r3(xyz[0]), r3(xyz[1]), r3(xyz[2]), r4(b), r4(c)]
 }
 
+/// The kinematic error of one move ([`Writer::move_error`]): the largest distance, the sum of
+/// the distances and the number of steps.
+type MoveError = (f64, f64, usize);
+
 /// Running kinematic figures of one feature.
 #[derive(Default)]
 pub(super) struct Accumulator {
@@ -34,9 +38,22 @@ pub(super) struct Accumulator {
     pub(super) sum: f64,
 }
 
+/// What a run of the [`Writer`] over the path is for: the program is made in two, so that its
+/// header can give the kinematic figures while its moves are passed on as they are made.
+pub(super) enum Pass {
+    /// The first: each print segment split until its kinematic error meets the goal (the
+    /// figures, plot and warnings are this run's), the number of its sub-moves recorded in
+    /// `splits`, in order; the text is made and dropped.
+    Measure { splits: Vec<u32> },
+    /// The second: each print segment split as recorded, its error not measured again; the
+    /// text is written (the figures this run gathers are not used).
+    Write { splits: std::vec::IntoIter<u32> },
+}
+
 /// The program being written and the machine state it leaves.
 pub(super) struct Writer<'a> {
     pub(super) out: String,
+    pass: Pass,
     m: &'a MachineProfile,
     g: &'a Delta5Geometry,
     offset: [f64; 3],
@@ -70,6 +87,7 @@ impl<'a> Writer<'a> {
         g: &'a Delta5Geometry,
         offset: [f64; 3],
         safe_z: f64,
+        pass: Pass,
     ) -> Writer<'a> {
         let (x0, y0) = if m.bed_origin_centre {
             (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
@@ -78,6 +96,7 @@ impl<'a> Writer<'a> {
         };
         Writer {
             out: String::new(),
+            pass,
             m,
             g,
             offset,
@@ -101,8 +120,28 @@ impl<'a> Writer<'a> {
         }
     }
 
+    /// Appends the line `s` (and its line break) to the text, unless measuring: that pass
+    /// drops its text.
     fn line(&mut self, s: &str) {
-        push_line(&mut self.out, s);
+        if !self.measuring() {
+            push_line(&mut self.out, s);
+        }
+    }
+
+    /// Whether this is the measuring pass, whose text is dropped.
+    fn measuring(&self) -> bool {
+        matches!(self.pass, Pass::Measure { .. })
+    }
+
+    /// The pass that writes what this one measured: the same splits of the print segments.
+    pub(super) fn replay(&mut self) -> Pass {
+        let splits = match &mut self.pass {
+            Pass::Measure { splits } => std::mem::take(splits),
+            Pass::Write { .. } => Vec::new(),
+        };
+        Pass::Write {
+            splits: splits.into_iter(),
+        }
     }
 
     /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
@@ -281,38 +320,21 @@ impl<'a> Writer<'a> {
             self.line(&line);
             self.retracted = false;
         }
-        let g = self.g;
-        let dc = (pq.c - pa.c).abs();
-        let mut n = ((dc / g.max_c_step_deg - 1e-9).ceil().max(1.0) as usize).min(MAX_SUBDIVISION);
         let length = norm(sub(q.p, a.p));
-        let (moves, errors) = loop {
-            let moves: Vec<Joints> = (1..=n)
-                .map(|k| {
-                    if k == n {
-                        self.joints(q.p, pq.b, pq.c)
-                    } else {
-                        let f = k as f64 / n as f64;
-                        let b = pa.b + (pq.b - pa.b) * f;
-                        let c = pa.c + (pq.c - pa.c) * f;
-                        self.joints(lerp(a.p, q.p, f), b, c)
-                    }
-                })
-                .collect();
-            let mut from = start;
-            let mut errors = Vec::with_capacity(n);
-            for &to in &moves {
-                errors.push(self.move_error(from, to, a.p, q.p));
-                from = to;
-            }
-            let worst = errors.iter().map(|e| e.0).fold(0.0, f64::max);
-            if worst <= g.kinematic_error_goal || n >= MAX_SUBDIVISION || length / (n as f64) < 1e-3
-            {
-                break (moves, errors);
-            }
-            // The error of a turning move shrinks with the square of its length.
-            let grow = (n as f64 * (worst / g.kinematic_error_goal).sqrt() * 1.1).ceil() as usize;
-            n = grow.max(n + 1).min(MAX_SUBDIVISION);
+        let replayed = match &mut self.pass {
+            Pass::Write { splits } => splits.next(),
+            Pass::Measure { .. } => None,
         };
+        let (moves, errors) = match replayed {
+            Some(n) => (self.sub_moves(a, pa, q, pq, n as usize), Vec::new()),
+            None => self.subdivide(start, a, pa, q, pq, length),
+        };
+        if let Pass::Measure { splits } = &mut self.pass {
+            // At most MAX_SUBDIVISION.
+            splits.push(moves.len() as u32);
+        }
+        let n = moves.len();
+        let measuring = self.measuring();
 
         // Planned deposition speed along the part.
         let bottom = match unit(q.axis) {
@@ -343,15 +365,17 @@ impl<'a> Writer<'a> {
         self.fan.set(on_table, &mut self.out);
         let mut lines = Vec::with_capacity(n);
         let mut written = Vec::with_capacity(n);
-        for (&to, &(worst, sum, count)) in moves.iter().zip(&errors) {
+        for (k, &to) in moves.iter().enumerate() {
             let xyz = norm(sub([to[0], to[1], to[2]], [from[0], from[1], from[2]]));
             let rotary = (to[3] - from[3]).hypot(to[4] - from[4]);
             let de = self.extrusion.add(q.e / n as f64);
-            acc.figures.max_mm = acc.figures.max_mm.max(worst);
-            acc.sum += sum;
-            acc.figures.samples += count;
-            self.printed_length += part_step;
-            self.plot.push((q.feature, self.printed_length, worst));
+            if let Some(&(worst, sum, count)) = errors.get(k) {
+                acc.figures.max_mm = acc.figures.max_mm.max(worst);
+                acc.sum += sum;
+                acc.figures.samples += count;
+                self.printed_length += part_step;
+                self.plot.push((q.feature, self.printed_length, worst));
+            }
             // Zero-length in machine coordinates (X, Y, Z, B and C as written), or extruding
             // nothing over a few micrometres: merged into the next move, which carries its E.
             if to == from || (de == 0 && mergeable(xyz, rotary)) {
@@ -372,26 +396,30 @@ impl<'a> Writer<'a> {
             };
             self.extrusion.written(de);
             acc.figures.max_c_step_deg = acc.figures.max_c_step_deg.max((to[4] - from[4]).abs());
-            let e = if de == 0 {
-                String::new()
-            } else {
-                format!(" E{}", e_text(de))
-            };
-            lines.push(format!(
-                "G1 X{} Y{} Z{} B{} C{}{e} F{}",
-                fixed(to[0], 3),
-                fixed(to[1], 3),
-                fixed(to[2], 3),
-                fixed(to[3], 4),
-                fixed(to[4], 4),
-                fixed(f, 3)
-            ));
+            if !measuring {
+                let e = if de == 0 {
+                    String::new()
+                } else {
+                    format!(" E{}", e_text(de))
+                };
+                lines.push(format!(
+                    "G1 X{} Y{} Z{} B{} C{}{e} F{}",
+                    fixed(to[0], 3),
+                    fixed(to[1], 3),
+                    fixed(to[2], 3),
+                    fixed(to[3], 4),
+                    fixed(to[4], 4),
+                    fixed(f, 3)
+                ));
+            }
             written.push(to);
             from = to;
         }
         acc.figures.print_moves += written.len();
-        for (to, l) in written.iter().zip(&lines) {
+        for to in &written {
             self.check([to[0], to[1], to[2]])?;
+        }
+        for l in &lines {
             self.line(l);
         }
         if let Some(&last) = written.last() {
@@ -401,17 +429,71 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
+    /// The planned segment from `a` (bed at `pa`) to `q` (bed at `pq`) split into `n` equal
+    /// sub-moves: positions on the segment, B and C linear along it, as joints.
+    fn sub_moves(
+        &self,
+        a: &PathPoint,
+        pa: &Pose,
+        q: &PathPoint,
+        pq: &Pose,
+        n: usize,
+    ) -> Vec<Joints> {
+        (1..=n)
+            .map(|k| {
+                if k == n {
+                    self.joints(q.p, pq.b, pq.c)
+                } else {
+                    let f = k as f64 / n as f64;
+                    let b = pa.b + (pq.b - pa.b) * f;
+                    let c = pa.c + (pq.c - pa.c) * f;
+                    self.joints(lerp(a.p, q.p, f), b, c)
+                }
+            })
+            .collect()
+    }
+
+    /// The sub-moves of the planned segment from `a` (bed at `pa`) to `q` (bed at `pq`,
+    /// `length` mm from `a`), the machine at `start`: split until no move turns C by more
+    /// than `max_c_step_deg` and the kinematic error stays within its goal (or
+    /// [`MAX_SUBDIVISION`] moves, or sub-moves of less than a micrometre); with each move's
+    /// error ([`Writer::move_error`]).
+    fn subdivide(
+        &self,
+        start: Joints,
+        a: &PathPoint,
+        pa: &Pose,
+        q: &PathPoint,
+        pq: &Pose,
+        length: f64,
+    ) -> (Vec<Joints>, Vec<MoveError>) {
+        let g = self.g;
+        let dc = (pq.c - pa.c).abs();
+        let mut n = ((dc / g.max_c_step_deg - 1e-9).ceil().max(1.0) as usize).min(MAX_SUBDIVISION);
+        loop {
+            let moves = self.sub_moves(a, pa, q, pq, n);
+            let mut from = start;
+            let mut errors = Vec::with_capacity(n);
+            for &to in &moves {
+                errors.push(self.move_error(from, to, a.p, q.p));
+                from = to;
+            }
+            let worst = errors.iter().map(|e| e.0).fold(0.0, f64::max);
+            if worst <= g.kinematic_error_goal || n >= MAX_SUBDIVISION || length / (n as f64) < 1e-3
+            {
+                return (moves, errors);
+            }
+            // The error of a turning move shrinks with the square of its length.
+            let grow = (n as f64 * (worst / g.kinematic_error_goal).sqrt() * 1.1).ceil() as usize;
+            n = grow.max(n + 1).min(MAX_SUBDIVISION);
+        }
+    }
+
     /// Kinematic error of the move `from` → `to` against the planned segment `p0`–`p1`: the
     /// controller's linear interpolation of the joints in steps of the resolutions, each step
     /// transformed back to the part (Isa & Lazoglu 2019, Fig. 16, after Makhanov). Returns the
     /// largest distance, the sum of the distances and the number of steps.
-    fn move_error(
-        &self,
-        from: Joints,
-        to: Joints,
-        p0: [f64; 3],
-        p1: [f64; 3],
-    ) -> (f64, f64, usize) {
+    fn move_error(&self, from: Joints, to: Joints, p0: [f64; 3], p1: [f64; 3]) -> MoveError {
         let g = self.g;
         let steps = [
             (to[0] - from[0]).abs() / g.resolution_xyz,

@@ -4,7 +4,6 @@
 use std::collections::BTreeMap;
 
 use super::cell::KukaCell;
-use super::motion::Step;
 use super::rotation::Pose;
 use toolpath::{fixed, ToolPath};
 
@@ -34,74 +33,85 @@ pub struct KukaFigures {
     pub gimbal_crossings: usize,
 }
 
-/// What the reach check found, per motion and per feature.
-pub(super) struct Checked {
-    /// Per `Step::Move`, in order: the KRL frame written.
-    pub(super) frames: Vec<[f64; 6]>,
-    /// Per `Step::Move`: a note for the LIN's comment, if any.
-    pub(super) notes: Vec<Option<&'static str>>,
-    pub(super) figures: BTreeMap<usize, KukaFigures>,
+/// The reach check, motion by motion in the program's order ([`Reach::motion`]): each
+/// motion's Euler angles (unwrapped along the program) and its pose against the arm model.
+pub(super) struct Reach<'a> {
+    /// The cell the arm stands in.
+    pub(super) cell: &'a KukaCell,
+    base: &'a Pose,
+    tool_inv: Pose,
+    /// Per path point: a motion for it is out of reach, near the wrist singularity.
+    unreachable: Vec<bool>,
+    singular: Vec<bool>,
+    figures: BTreeMap<usize, KukaFigures>,
+    prev_abc: Option<[f64; 3]>,
+    /// The joints and configuration the arm is in.
+    joints: [f64; 6],
+    config: Option<u8>,
 }
 
-/// Euler angles (unwrapped along the program) and the reach check of every motion.
-pub(super) fn check(
-    path: &ToolPath,
-    steps: &[Step],
-    cell: &KukaCell,
-    base: &Pose,
-    warnings: &mut Vec<String>,
-) -> Checked {
-    let arm = &cell.arm;
-    let tool_inv = cell.tool.pose().inverse();
-    let n = path.points.len();
-    let mut unreachable = vec![false; n];
-    let mut singular = vec![false; n];
-    let mut figures: BTreeMap<usize, KukaFigures> = BTreeMap::new();
-    for q in &path.points {
-        figures.entry(q.feature).or_default().points += 1;
+impl<'a> Reach<'a> {
+    /// The check of `path`'s motions, the arm at home.
+    pub(super) fn new(path: &ToolPath, cell: &'a KukaCell, base: &'a Pose) -> Reach<'a> {
+        let n = path.points.len();
+        let mut figures: BTreeMap<usize, KukaFigures> = BTreeMap::new();
+        for q in &path.points {
+            figures.entry(q.feature).or_default().points += 1;
+        }
+        Reach {
+            cell,
+            base,
+            tool_inv: cell.tool.pose().inverse(),
+            unreachable: vec![false; n],
+            singular: vec![false; n],
+            figures,
+            prev_abc: None,
+            joints: cell.home,
+            config: Some(cell.arm.configuration(&cell.home)),
+        }
     }
-    let mut frames = Vec::new();
-    let mut notes = Vec::new();
-    let mut prev_abc: Option<[f64; 3]> = None;
-    let mut joints = cell.home;
-    let mut config = Some(arm.configuration(&cell.home));
-    for step in steps {
-        let Step::Move { pose, point, .. } = step else {
-            continue;
-        };
-        let feature = path.points[*point].feature;
-        let fig = figures.entry(feature).or_default();
+
+    /// The next motion, to `pose` for path point `point` of `feature`: the KRL frame written,
+    /// and a note for its line when the arm cannot reach it or it is near the wrist
+    /// singularity.
+    pub(super) fn motion(
+        &mut self,
+        pose: &Pose,
+        point: usize,
+        feature: usize,
+    ) -> ([f64; 6], Option<&'static str>) {
+        let (cell, arm) = (self.cell, &self.cell.arm);
+        let fig = self.figures.entry(feature).or_default();
         fig.moves += 1;
-        let f = pose.to_frame(prev_abc);
-        if let Some(p) = prev_abc {
+        let f = pose.to_frame(self.prev_abc);
+        if let Some(p) = self.prev_abc {
             if (f[3] - p[0]).abs() > 90.0 || (f[5] - p[2]).abs() > 90.0 {
                 fig.gimbal_crossings += 1;
             }
         }
-        prev_abc = Some([f[3], f[4], f[5]]);
-        frames.push(f);
-        let flange = base.compose(pose).compose(&tool_inv);
-        let note = match arm.nearest(&flange, &joints, config) {
+        self.prev_abc = Some([f[3], f[4], f[5]]);
+        let flange = self.base.compose(pose).compose(&self.tool_inv);
+        let note = match arm.nearest(&flange, &self.joints, self.config) {
             None => {
-                unreachable[*point] = true;
-                if fig.first_unreachable.is_none_or(|i| *point < i) {
-                    fig.first_unreachable = Some(*point);
+                self.unreachable[point] = true;
+                if fig.first_unreachable.is_none_or(|i| point < i) {
+                    fig.first_unreachable = Some(point);
                 }
                 Some("UNREACHABLE")
             }
             Some((j, c)) => {
-                if config.is_some_and(|k| k != c) {
+                if self.config.is_some_and(|k| k != c) {
                     fig.configuration_changes += 1;
                 }
-                joints = j;
-                config = Some(c);
+                self.joints = j;
+                self.config = Some(c);
                 let bend = arm.wrist_bend(&j);
                 let bend = bend.min(180.0 - bend);
                 fig.min_wrist_bend_deg = Some(fig.min_wrist_bend_deg.map_or(bend, |b| b.min(bend)));
                 if bend < cell.wrist_singularity_deg {
-                    singular[*point] = true;
-                    if fig.first_wrist_singular.is_none_or(|i| *point < i) {
-                        fig.first_wrist_singular = Some(*point);
+                    self.singular[point] = true;
+                    if fig.first_wrist_singular.is_none_or(|i| point < i) {
+                        fig.first_wrist_singular = Some(point);
                     }
                     Some("WRIST SINGULAR")
                 } else {
@@ -109,56 +119,68 @@ pub(super) fn check(
                 }
             }
         };
-        notes.push(note);
+        (f, note)
     }
-    for (i, q) in path.points.iter().enumerate() {
-        if let Some(fig) = figures.get_mut(&q.feature) {
-            fig.unreachable_points += usize::from(unreachable[i]);
-            fig.wrist_singular_points += usize::from(singular[i]);
+
+    /// What the check found per feature, once every motion is checked; its warnings, one line
+    /// each, pushed onto `warnings`.
+    pub(super) fn finish(
+        self,
+        path: &ToolPath,
+        warnings: &mut Vec<String>,
+    ) -> BTreeMap<usize, KukaFigures> {
+        let Reach {
+            cell,
+            unreachable,
+            singular,
+            mut figures,
+            ..
+        } = self;
+        for (i, q) in path.points.iter().enumerate() {
+            if let Some(fig) = figures.get_mut(&q.feature) {
+                fig.unreachable_points += usize::from(unreachable[i]);
+                fig.wrist_singular_points += usize::from(singular[i]);
+            }
         }
-    }
-    let at = |i: usize| {
-        let p = path.points[i].p;
-        format!(
-            "point {i} (part X{} Y{} Z{})",
-            fixed(p[0], 3),
-            fixed(p[1], 3),
-            fixed(p[2], 3)
-        )
-    };
-    for (id, fig) in &figures {
-        if let Some(i) = fig.first_unreachable {
-            warnings.push(format!(
+        let at = |i: usize| {
+            let p = path.points[i].p;
+            format!(
+                "point {i} (part X{} Y{} Z{})",
+                fixed(p[0], 3),
+                fixed(p[1], 3),
+                fixed(p[2], 3)
+            )
+        };
+        for (id, fig) in &figures {
+            if let Some(i) = fig.first_unreachable {
+                warnings.push(format!(
                 "feature {id}: {} of {} points out of the arm's reach or joint limits, first at {}",
                 fig.unreachable_points,
                 fig.points,
                 at(i)
             ));
-        }
-        if let Some(i) = fig.first_wrist_singular {
-            warnings.push(format!(
+            }
+            if let Some(i) = fig.first_wrist_singular {
+                warnings.push(format!(
                 "feature {id}: {} points within {}° of the wrist singularity (|A5| small), first at {}",
                 fig.wrist_singular_points,
                 fixed(cell.wrist_singularity_deg, 1),
                 at(i)
             ));
-        }
-        if fig.configuration_changes > 0 {
-            warnings.push(format!(
-                "feature {id}: the arm changes configuration on {} motions (a LIN cannot)",
-                fig.configuration_changes
-            ));
-        }
-        if fig.gimbal_crossings > 0 {
-            warnings.push(format!(
+            }
+            if fig.configuration_changes > 0 {
+                warnings.push(format!(
+                    "feature {id}: the arm changes configuration on {} motions (a LIN cannot)",
+                    fig.configuration_changes
+                ));
+            }
+            if fig.gimbal_crossings > 0 {
+                warnings.push(format!(
                 "feature {id}: the tool's X axis passes through or near $BASE Z on {} motions: A or C turns by more than 90° there (B stays within ±90°)",
                 fig.gimbal_crossings
             ));
+            }
         }
-    }
-    Checked {
-        frames,
-        notes,
-        figures,
+        figures
     }
 }

@@ -2,11 +2,14 @@
 //! names and frame aggregates.
 
 use super::cell::{ExtruderSwitch, KukaCell};
-use super::checks::Checked;
+use super::checks::{KukaFigures, Reach};
 use super::motion::Step;
-use crate::gcode::comment_text;
+use crate::gcode::{comment_text, push_line};
 use crate::machine::MachineProfile;
-use toolpath::fixed;
+use crate::sink::{insert_notes, write_file, Chunked, ProgramSink};
+use crate::PostError;
+use std::collections::BTreeMap;
+use toolpath::{fixed, ToolPath};
 
 /// Longest KRL name (identifiers and module names).
 pub const KRL_NAME_MAX: usize = 24;
@@ -141,78 +144,117 @@ pub fn frame_text(f: &[f64; 6]) -> String {
     )
 }
 
-/// The `.src` and `.dat` files.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn write_files(
-    m: &MachineProfile,
-    cell: &KukaCell,
-    steps: &[Step],
-    checked: &Checked,
-    offset: [f64; 3],
-    program_name: &str,
-    source: &str,
-    warnings: &mut Vec<String>,
-) -> Vec<(String, String)> {
-    let out = cell.extruder_output;
-    let feed_out = cell.feed_output;
-    // Print LINs whose feed ratio is beyond the analog output's full scale.
-    let mut beyond = (0usize, 0.0f64);
-    // Lines grouped by motion: each group ends with one motion; the lines before it (comments,
-    // speeds, extruder switching) go with it, so a TRIGGER stays with its motion.
-    let mut groups: Vec<Vec<String>> = Vec::new();
-    let mut pending: Vec<String> = Vec::new();
-    let mut vel_before: Vec<Option<f64>> = Vec::new();
-    let mut vel = None;
-    let mut k = 0;
-    for step in steps {
-        match step {
-            Step::Comment(c) => pending.push(format!("; {}", comment_text(c))),
+/// The program's lines, one per step ([`Steps::push`]), and what writing them finds.
+struct Steps<'a> {
+    cell: &'a KukaCell,
+    path: &'a ToolPath,
+    /// The reach check of the motions, as they are written.
+    reach: Reach<'a>,
+    /// The `$VEL.CP` in force.
+    vel: Option<f64>,
+    /// Print LINs whose feed ratio is beyond the analog output's full scale, and the largest
+    /// such ratio.
+    beyond: (usize, f64),
+}
+
+impl Steps<'_> {
+    /// Appends the line of `step` (and its line break) to `out`.
+    fn push(&mut self, step: &Step, out: &mut String) {
+        let cell = self.cell;
+        let (out_n, feed_out) = (cell.extruder_output, cell.feed_output);
+        let line = match step {
+            Step::Comment(c) => format!("; {}", comment_text(c)),
             Step::Vel(v) => {
-                pending.push(format!("$VEL.CP = {}", fixed(*v, 4)));
+                self.vel = Some(*v);
+                format!("$VEL.CP = {}", fixed(*v, 4))
             }
             Step::Extruder(on) => {
                 let state = if *on { "TRUE" } else { "FALSE" };
-                pending.push(match cell.extruder_switch {
-                    ExtruderSwitch::Out => format!("$OUT[{out}] = {state}"),
+                match cell.extruder_switch {
+                    ExtruderSwitch::Out => format!("$OUT[{out_n}] = {state}"),
                     ExtruderSwitch::Trigger => {
-                        format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out}]={state}")
+                        format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out_n}]={state}")
                     }
-                });
+                }
             }
             Step::Feed(ratio) => {
                 let v = ratio / cell.feed_ratio_full_scale;
                 if v > 1.0 {
-                    beyond = (beyond.0 + 1, beyond.1.max(*ratio));
+                    self.beyond = (self.beyond.0 + 1, self.beyond.1.max(*ratio));
                 }
-                pending.push(format!(
+                format!(
                     "TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[{feed_out}]={}",
                     fixed(v.clamp(0.0, 1.0), 5)
-                ));
+                )
             }
-            Step::Move { ptp, .. } => {
-                let f = &checked.frames[k];
+            Step::Move { ptp, pose, point } => {
+                let feature = self.path.points[*point].feature;
+                let (f, note) = self.reach.motion(pose, *point, feature);
                 let mut line = if *ptp {
-                    format!("PTP {}", frame_text(f))
+                    format!("PTP {}", frame_text(&f))
                 } else {
-                    format!("LIN {} C_DIS", frame_text(f))
+                    format!("LIN {} C_DIS", frame_text(&f))
                 };
-                if let Some(note) = checked.notes[k] {
+                if let Some(note) = note {
                     line.push_str(" ; ");
                     line.push_str(note);
                 }
-                k += 1;
-                pending.push(line);
-                vel_before.push(vel);
-                groups.push(std::mem::take(&mut pending));
+                line
+            }
+        };
+        push_line(out, &line);
+    }
+
+    /// Writes the lines of `steps` after `text` (what the file starts with) into the file
+    /// `name` of `sink` as they are made ([`Chunked`]), up to and including the step of its
+    /// `motions`th motion (all of them when `None`), then `end`.
+    fn write(
+        &mut self,
+        steps: impl Iterator<Item = Step>,
+        motions: Option<usize>,
+        mut text: String,
+        end: &str,
+        sink: &mut dyn ProgramSink,
+        name: &str,
+    ) -> Result<(), PostError> {
+        let mut file = Chunked::open(sink, name)?;
+        let mut seen = 0;
+        for step in steps {
+            self.push(&step, &mut text);
+            file.pass_on(&mut text)?;
+            if matches!(step, Step::Move { .. }) {
+                seen += 1;
+                if Some(seen) == motions {
+                    break;
+                }
             }
         }
-        if let Step::Vel(v) = step {
-            vel = Some(*v);
-        }
+        text.push_str(end);
+        file.finish(&text)
     }
-    let trailing = pending;
+}
 
-    let moves = groups.len();
+/// The `.src` and `.dat` files of the program of `steps` (`moves` motions, each checked as its
+/// line is written: [`Reach`]), written into `sink` as their lines are made ([`Chunked`]):
+/// `<name>.src` (with `notes` after the line naming the source) and `<name>.dat`, then the
+/// parts' `.src` and `.dat` in order when the program is split. Returns the figures of the
+/// check, its warnings pushed onto `warnings`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn write_files(
+    m: &MachineProfile,
+    path: &ToolPath,
+    steps: impl Iterator<Item = Step>,
+    moves: usize,
+    reach: Reach,
+    offset: [f64; 3],
+    job: (&str, &str, &[String]),
+    sink: &mut dyn ProgramSink,
+    warnings: &mut Vec<String>,
+) -> Result<BTreeMap<usize, KukaFigures>, PostError> {
+    let (program_name, source, notes) = job;
+    let cell = reach.cell;
+    let out = cell.extruder_output;
+    let feed_out = cell.feed_output;
     let per = cell.max_moves_per_file.max(1);
     let parts = if moves > per { moves.div_ceil(per) } else { 0 };
     let digits = parts.to_string().len().max(3);
@@ -224,14 +266,6 @@ pub(super) fn write_files(
     let part_name = |i: usize| format!("{name}_p{:0digits$}", i + 1);
 
     let src = comment_text(source);
-    if beyond.0 > 0 {
-        warnings.push(format!(
-            "{} print LIN(s) need a feed ratio above kuka.feed_ratio_full_scale {} mm/mm (up to {}): $ANOUT[{feed_out}] is held at 1.0 there, under-extruding",
-            beyond.0,
-            fixed(cell.feed_ratio_full_scale, 5),
-            fixed(beyond.1, 5)
-        ));
-    }
     let switch = match cell.extruder_switch {
         ExtruderSwitch::Out => format!("$OUT[{out}] between motions (exact stop)"),
         ExtruderSwitch::Trigger => format!("$OUT[{out}] by TRIGGER at the motion's start"),
@@ -285,56 +319,18 @@ pub(super) fn write_files(
         format!("$OUT[{out}] = FALSE"),
         format!("PTP {HOME_NAME}"),
     ];
-    let mut files = Vec::new();
-    let mut part_files = Vec::new();
-    if parts == 0 {
-        for g in &groups {
-            main.extend(g.iter().cloned());
-        }
-        main.extend(trailing.iter().cloned());
-    } else {
-        for (i, chunk) in groups.chunks(per).enumerate() {
-            let pname = part_name(i);
-            main.push(format!("{pname}( )"));
-            let mut lines: Vec<String> = vec![
-                "&ACCESS RVP".into(),
-                "&REL 1".into(),
-                format!("DEF {pname}( )"),
-                format!(
-                    "; part {} of {parts} of {name}, generated by features from {src}",
-                    i + 1
-                ),
-            ];
-            // The speed in force, unless the part's first motion sets its own.
-            let sets_vel = chunk
-                .first()
-                .is_some_and(|g| g.iter().any(|l| l.starts_with("$VEL.CP")));
-            if let (Some(Some(v)), false) = (vel_before.get(i * per), sets_vel) {
-                lines.push(format!("$VEL.CP = {}", fixed(*v, 4)));
-            }
-            for g in chunk {
-                lines.extend(g.iter().cloned());
-            }
-            if i + 1 == parts {
-                lines.extend(trailing.iter().cloned());
-            }
-            lines.push("END".into());
-            let dat = vec![
-                "&ACCESS RVP".into(),
-                "&REL 1".into(),
-                format!("DEFDAT {pname}"),
-                format!("; part {} of {parts} of {name}", i + 1),
-                "ENDDAT".into(),
-            ];
-            part_files.push((format!("{pname}.src"), join(&lines)));
-            part_files.push((format!("{pname}.dat"), join(&dat)));
-        }
+    if parts > 0 {
+        main.extend((0..parts).map(|i| format!("{}( )", part_name(i))));
     }
-    main.push(format!("$OUT[{out}] = FALSE"));
-    main.push(format!("PTP {HOME_NAME}"));
-    main.push("END".into());
+    let mut head = join(&main);
+    insert_notes(&mut head, notes);
+    let tail = join(&[
+        format!("$OUT[{out}] = FALSE"),
+        format!("PTP {HOME_NAME}"),
+        "END".into(),
+    ]);
     let h = cell.home;
-    let dat = vec![
+    let dat = join(&[
         "&ACCESS RVP".into(),
         "&REL 1".into(),
         format!("DEFDAT {name}"),
@@ -349,11 +345,70 @@ pub(super) fn write_files(
             fixed(h[5], 3)
         ),
         "ENDDAT".into(),
-    ];
-    files.push((format!("{name}.src"), join(&main)));
-    files.push((format!("{name}.dat"), join(&dat)));
-    files.extend(part_files);
-    files
+    ]);
+    let mut lines = Steps {
+        cell,
+        path,
+        reach,
+        vel: None,
+        beyond: (0, 0.0),
+    };
+    let main_src = format!("{name}.src");
+    let mut steps = steps;
+    if parts == 0 {
+        lines.write(steps, None, head, &tail, sink, &main_src)?;
+        write_file(sink, &format!("{name}.dat"), dat.as_bytes())?;
+    } else {
+        head.push_str(&tail);
+        write_file(sink, &main_src, head.as_bytes())?;
+        write_file(sink, &format!("{name}.dat"), dat.as_bytes())?;
+        for i in 0..parts {
+            let pname = part_name(i);
+            let mut text = join(&[
+                "&ACCESS RVP".into(),
+                "&REL 1".into(),
+                format!("DEF {pname}( )"),
+                format!(
+                    "; part {} of {parts} of {name}, generated by features from {src}",
+                    i + 1
+                ),
+            ]);
+            // The speed in force, unless the part's first motion sets its own.
+            let mut first = Vec::new();
+            for step in steps.by_ref() {
+                let motion = matches!(step, Step::Move { .. });
+                first.push(step);
+                if motion {
+                    break;
+                }
+            }
+            let sets_vel = first.iter().any(|s| matches!(s, Step::Vel(_)));
+            if let (Some(v), false) = (lines.vel, sets_vel) {
+                push_line(&mut text, &format!("$VEL.CP = {}", fixed(v, 4)));
+            }
+            // The last part takes the steps after the last motion too.
+            let motions = (i + 1 < parts).then_some(per);
+            let part = first.into_iter().chain(steps.by_ref());
+            lines.write(part, motions, text, "END\n", sink, &format!("{pname}.src"))?;
+            let dat = join(&[
+                "&ACCESS RVP".into(),
+                "&REL 1".into(),
+                format!("DEFDAT {pname}"),
+                format!("; part {} of {parts} of {name}", i + 1),
+                "ENDDAT".into(),
+            ]);
+            write_file(sink, &format!("{pname}.dat"), dat.as_bytes())?;
+        }
+    }
+    let (beyond, most) = lines.beyond;
+    if beyond > 0 {
+        warnings.push(format!(
+            "{beyond} print LIN(s) need a feed ratio above kuka.feed_ratio_full_scale {} mm/mm (up to {}): $ANOUT[{feed_out}] is held at 1.0 there, under-extruding",
+            fixed(cell.feed_ratio_full_scale, 5),
+            fixed(most, 5)
+        ));
+    }
+    Ok(lines.reach.finish(path, warnings))
 }
 
 /// Lines joined with `\n`, ending with one.

@@ -77,10 +77,11 @@ pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 
 use crate::machine::MachineProfile;
+use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
-use checks::check;
+use checks::Reach;
 use krl_text::write_files;
-use motion::{placement, plan_motion};
+use motion::{placement, Planner, Step};
 use toolpath::vec3::{norm, scale};
 use toolpath::ToolPath;
 
@@ -117,6 +118,30 @@ pub fn kuka(
     program_name: &str,
     source: &str,
 ) -> Result<KrlProgram, PostError> {
+    let mut files = InMemory::default();
+    let mut program = kuka_to(path, m, program_name, source, &[], &mut files)?;
+    program.files = files
+        .files
+        .into_iter()
+        // The program is made of `str`s.
+        .map(|f| (f.name, String::from_utf8(f.bytes).unwrap_or_default()))
+        .collect();
+    Ok(program)
+}
+
+/// [`kuka`]'s program, with `notes` (comment lines after the one naming the source in the
+/// main `.src`, see [`crate::Job::notes`]), written into `sink` in the order of
+/// [`KrlProgram::files`], each `.src` as its lines are made, a megabyte at a time ([`ProgramSink::chunk`]); the
+/// returned program holds no file. The files are opened once the motions are planned and
+/// checked; an error writing them is [`PostError::Write`].
+pub fn kuka_to(
+    path: &ToolPath,
+    m: &MachineProfile,
+    program_name: &str,
+    source: &str,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+) -> Result<KrlProgram, PostError> {
     let cell = m.kuka_table()?;
     path.check_finite()?;
     let mut axes = Vec::with_capacity(path.points.len());
@@ -136,21 +161,24 @@ pub fn kuka(
     let mut warnings = Vec::new();
     let offset = placement(path, m, &mut warnings)?;
     let base = cell.base.pose();
-    let steps = plan_motion(path, &axes, offset, m, cell, &base);
-    let checked = check(path, &steps, cell, &base, &mut warnings);
-    let files = write_files(
+    // The header counts the motions: a first run of the planner counts them, the second
+    // plans them again as they are checked and written.
+    let planner = || Planner::new(path, &axes, offset, m, cell, &base);
+    let moves = planner().filter(|s| matches!(s, Step::Move { .. })).count();
+    let figures = write_files(
         m,
-        cell,
-        &steps,
-        &checked,
+        path,
+        planner(),
+        moves,
+        Reach::new(path, cell, &base),
         offset,
-        program_name,
-        source,
+        (program_name, source, notes),
+        sink,
         &mut warnings,
-    );
+    )?;
     Ok(KrlProgram {
-        files,
-        figures: checked.figures,
+        files: vec![],
+        figures,
         warnings,
     })
 }

@@ -9,6 +9,7 @@ use super::rotation::{
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
 use crate::PostError;
+use std::collections::VecDeque;
 use toolpath::vec3::{add, cross, norm, scale, sub, V3};
 use toolpath::{MoveKind, ToolPath};
 
@@ -62,45 +63,99 @@ pub(super) fn placement(
     }
 }
 
-/// The motions of the program: travels, print moves, speeds and extruder switching.
-pub(super) fn plan_motion(
-    path: &ToolPath,
-    axes: &[V3],
+/// The motions of the program, planned as they are asked for: travels, print moves, speeds
+/// and extruder switching, the steps in order ([`Iterator`]); a path point at a time, so that
+/// the program is written as it is planned.
+pub(super) struct Planner<'a> {
+    path: &'a ToolPath,
+    /// The path's tool axes, unit.
+    axes: &'a [V3],
     offset: [f64; 3],
-    m: &MachineProfile,
-    cell: &KukaCell,
-    base: &Pose,
-) -> Vec<Step> {
-    let (print_v, first_v) = if cell.print_vel_cp > 0.0 {
-        (
-            cell.print_vel_cp,
-            cell.print_vel_cp * m.first_layer_speed / m.print_speed,
-        )
-    } else {
-        (m.print_speed / 1000.0, m.first_layer_speed / 1000.0)
-    };
-    let travel_v = if cell.travel_vel_cp > 0.0 {
-        cell.travel_vel_cp
-    } else {
-        m.travel_speed / 1000.0
-    };
-    let mut w = Motion {
-        steps: Vec::new(),
-        vel: None,
-        feed: None,
-        on: false,
-        clearance: cell.travel_clearance,
-        z_top: f64::NEG_INFINITY,
-        height: HeightMap {
-            cell: HEIGHT_CELL,
-            z: Default::default(),
-        },
-    };
-    let (mut layer, mut feature) = (None, None);
-    let mut cur: Option<(Pose, usize)> = None;
-    for (i, q) in path.points.iter().enumerate() {
-        let p = add(q.p, offset);
-        let z = scale(axes[i], -1.0);
+    base: &'a Pose,
+    /// `$VEL.CP` (m/s) of print moves, of those resting on the plate, and of travels.
+    print_v: f64,
+    first_v: f64,
+    travel_v: f64,
+    w: Motion,
+    /// The next path point.
+    i: usize,
+    /// The layer and feature of the last comment.
+    layer: Option<usize>,
+    feature: Option<usize>,
+    /// The pose the last point left the tool at, and that point.
+    cur: Option<(Pose, usize)>,
+    /// The end (retreat and rise) is planned.
+    done: bool,
+}
+
+impl<'a> Planner<'a> {
+    /// The planner of the path's motions; `axes` are its points' tool axes made unit,
+    /// `offset` the part's placement ([`placement`]), `base` the table's frame.
+    pub(super) fn new(
+        path: &'a ToolPath,
+        axes: &'a [V3],
+        offset: [f64; 3],
+        m: &MachineProfile,
+        cell: &KukaCell,
+        base: &'a Pose,
+    ) -> Planner<'a> {
+        let (print_v, first_v) = if cell.print_vel_cp > 0.0 {
+            (
+                cell.print_vel_cp,
+                cell.print_vel_cp * m.first_layer_speed / m.print_speed,
+            )
+        } else {
+            (m.print_speed / 1000.0, m.first_layer_speed / 1000.0)
+        };
+        let travel_v = if cell.travel_vel_cp > 0.0 {
+            cell.travel_vel_cp
+        } else {
+            m.travel_speed / 1000.0
+        };
+        Planner {
+            path,
+            axes,
+            offset,
+            base,
+            print_v,
+            first_v,
+            travel_v,
+            w: Motion {
+                steps: VecDeque::new(),
+                last: None,
+                vel: None,
+                feed: None,
+                on: false,
+                clearance: cell.travel_clearance,
+                z_top: f64::NEG_INFINITY,
+                height: HeightMap {
+                    cell: HEIGHT_CELL,
+                    z: Default::default(),
+                },
+            },
+            i: 0,
+            layer: None,
+            feature: None,
+            cur: None,
+            done: false,
+        }
+    }
+
+    /// Plans the steps of the next path point (none for some), or the end after the last.
+    fn advance(&mut self) {
+        let path = self.path;
+        let Some(q) = path.points.get(self.i) else {
+            if let Some((end, i)) = self.cur {
+                self.w.leave(&end, i, self.travel_v);
+            }
+            self.done = true;
+            return;
+        };
+        let i = self.i;
+        self.i += 1;
+        let w = &mut self.w;
+        let p = add(q.p, self.offset);
+        let z = scale(self.axes[i], -1.0);
         w.z_top = w.z_top.max(p[2]);
         // A travel point goes only where a path starts (a print point follows): the
         // planner's other travel points (lifts, waypoints) are superseded by the safe travel.
@@ -109,17 +164,17 @@ pub(super) fn plan_motion(
             .get(i + 1)
             .is_some_and(|n| n.kind == MoveKind::Print);
         if q.kind == MoveKind::Travel && !starts_path {
-            continue;
+            return;
         }
-        if layer != Some(q.layer) || feature != Some(q.feature) {
-            layer = Some(q.layer);
-            feature = Some(q.feature);
-            w.steps.push(Step::Comment(format!(
+        if self.layer != Some(q.layer) || self.feature != Some(q.feature) {
+            self.layer = Some(q.layer);
+            self.feature = Some(q.feature);
+            w.steps.push_back(Step::Comment(format!(
                 "FEATURE {} LAYER {}",
                 q.feature, q.layer
             )));
         }
-        let next = match (q.kind, cur) {
+        let next = match (q.kind, self.cur) {
             (MoveKind::Print, Some((prev, _))) => {
                 let pose = Pose {
                     r: transport(&prev.r, z),
@@ -128,11 +183,11 @@ pub(super) fn plan_motion(
                 // A print move that goes nowhere (the nozzle is already there) is dropped,
                 // with its switching. Speed first: a TRIGGER goes right before its motion.
                 if w.goes_nowhere(&pose) {
-                    cur = Some((pose, i));
-                    continue;
+                    self.cur = Some((pose, i));
+                    return;
                 }
                 let on_plate = p[2] - q.thickness.max(0.0) <= 0.01;
-                w.vel(if on_plate { first_v } else { print_v });
+                w.vel(if on_plate { self.first_v } else { self.print_v });
                 if !w.on {
                     w.extruder(true);
                 }
@@ -142,24 +197,36 @@ pub(super) fn plan_motion(
             }
             _ => {
                 let pose = Pose {
-                    r: start_frame(z, p, base),
+                    r: start_frame(z, p, self.base),
                     t: p,
                 };
-                w.travel(cur.map(|c| c.0), pose, i, travel_v);
+                w.travel(self.cur.map(|c| c.0), pose, i, self.travel_v);
                 pose
             }
         };
         // The bead just laid (or the path's start) is material the travels must clear.
-        match (q.kind, cur) {
+        match (q.kind, self.cur) {
             (MoveKind::Print, Some((prev, _))) => w.height.add_segment(prev.t, p),
             _ => w.height.add(p),
         }
-        cur = Some((next, i));
+        self.cur = Some((next, i));
     }
-    if let Some((end, i)) = cur {
-        w.leave(&end, i, travel_v);
+}
+
+impl Iterator for Planner<'_> {
+    type Item = Step;
+
+    fn next(&mut self) -> Option<Step> {
+        loop {
+            if let Some(s) = self.w.steps.pop_front() {
+                return Some(s);
+            }
+            if self.done {
+                return None;
+            }
+            self.advance();
+        }
     }
-    w.steps
 }
 
 /// The highest point visited so far over each cell of a square grid of the table (`$BASE`
@@ -242,7 +309,10 @@ pub(super) fn start_frame(z: V3, p: V3, base: &Pose) -> Mat3 {
 
 /// The steps being planned and the state they leave.
 pub(super) struct Motion {
-    steps: Vec<Step>,
+    /// Steps planned, not yet taken.
+    steps: VecDeque<Step>,
+    /// The pose and path point of the last motion.
+    last: Option<(Pose, usize)>,
     vel: Option<f64>,
     /// The feed ratio in force.
     feed: Option<f64>,
@@ -258,13 +328,13 @@ impl Motion {
     fn vel(&mut self, v: f64) {
         if self.vel != Some(v) {
             self.vel = Some(v);
-            self.steps.push(Step::Vel(v));
+            self.steps.push_back(Step::Vel(v));
         }
     }
 
     fn extruder(&mut self, on: bool) {
         self.on = on;
-        self.steps.push(Step::Extruder(on));
+        self.steps.push_back(Step::Extruder(on));
     }
 
     /// The feed ratio of a print LIN to `pose` (path point `point`): the planned filament of
@@ -272,10 +342,7 @@ impl Motion {
     /// nowhere hands its filament on) over the LIN's length; a step only where it changes by
     /// more than the output's rounding.
     fn feed(&mut self, path: &ToolPath, pose: &Pose, point: usize) {
-        let Some((last, from)) = self.steps.iter().rev().find_map(|s| match s {
-            Step::Move { pose, point, .. } => Some((*pose, *point)),
-            _ => None,
-        }) else {
+        let Some((last, from)) = self.last else {
             return;
         };
         let length = norm(sub(pose.t, last.t));
@@ -290,17 +357,13 @@ impl Motion {
         let ratio = e / length;
         if self.feed.is_none_or(|f| (f - ratio).abs() > 1e-7) {
             self.feed = Some(ratio);
-            self.steps.push(Step::Feed(ratio));
+            self.steps.push_back(Step::Feed(ratio));
         }
     }
 
     /// Whether `pose` is the previous motion's (within 1e-9 mm and 1e-9°).
     fn goes_nowhere(&self, pose: &Pose) -> bool {
-        let last = self.steps.iter().rev().find_map(|s| match s {
-            Step::Move { pose, .. } => Some(*pose),
-            _ => None,
-        });
-        last.is_some_and(|last| {
+        self.last.is_some_and(|(last, _)| {
             norm(sub(last.t, pose.t)) < 1e-9 && rotation_angle_deg(&last.r, &pose.r) < 1e-9
         })
     }
@@ -308,7 +371,8 @@ impl Motion {
     /// A motion, unless it would go nowhere.
     fn motion(&mut self, ptp: bool, pose: Pose, point: usize) {
         if !self.goes_nowhere(&pose) {
-            self.steps.push(Step::Move { ptp, pose, point });
+            self.last = Some((pose, point));
+            self.steps.push_back(Step::Move { ptp, pose, point });
         }
     }
 
