@@ -113,6 +113,11 @@ struct Ctx {
     /// most 0.25 % of the width (small, because each ring is offset from the simplified one
     /// before it and the error adds up).
     tol: f64,
+    /// How far a contour-fill ring may be simplified where it is laid, mm: a tenth of the
+    /// feature's tolerance, at most 1 % of the width (the chord error of the offsets' arcs).
+    /// Each ring is simplified on its own for printing (the next one is offset from it
+    /// before), so this error does not add up from ring to ring.
+    print_tol: f64,
 }
 
 /// Paths filling `regions` for layer number `layer` (for zig-zag angle alternation), bead width
@@ -190,6 +195,7 @@ pub fn fill_layer(
             spacing,
             join: round_join(tol.min(0.01 * width), deepest.min(0.5 * size)),
             tol: tol.min(0.0025 * width),
+            print_tol: ring_print_tolerance(tol, width),
         };
         let lines_from = out.len();
         match params.path_mode {
@@ -247,6 +253,13 @@ pub fn fill_layer(
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
     }
+}
+
+/// How far (mm) a contour-fill ring may move where it is simplified for printing, for a
+/// feature tolerance `tol` and beads `width` wide: a tenth of the tolerance, at most 1 % of
+/// the width (what the offsets' arcs are chorded within already).
+fn ring_print_tolerance(tol: f64, width: f64) -> f64 {
+    (0.1 * tol).min(0.01 * width)
 }
 
 /// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]

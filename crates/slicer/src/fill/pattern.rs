@@ -1,7 +1,7 @@
 //! The paths of the fill patterns: rings inward from the boundary (with the gap fill of the
 //! strips they leave) and scan lines across an area, free or chained into zig-zags.
 
-use super::offset::{clean_offset, dilate_sharp, drop_specks, erode, simplify};
+use super::offset::{clean_offset, dilate_sharp, drop_specks, erode, simplify, simplify_ring};
 use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
@@ -75,7 +75,12 @@ pub(super) fn drop_short_segments(pts: &mut Vec<Point2>) {
 /// disk took 0.7 s at its radius). With `thin`, rings after the first are simplified within
 /// the chord tolerance, so that inner rings are not as dense as the boundary (contour fill,
 /// where rings go all the way in); contour-zig-zag keeps its few perimeters exact, so its
-/// infill lines end exactly on the offset boundary.
+/// infill lines end exactly on the offset boundary. With `thin`, too, every ring is laid
+/// simplified within the print tolerance (`Ctx::print_tol`): i_overlay's offsets leave runs
+/// of points micrometres apart (the two ends of neighbouring offset edges, arcs of a small
+/// radius chorded as finely as the deepest ring's), which only multiply the plan's points.
+/// The next ring is offset from the ring before this simplification, so the error does not
+/// add up.
 pub(super) fn rings(
     base: &Shapes,
     ctx: &Ctx,
@@ -121,8 +126,13 @@ pub(super) fn rings(
             Role::Perimeter
         };
         for c in ring.iter().flatten() {
-            let mut pts = c.clone();
-            pts.push(c[0]);
+            let mut pts = if thin {
+                simplify_ring(c.clone(), ctx.print_tol)
+            } else {
+                c.clone()
+            };
+            let Some(&first) = pts.first() else { continue };
+            pts.push(first);
             out.push(Path2 {
                 points: pts,
                 kind: PathKind::Perimeter,
