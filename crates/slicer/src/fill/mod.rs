@@ -39,7 +39,7 @@ use crate::params::{LayerParams, PathMode};
 use crate::toolpath::Role;
 use i_overlay::mesh::float::style::LineJoin;
 use offset::{erode, offset, round_join};
-use pattern::{drop_short_segments, rings, scan_fill, Reach};
+use pattern::{drop_short_segments, rings, scan_fill, Reach, OPEN_SHARE};
 use region::{bounds, region_shapes, shape_region};
 
 pub use crate::geom2d::{Point2, Region};
@@ -109,6 +109,12 @@ struct Ctx {
     spacing: f64,
     /// Join of inward offsets (arcs at reflex corners).
     join: LineJoin<f64>,
+    /// Join of the erosion a ring's opening grows straight back (`pattern::opening`), whose
+    /// arcs never grow deeper than that erosion: in contour mode chorded for its depth, not
+    /// for the deepest ring's (an arc chorded that finely, some hundred points micrometres
+    /// apart, is grown back into its centre, and i_overlay meets every pair of its segments
+    /// there). The same as `join` in the other modes.
+    open_join: LineJoin<f64>,
     /// How far contour fill's inner rings may be simplified, mm: the feature's tolerance, at
     /// most 0.25 % of the width (small, because each ring is offset from the simplified one
     /// before it and the error adds up).
@@ -190,10 +196,16 @@ pub fn fill_layer(
                     PathMode::Contour => f64::INFINITY,
                     PathMode::ContourZigzag => params.perimeters as f64,
                 };
+        let join = round_join(tol.min(0.01 * width), deepest.min(0.5 * size));
+        let open_join = match params.path_mode {
+            PathMode::Contour => round_join(tol.min(0.01 * width), OPEN_SHARE * spacing),
+            _ => join.clone(),
+        };
         let ctx = Ctx {
             width,
             spacing,
-            join: round_join(tol.min(0.01 * width), deepest.min(0.5 * size)),
+            join,
+            open_join,
             tol: tol.min(0.0025 * width),
             print_tol: ring_print_tolerance(tol, width),
         };

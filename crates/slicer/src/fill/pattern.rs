@@ -170,13 +170,13 @@ fn line_fill(strips: Shapes, ctx: &Ctx, out: &mut Vec<Path2>) {
 /// A ring keeps only the parts of its offset at least `2 · OPEN_SHARE` spacings wide: where
 /// the offset is narrower, the ring's beads from either side overlap by more than a tenth of
 /// a bead (a ring about a part exactly a spacing wide covers it, beads edge to edge).
-const OPEN_SHARE: f64 = 0.45;
+pub(super) const OPEN_SHARE: f64 = 0.45;
 
 /// `cur` without its parts narrower than `2·d`: eroded by `d` and grown back by `d` with
 /// mitred corners, so that convex corners come back sharp (bevelled only past 9°), and
 /// clipped to `cur` (a mitre grown from where the erosion pinched a neck would stick out).
 fn opening(cur: &Shapes, d: f64, ctx: &Ctx) -> Shapes {
-    let core = erode(cur, d, &ctx.join);
+    let core = erode(cur, d, &ctx.open_join);
     if core.is_empty() {
         return core;
     }
