@@ -222,10 +222,11 @@ pub fn fill_two5d(
 }
 
 /// Each layer's paths from its section's regions, filled in parallel. A layer whose section is
-/// the same polygon as an earlier layer's of the same parity ([`SectionKey`]; the zig-zag's
-/// angle turns every other layer, and nothing else of a fill depends on the layer) takes a copy
-/// of that layer's fill instead of making it again: the layers of a prism are all one section.
-/// Bottom and top layers then get their solid skins.
+/// the same polygon as an earlier layer's ([`SectionKey`]) of the same parity where the fill
+/// alternates ([`alternates`]: the zig-zag's angle turns every other layer, and nothing else of
+/// a fill depends on the layer) takes a copy of that layer's fill instead of making it again:
+/// the layers of a prism are all one section. Bottom and top layers then get their solid
+/// skins.
 fn fill_sections(
     sections: Vec<Vec<Region>>,
     params: &LayerParams,
@@ -233,12 +234,21 @@ fn fill_sections(
     spacing: f64,
 ) -> Vec<Vec<FillPath>> {
     let n = sections.len();
+    let mut sections = sections;
+    if params.path_mode == PathMode::Contour {
+        sections.par_iter_mut().for_each(|r| canonical_order(r));
+    }
     let keys: Vec<SectionKey> = sections.par_iter().map(|r| SectionKey::new(r)).collect();
     // The first layer with each section and parity; every layer points at its first.
     let mut first: Vec<usize> = Vec::with_capacity(n);
     let mut seen: crate::fast_hash::FastMap<(u64, usize), Vec<usize>> = Default::default();
     for (layer, key) in keys.iter().enumerate() {
-        let same = seen.entry((key.hash, layer % 2)).or_default();
+        let parity = if alternates(params.path_mode) {
+            layer % 2
+        } else {
+            0
+        };
+        let same = seen.entry((key.hash, parity)).or_default();
         match same.iter().find(|&&j| keys[j].rings == key.rings) {
             Some(&j) => first.push(j),
             None => {
@@ -271,6 +281,36 @@ fn fill_sections(
             solid_on_skins(paths, layer, n)
         })
         .collect()
+}
+
+/// Puts a section's regions, and each region's holes, in an order of their own (by their
+/// least vertex, x then y: a corner, never a point where the plane crosses a face's diagonal),
+/// not the order the section found its loops in, which changes from layer to layer: a prism's
+/// layers then have one [`SectionKey`] and share their fill. Only for contour fills, whose
+/// paths come in this order (the other modes keep the order they have always had).
+fn canonical_order(regions: &mut [Region]) {
+    let least = |ring: &[Point2]| {
+        ring.iter()
+            .copied()
+            .min_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal))
+            .unwrap_or([0.0; 2])
+    };
+    let by_least = |a: &[Point2], b: &[Point2]| {
+        least(a)
+            .partial_cmp(&least(b))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    };
+    for r in regions.iter_mut() {
+        r.holes.sort_by(|a, b| by_least(a, b));
+    }
+    regions.sort_by(|a, b| by_least(&a.outer, &b.outer));
+}
+
+/// True when the fill of `mode` turns from layer to layer (every other layer's zig-zag runs
+/// at 90° to the one before), so that only layers of the same parity may share a fill. Raster
+/// lines keep one angle, and contour rings and their gap fill depend on the section alone.
+fn alternates(mode: PathMode) -> bool {
+    matches!(mode, PathMode::Zigzag | PathMode::ContourZigzag)
 }
 
 /// A layer's section as a polygon, to find layers cut through the same one: each ring without
@@ -493,6 +533,71 @@ mod tests {
             .holes
             .push(vec![[5.0, -5.0], [5.0, -10.0], [10.0, -10.0], [10.0, -5.0]]);
         assert_ne!(SectionKey::new(&holed), a);
+    }
+
+    /// The modes whose layers of either parity share a fill ([`alternates`] false) fill a
+    /// section the same on even and odd layers, rings, their gap fill and beads as wide as a
+    /// thin web included: a plate with a round hole and a slot that leaves a web 0.7 mm wide
+    /// (under two beads), and the zig-zag modes, which turn, do not.
+    #[test]
+    fn only_turning_fills_depend_on_the_layer_parity() {
+        let hole: Vec<Point2> = (0..96)
+            .map(|i| {
+                let t = -2.0 * std::f64::consts::PI * i as f64 / 96.0;
+                [6.0 + 3.0 * t.cos(), 6.0 + 3.0 * t.sin()]
+            })
+            .collect();
+        let slot = vec![[12.0, 10.0], [12.0, 2.0], [19.3, 2.0], [19.3, 10.0]];
+        let outer = vec![[0.0, 0.0], [20.0, 0.0], [20.0, 12.0], [0.0, 12.0]];
+        let regions = regions_from_loops(&[outer, hole, slot]);
+        assert_eq!(regions.len(), 1);
+        assert_eq!(regions[0].holes.len(), 2);
+        for mode in [
+            PathMode::Raster,
+            PathMode::Zigzag,
+            PathMode::Contour,
+            PathMode::ContourZigzag,
+        ] {
+            let params = LayerParams {
+                path_mode: mode,
+                ..LayerParams::default()
+            };
+            let fill = |layer| fill_regions(regions.clone(), &params, layer, 0.45, 0.45);
+            let (even, odd) = (fill(2), fill(3));
+            assert!(!even.is_empty());
+            assert_eq!(even == odd, !alternates(mode), "{mode:?}");
+        }
+    }
+
+    /// A section whose loops come in another order (as a mesh's section finds them, from
+    /// layer to layer; holes of one area keep it when grouped into regions, largest first)
+    /// is, for contour fills, put in the same order: one key, and the layers
+    /// get the same paths, in the same order.
+    #[test]
+    fn contour_sections_in_another_loop_order_share_their_fill() {
+        let square = |x: f64, y: f64, s: f64| vec![[x, y], [x, y + s], [x + s, y + s], [x + s, y]];
+        let outer = vec![[0.0, 0.0], [30.0, 0.0], [30.0, 12.0], [0.0, 12.0]];
+        let loops = [
+            outer,
+            square(3.0, 3.0, 4.0),
+            square(12.0, 4.0, 4.0),
+            square(20.0, 2.0, 4.0),
+        ];
+        let mut other = loops.clone();
+        other.swap(1, 3);
+        let (a, b) = (regions_from_loops(&loops), regions_from_loops(&other));
+        assert_ne!(SectionKey::new(&a), SectionKey::new(&b));
+        let (mut ca, mut cb) = (a.clone(), b.clone());
+        canonical_order(&mut ca);
+        canonical_order(&mut cb);
+        assert_eq!(SectionKey::new(&ca), SectionKey::new(&cb));
+        let params = LayerParams {
+            path_mode: PathMode::Contour,
+            ..LayerParams::default()
+        };
+        let filled = fill_sections(vec![a, b.clone(), b], &params, 0.45, 0.45);
+        assert!(!filled[1].is_empty());
+        assert_eq!(filled[0], filled[1]);
     }
 
     /// Layers taking an earlier layer's fill get what filling their own section gives, for

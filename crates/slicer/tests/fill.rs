@@ -1228,3 +1228,59 @@ fn paths_carry_the_roles_slicers_name() {
     );
     assert!(paths.iter().any(|p| p.role == Role::ExternalPerimeter));
 }
+
+/// Contour rings are laid simplified within a tenth of the feature's tolerance (0.005 mm, at
+/// most 1 % of the 0.4 mm width): about a 1024-sided hole of radius 3 mm, each ring that
+/// runs round it alone stays, between its points too, within that of the circle its offset
+/// is, its rings stay a spacing apart, and it has no more points than twice what a chord
+/// sag of that tolerance needs (an offset keeps every vertex of the ring before it, and
+/// i_overlay puts two at each: the hole's 1024 and more).
+#[test]
+fn contour_rings_are_simplified_within_the_tolerance() {
+    let c = [15.0, 15.0];
+    let r = Region {
+        outer: rect(0.0, 0.0, 30.0, 30.0),
+        holes: vec![circle(c, 3.0, 1024, false)],
+    };
+    let p = params(PathMode::Contour);
+    let tol = (0.1 * p.tolerance).min(0.01 * 0.4);
+    let paths = fill_layer(&[r], &p, 0, 0.4, 0.4).paths;
+    let radius = |q: &Point2| (q[0] - c[0]).hypot(q[1] - c[1]);
+    let mut hole_rings: Vec<(f64, &Path2)> = paths
+        .iter()
+        .filter(|path| path.kind == PathKind::Perimeter)
+        .filter_map(|path| {
+            let (lo, hi) = path
+                .points
+                .iter()
+                .map(radius)
+                .fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
+                    (lo.min(d), hi.max(d))
+                });
+            (hi < 8.0 && hi - lo < 0.05).then_some((hi, path))
+        })
+        .collect();
+    hole_rings.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!(
+        hole_rings.len() >= 8,
+        "{} rings about the hole",
+        hole_rings.len()
+    );
+    for (k, (_, ring)) in hole_rings.iter().enumerate() {
+        let rho = 3.0 + 0.2 + 0.4 * k as f64;
+        // The ring's points and the middles of its chords (where a chord strays farthest).
+        for w in ring.points.windows(2) {
+            let mid = [0.5 * (w[0][0] + w[1][0]), 0.5 * (w[0][1] + w[1][1])];
+            for q in [w[0], mid] {
+                let e = radius(&q) - rho;
+                assert!(e.abs() <= tol + 1e-4, "ring {k}: {e} off radius {rho}");
+            }
+        }
+        let need = PI / (1.0 - tol / rho).acos();
+        let n = ring.points.len() - 1;
+        assert!(
+            (n as f64) <= 2.0 * need + 8.0,
+            "ring {k}: {n} points, {need:.0} needed"
+        );
+    }
+}

@@ -39,7 +39,7 @@ use crate::params::{LayerParams, PathMode};
 use crate::toolpath::Role;
 use i_overlay::mesh::float::style::LineJoin;
 use offset::{erode, offset, round_join};
-use pattern::{drop_short_segments, rings, scan_fill, Reach};
+use pattern::{drop_short_segments, rings, scan_fill, Reach, OPEN_SHARE};
 use region::{bounds, region_shapes, shape_region};
 
 pub use crate::geom2d::{Point2, Region};
@@ -109,10 +109,21 @@ struct Ctx {
     spacing: f64,
     /// Join of inward offsets (arcs at reflex corners).
     join: LineJoin<f64>,
+    /// Join of the erosion a ring's opening grows straight back (`pattern::opening`), whose
+    /// arcs never grow deeper than that erosion: in contour mode chorded for its depth, not
+    /// for the deepest ring's (an arc chorded that finely, some hundred points micrometres
+    /// apart, is grown back into its centre, and i_overlay meets every pair of its segments
+    /// there). The same as `join` in the other modes.
+    open_join: LineJoin<f64>,
     /// How far contour fill's inner rings may be simplified, mm: the feature's tolerance, at
     /// most 0.25 % of the width (small, because each ring is offset from the simplified one
     /// before it and the error adds up).
     tol: f64,
+    /// How far a contour-fill ring may be simplified where it is laid, mm: a tenth of the
+    /// feature's tolerance, at most 1 % of the width (the chord error of the offsets' arcs).
+    /// Each ring is simplified on its own for printing (the next one is offset from it
+    /// before), so this error does not add up from ring to ring.
+    print_tol: f64,
 }
 
 /// Paths filling `regions` for layer number `layer` (for zig-zag angle alternation), bead width
@@ -185,11 +196,18 @@ pub fn fill_layer(
                     PathMode::Contour => f64::INFINITY,
                     PathMode::ContourZigzag => params.perimeters as f64,
                 };
+        let join = round_join(tol.min(0.01 * width), deepest.min(0.5 * size));
+        let open_join = match params.path_mode {
+            PathMode::Contour => round_join(tol.min(0.01 * width), OPEN_SHARE * spacing),
+            _ => join.clone(),
+        };
         let ctx = Ctx {
             width,
             spacing,
-            join: round_join(tol.min(0.01 * width), deepest.min(0.5 * size)),
+            join,
+            open_join,
             tol: tol.min(0.0025 * width),
+            print_tol: ring_print_tolerance(tol, width),
         };
         let lines_from = out.len();
         match params.path_mode {
@@ -247,6 +265,13 @@ pub fn fill_layer(
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
     }
+}
+
+/// How far (mm) a contour-fill ring may move where it is simplified for printing, for a
+/// feature tolerance `tol` and beads `width` wide: a tenth of the tolerance, at most 1 % of
+/// the width (what the offsets' arcs are chorded within already).
+fn ring_print_tolerance(tol: f64, width: f64) -> f64 {
+    (0.1 * tol).min(0.01 * width)
 }
 
 /// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]

@@ -165,7 +165,10 @@ pub(super) fn simplify(shapes: Shapes, tol: f64) -> Shapes {
         .collect()
 }
 
-fn simplify_ring(c: Contour, tol: f64) -> Contour {
+/// Douglas-Peucker on one closed contour (see [`simplify`]): every dropped vertex lies within
+/// `tol` of the contour left, whose vertices are original ones. Contours of four points or
+/// fewer, and any that would lose all their area, come back as they were.
+pub(super) fn simplify_ring(c: Contour, tol: f64) -> Contour {
     let n = c.len();
     if n <= 4 {
         return c;

@@ -1,7 +1,7 @@
 //! The paths of the fill patterns: rings inward from the boundary (with the gap fill of the
 //! strips they leave) and scan lines across an area, free or chained into zig-zags.
 
-use super::offset::{clean_offset, dilate_sharp, drop_specks, erode, simplify};
+use super::offset::{clean_offset, dilate_sharp, drop_specks, erode, simplify, simplify_ring};
 use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
@@ -75,7 +75,12 @@ pub(super) fn drop_short_segments(pts: &mut Vec<Point2>) {
 /// disk took 0.7 s at its radius). With `thin`, rings after the first are simplified within
 /// the chord tolerance, so that inner rings are not as dense as the boundary (contour fill,
 /// where rings go all the way in); contour-zig-zag keeps its few perimeters exact, so its
-/// infill lines end exactly on the offset boundary.
+/// infill lines end exactly on the offset boundary. With `thin`, too, every ring is laid
+/// simplified within the print tolerance (`Ctx::print_tol`): i_overlay's offsets leave runs
+/// of points micrometres apart (the two ends of neighbouring offset edges, arcs of a small
+/// radius chorded as finely as the deepest ring's), which only multiply the plan's points.
+/// The next ring is offset from the ring before this simplification, so the error does not
+/// add up.
 pub(super) fn rings(
     base: &Shapes,
     ctx: &Ctx,
@@ -121,8 +126,13 @@ pub(super) fn rings(
             Role::Perimeter
         };
         for c in ring.iter().flatten() {
-            let mut pts = c.clone();
-            pts.push(c[0]);
+            let mut pts = if thin {
+                simplify_ring(c.clone(), ctx.print_tol)
+            } else {
+                c.clone()
+            };
+            let Some(&first) = pts.first() else { continue };
+            pts.push(first);
             out.push(Path2 {
                 points: pts,
                 kind: PathKind::Perimeter,
@@ -160,13 +170,13 @@ fn line_fill(strips: Shapes, ctx: &Ctx, out: &mut Vec<Path2>) {
 /// A ring keeps only the parts of its offset at least `2 · OPEN_SHARE` spacings wide: where
 /// the offset is narrower, the ring's beads from either side overlap by more than a tenth of
 /// a bead (a ring about a part exactly a spacing wide covers it, beads edge to edge).
-const OPEN_SHARE: f64 = 0.45;
+pub(super) const OPEN_SHARE: f64 = 0.45;
 
 /// `cur` without its parts narrower than `2·d`: eroded by `d` and grown back by `d` with
 /// mitred corners, so that convex corners come back sharp (bevelled only past 9°), and
 /// clipped to `cur` (a mitre grown from where the erosion pinched a neck would stick out).
 fn opening(cur: &Shapes, d: f64, ctx: &Ctx) -> Shapes {
-    let core = erode(cur, d, &ctx.join);
+    let core = erode(cur, d, &ctx.open_join);
     if core.is_empty() {
         return core;
     }
