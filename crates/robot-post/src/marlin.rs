@@ -100,6 +100,16 @@ pub fn marlin_to(
     file.finish(&w.out)
 }
 
+/// Appends `code X.. Y.. Z..` (the machine position `t`, 0.001 mm) to `out`, straight into
+/// the text: a plan writes millions of these moves.
+fn push_move(out: &mut String, code: &str, t: [f64; 3]) {
+    out.push_str(code);
+    for (word, x) in [" X", " Y", " Z"].into_iter().zip(t) {
+        out.push_str(word);
+        push_fixed(out, x, 3);
+    }
+}
+
 /// Whether `axis` is +Z within [`AXIS_TOLERANCE`].
 fn is_plus_z(axis: [f64; 3]) -> bool {
     axis[0].abs() <= AXIS_TOLERANCE
@@ -297,14 +307,8 @@ impl Writer {
             self.hopped = true;
         }
         let z = if self.hopped { self.hop_z(t[2]) } else { t[2] };
-        // Straight into the text: a plan writes millions of these lines.
         let out = &mut self.out;
-        out.push_str("G0 X");
-        push_fixed(out, t[0], 3);
-        out.push_str(" Y");
-        push_fixed(out, t[1], 3);
-        out.push_str(" Z");
-        push_fixed(out, z, 3);
+        push_move(out, "G0", [t[0], t[1], z]);
         out.push_str(" F");
         out.push_str(&self.travel_f);
         out.push('\n');
@@ -331,14 +335,8 @@ impl Writer {
         } else {
             &self.print_f
         };
-        // Straight into the text: a plan writes millions of these lines.
         let out = &mut self.out;
-        out.push_str("G1 X");
-        push_fixed(out, t[0], 3);
-        out.push_str(" Y");
-        push_fixed(out, t[1], 3);
-        out.push_str(" Z");
-        push_fixed(out, t[2], 3);
+        push_move(out, "G1", t);
         if de != 0 {
             out.push_str(" E");
             push_e_text(out, de);

@@ -491,6 +491,14 @@ impl Two5dFill {
 mod tests {
     use super::*;
 
+    /// Every path mode.
+    const EVERY_MODE: [PathMode; 4] = [
+        PathMode::Raster,
+        PathMode::Zigzag,
+        PathMode::Contour,
+        PathMode::ContourZigzag,
+    ];
+
     /// A 20 × 30 mm rectangle as a section cuts it, with a point where the plane crosses each
     /// side face's diagonal at `t` of the way along.
     fn cut_box(t: f64) -> Vec<Region> {
@@ -552,12 +560,7 @@ mod tests {
         let regions = regions_from_loops(&[outer, hole, slot]);
         assert_eq!(regions.len(), 1);
         assert_eq!(regions[0].holes.len(), 2);
-        for mode in [
-            PathMode::Raster,
-            PathMode::Zigzag,
-            PathMode::Contour,
-            PathMode::ContourZigzag,
-        ] {
+        for mode in EVERY_MODE {
             let params = LayerParams {
                 path_mode: mode,
                 ..LayerParams::default()
@@ -604,12 +607,7 @@ mod tests {
     /// every path mode: the fill depends on the layer only through its parity.
     #[test]
     fn a_repeated_section_gets_the_fill_its_own_would_give() {
-        for mode in [
-            PathMode::Raster,
-            PathMode::Zigzag,
-            PathMode::Contour,
-            PathMode::ContourZigzag,
-        ] {
+        for mode in EVERY_MODE {
             let params = LayerParams {
                 path_mode: mode,
                 ..LayerParams::default()
