@@ -2,7 +2,7 @@
 //! text of every post (KUKA's KRL too).
 
 use crate::machine::MachineProfile;
-use toolpath::{push_fixed, MoveKind, PathPoint, Role};
+use toolpath::{push_fixed, push_scaled, MoveKind, PathPoint, Role};
 
 /// `s` with line breaks and other control characters replaced by spaces, for comments (G-code
 /// and KRL alike: a comment never spills onto a new line).
@@ -165,31 +165,7 @@ pub(crate) fn e_text(units: i64) -> String {
 
 /// Appends [`e_text`]`(units)` to `out` without a new allocation.
 pub(crate) fn push_e_text(out: &mut String, units: i64) {
-    if units < 0 {
-        out.push('-');
-    }
-    let a = units.unsigned_abs();
-    let mut digits = [0u8; 20];
-    let mut n = a / 100_000;
-    let mut k = digits.len();
-    loop {
-        k -= 1;
-        digits[k] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
-    }
-    // ASCII digits.
-    out.extend(digits[k..].iter().map(|&d| d as char));
-    out.push('.');
-    let mut frac = a % 100_000;
-    let mut five = [b'0'; 5];
-    for d in five.iter_mut().rev() {
-        *d = b'0' + (frac % 10) as u8;
-        frac /= 10;
-    }
-    out.extend(five.iter().map(|&d| d as char));
+    push_scaled(out, units < 0, units.unsigned_abs(), 5);
 }
 
 #[cfg(test)]

@@ -68,8 +68,10 @@ fn scaled(x: f64, decimals: usize) -> Option<(bool, u64)> {
     u64::try_from(q).ok().map(|q| (negative, q))
 }
 
-/// Writes the integer `n` as a fixed-point number with `decimals` places.
-fn push_scaled(out: &mut String, negative: bool, n: u64, decimals: usize) {
+/// Writes the integer `n` as a fixed-point number with `decimals` places (at most 19),
+/// `-` before it when `negative` and `n` is not 0: `n = 7, decimals = 5` is `0.00007`. For
+/// quantities kept in integer units (a program's E, in 0.00001 mm).
+pub fn push_scaled(out: &mut String, negative: bool, n: u64, decimals: usize) {
     let mut digits = [0u8; 40];
     let mut len = 0;
     let mut v = n;

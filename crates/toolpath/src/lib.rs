@@ -18,6 +18,6 @@ mod role;
 pub mod vec3;
 
 pub use bead::Bead;
-pub use fixed::{fixed, push_fixed};
+pub use fixed::{fixed, push_fixed, push_scaled};
 pub use path::{MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};
 pub use role::Role;
