@@ -1,7 +1,8 @@
 //! The machine program's files as the post writes them ([`plan::plan_into`]), and
-//! `toolpath.csv` as it is written beside them: each under a temporary name in the output folder, renamed into place only when the whole plan passed
-//! its checks ([`Staged::commit`]), removed otherwise (dropped uncommitted), with the folder
-//! when it was made for them. So a program of hundreds of megabytes is never held in memory,
+//! `toolpath.csv` as it is written beside them: each under a temporary name in the output
+//! folder, renamed into place only when the whole plan passed its checks
+//! ([`Staged::commit`]), removed otherwise (dropped uncommitted), with the folders made for
+//! them. So a program of hundreds of megabytes is never held in memory,
 //! and a failed plan still leaves nothing that looks complete.
 
 use crate::mesh::TempFile;

@@ -434,9 +434,10 @@ pub fn plan_into(
             let path = &toolpath;
             let lines = scope.spawn(move || path.write_csv(&mut &mut *w).and_then(|()| w.flush()));
             let program = post.post_to(&toolpath, &job, sink);
+            // A panic in the writer is a panic of the plan, as on this thread.
             let csv = lines
                 .join()
-                .unwrap_or_else(|_| Err(std::io::Error::other("toolpath.csv's writer panicked")));
+                .unwrap_or_else(|p| std::panic::resume_unwind(p));
             (program, csv)
         }),
         None => (post.post_to(&toolpath, &job, sink), Ok(())),
