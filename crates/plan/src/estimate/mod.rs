@@ -83,19 +83,10 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
         let (mut printing, mut stop, mut any) = (false, true, false);
         pts.windows(2).filter_map(move |w| {
             let (a, q) = (&w[0], &w[1]);
-            match q.kind {
-                MoveKind::Print => {
-                    if !printing && retracts && any {
-                        stop = true;
-                    }
-                    printing = true;
-                }
-                MoveKind::Travel => {
-                    if printing && retracts {
-                        stop = true;
-                    }
-                    printing = false;
-                }
+            match filament_turn(&mut printing, q.kind) {
+                Some(Turn::Retract) => stop |= retracts,
+                Some(Turn::Resume) => stop |= retracts && any,
+                None => {}
             }
             long(a, q).then(|| {
                 any = true;
@@ -114,17 +105,11 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
     let mut filament = 0.0;
     let mut printing = false;
     for q in pts.iter().skip(1) {
-        match q.kind {
-            MoveKind::Print => {
-                filament += q.e;
-                printing = true;
-            }
-            MoveKind::Travel => {
-                if printing && retracts {
-                    retraction_time += 2.0 * machine.retraction_length / machine.retraction_speed;
-                }
-                printing = false;
-            }
+        if q.kind == MoveKind::Print {
+            filament += q.e;
+        }
+        if filament_turn(&mut printing, q.kind) == Some(Turn::Retract) && retracts {
+            retraction_time += 2.0 * machine.retraction_length / machine.retraction_speed;
         }
     }
     let area = std::f64::consts::PI * machine.filament_diameter.powi(2) / 4.0;
@@ -133,6 +118,27 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
         time_s: motion::time_of(moves, reversed, jerk) + retraction_time,
         filament_mm: filament,
         filament_g: filament * area * density,
+    }
+}
+
+/// Where the filament is retracted or fed back (with a retraction in the profile).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Turn {
+    /// A travel after printing: the filament is retracted.
+    Retract,
+    /// Printing after travel: the filament is fed back.
+    Resume,
+}
+
+/// The turn a move of `kind` makes after the moves before it (`printing`: the last one
+/// printed, updated), if any.
+fn filament_turn(printing: &mut bool, kind: MoveKind) -> Option<Turn> {
+    let now = kind == MoveKind::Print;
+    let was = std::mem::replace(printing, now);
+    match (was, now) {
+        (true, false) => Some(Turn::Retract),
+        (false, true) => Some(Turn::Resume),
+        _ => None,
     }
 }
 
