@@ -236,7 +236,7 @@ fn fill_sections(
     let n = sections.len();
     let mut sections = sections;
     if params.path_mode == PathMode::Contour {
-        sections.par_iter_mut().for_each(|r| canonical_order(r));
+        sections.par_iter_mut().for_each(canonical_order);
     }
     let keys: Vec<SectionKey> = sections.par_iter().map(|r| SectionKey::new(r)).collect();
     // The first layer with each section and parity; every layer points at its first.
@@ -288,22 +288,26 @@ fn fill_sections(
 /// not the order the section found its loops in, which changes from layer to layer: a prism's
 /// layers then have one [`SectionKey`] and share their fill. Only for contour fills, whose
 /// paths come in this order (the other modes keep the order they have always had).
-fn canonical_order(regions: &mut [Region]) {
-    let least = |ring: &[Point2]| {
-        ring.iter()
-            .copied()
-            .min_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal))
-            .unwrap_or([0.0; 2])
-    };
-    let by_least = |a: &[Point2], b: &[Point2]| {
-        least(a)
-            .partial_cmp(&least(b))
-            .unwrap_or(std::cmp::Ordering::Equal)
-    };
+fn canonical_order(regions: &mut Vec<Region>) {
     for r in regions.iter_mut() {
-        r.holes.sort_by(|a, b| by_least(a, b));
+        sort_by_least_vertex(&mut r.holes, |h| h);
     }
-    regions.sort_by(|a, b| by_least(&a.outer, &b.outer));
+    sort_by_least_vertex(regions, |r| &r.outer);
+}
+
+/// `items` sorted (stably) by the least vertex, x then y, of each one's `ring`, found once
+/// per item.
+fn sort_by_least_vertex<T>(items: &mut Vec<T>, ring: impl Fn(&T) -> &[Point2]) {
+    let by = |a: &Point2, b: &Point2| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal);
+    let mut keyed: Vec<(Point2, T)> = items
+        .drain(..)
+        .map(|t| {
+            let least = ring(&t).iter().copied().min_by(by).unwrap_or([0.0; 2]);
+            (least, t)
+        })
+        .collect();
+    keyed.sort_by(|a, b| by(&a.0, &b.0));
+    items.extend(keyed.into_iter().map(|(_, t)| t));
 }
 
 /// True when the fill of `mode` turns from layer to layer (every other layer's zig-zag runs
