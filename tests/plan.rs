@@ -947,3 +947,131 @@ fn every_corpus_plan_passes_its_self_check_or_exits_2_naming_why() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// What the library makes of `part` with the command line's `args` (placement, `--set`,
+/// `--strict`, `--keep-going`), through the same settings and stages: the plan, or the gate
+/// that refused it.
+fn plan_in_library(
+    part: &Path,
+    machine: &str,
+    placement: plan::Placement,
+    sets: &[&str],
+    strict: bool,
+) -> Result<plan::Plan, plan::PlanError> {
+    let sources = plan::settings::Sources {
+        part: part.to_path_buf(),
+        machine: Some(machine.into()),
+        set: sets.iter().map(|s| s.to_string()).collect(),
+        ..Default::default()
+    };
+    let (process, machine) = plan::settings::load(&sources).expect("settings");
+    let file = brep::StepFile::read(part).expect("reads");
+    let options = plan::Options {
+        source: part.display().to_string(),
+        stem: "part".into(),
+        placement,
+        strict,
+        allow_collisions: true,
+        ..Default::default()
+    };
+    let mut sink = robot_post::InMemory::default();
+    let mut csv: Vec<u8> = vec![];
+    let plan = plan::plan_file_into(
+        &file,
+        &process,
+        &machine,
+        &options,
+        &mut sink,
+        Some(&mut csv),
+    )?;
+    assert_eq!(csv, {
+        let mut again = vec![];
+        plan.toolpath.write_csv(&mut again).expect("csv");
+        again
+    });
+    Ok(plan)
+}
+
+#[test]
+fn the_library_plans_as_the_command_line_does() {
+    // Passes: --orient auto and --set, the same placement, features, path and figures.
+    let part = fixture("plate_boss_boss.step");
+    let (_dir, cli, csv, _, _) = plan_part(
+        &part,
+        &["--orient", "auto", "--set", "uniform_layer_height=0.25"],
+    );
+    let lib = plan_in_library(
+        &part,
+        "marlin",
+        plan::Placement::Auto,
+        &["uniform_layer_height=0.25"],
+        false,
+    )
+    .expect("plans");
+    let mut lib_csv = vec![];
+    lib.toolpath.write_csv(&mut lib_csv).expect("csv");
+    assert_eq!(String::from_utf8_lossy(&lib_csv), csv);
+    let mut report = serde_json::to_value(&lib.report).expect("json");
+    report["outputs"] = cli["outputs"].clone();
+    report["source"] = cli["source"].clone();
+    assert_eq!(report, cli);
+    assert_eq!(
+        cli["placement"]["rule"]
+            .as_str()
+            .map(|r| r.starts_with("auto")),
+        Some(true)
+    );
+    assert_eq!(
+        cli["settings"]["process"]["defaults"]["uniform_layer_height"],
+        0.25
+    );
+
+    // Refused by --strict: the command line exits 2 with the count of warnings the library's
+    // gate refuses.
+    let part = fixture("stacked_solids.step");
+    let out = Command::new(BIN)
+        .args(["plan", "--strict", "--allow-collisions", "-o"])
+        .arg(std::env::temp_dir().join(format!("features-strict-{}", std::process::id())))
+        .arg(&part)
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    match plan_in_library(&part, "marlin", plan::Placement::AsModelled, &[], true) {
+        Err(plan::PlanError::Refused {
+            gate: plan::Gate::Strict(n),
+            plan,
+        }) => {
+            assert!(n > 0);
+            assert_eq!(plan.warnings().len(), n);
+            assert!(
+                stderr.contains(&format!("{n} warning(s) (listed above) and --strict")),
+                "{stderr}"
+            );
+        }
+        other => panic!(
+            "not refused by strict: {:?}",
+            other.map(|p| p.report.warnings)
+        ),
+    }
+
+    // Fails: the self-check gate refuses SolidWorks' leg fork in the library as on the
+    // command line (a_plan_that_loses_material_exits_2_naming_the_feature_and_writes_nothing).
+    let part =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus/sw2017_leg_fork.step");
+    if part.exists() {
+        match plan_in_library(&part, "marlin", plan::Placement::AsModelled, &[], false) {
+            Err(plan::PlanError::Refused {
+                gate: plan::Gate::SelfCheck(problems),
+                plan,
+            }) => {
+                assert_eq!(problems.len(), 1);
+                assert!(!plan.report.complete);
+            }
+            other => panic!(
+                "not refused by the self-check: {:?}",
+                other.map(|p| p.report.complete)
+            ),
+        }
+    }
+}

@@ -473,7 +473,7 @@ fn the_progress_bar_covers_the_whole_run_on_a_terminal_only() {
     assert!(elapsed.is_some_and(|s| s >= 1), "no elapsed time: {tty:?}");
     // The print-head check, a second or so on the impeller, shows (a quicker stage may be
     // drawn over before the terminal is redrawn).
-    assert!(tty.contains(plan::STAGES[1]), "{tty:?}");
+    assert!(tty.contains(plan::Stage::HeadCheck.name()), "{tty:?}");
     // The warnings are whole lines among the bar's redraws.
     assert!(tty.contains("features: "), "{tty:?}");
     assert!(out.join("program.gcode").exists());

@@ -35,5 +35,5 @@ pub use step::{error, p21, write};
 
 pub use error::ReadError;
 pub use solid::SolidReport;
-pub use step::{read_step, read_step_bytes, read_step_turned, turn_down, StepPart};
+pub use step::{read_step, read_step_bytes, read_step_turned, turn_down, StepFile, StepPart};
 pub use topology::Brep;

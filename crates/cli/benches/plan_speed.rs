@@ -181,7 +181,7 @@ struct Stages {
 }
 
 /// Plans `step` for `machine` in this process and times its stages by the plan's progress
-/// reports ([`plan::Progress`]): the features up to `Planned`, then each of [`plan::STAGES`]
+/// reports ([`plan::Progress`]): the features up to `Planned`, then each of [`plan::Stage::AFTER_FEATURES`]
 /// to the next (the last to the plan's return).
 fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
     use plan::Progress;
@@ -198,7 +198,7 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         let label = match p {
             Progress::Start { .. } => Some("start"),
             Progress::Planned => Some("planned"),
-            Progress::Stage(s) => Some(s),
+            Progress::Stage(s) => Some(s.name()),
             _ => None,
         };
         if let (Some(l), Ok(mut m)) = (label, marks.lock()) {
@@ -211,6 +211,7 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         allow_collisions: true,
         keep_going: true,
         progress: Some(&mark),
+        ..Default::default()
     };
     let t0 = Instant::now();
     plan::plan(&part, &plan::Process::default(), &machine, &options)
@@ -222,7 +223,7 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
         _ => 0.0,
     };
-    let [smooth, head, program] = plan::STAGES;
+    let [smooth, head, program] = plan::Stage::AFTER_FEATURES.map(plan::Stage::name);
     Ok(Stages {
         features: span(Some(t0), at("planned")),
         smoothing: span(at(smooth), at(head)),

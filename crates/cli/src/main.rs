@@ -8,11 +8,9 @@ mod inspect;
 mod memory;
 mod mesh;
 mod outputs;
-mod placement;
 mod plan;
 mod preview;
 mod profiles;
-mod settings;
 mod staged;
 
 use clap::{Args, Parser, Subcommand};

@@ -1,20 +1,93 @@
-//! `features plan`: reads the settings and the part, runs [`plan::plan`] and writes its files.
+//! `features plan`: the settings, then [`plan::plan_file_into`] (every stage, its gates
+//! included), then the plan's files written: all of them, or none.
 
 use crate::mesh::write_atomic;
 use crate::outputs::Outputs;
-use crate::settings::settings;
 use crate::staged::Staged;
 use crate::{emit, Failure, PlanArgs};
-use plan::{Options, PlanError, Progress};
+use plan::{Gate, Options, Placement, Plan, PlanError, Progress, Stage};
 use std::io::Write as _;
+use std::path::Path;
 
 /// Runs the command.
 pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let path = &args.part;
     // Settings first: a bad process or machine file fails before any work.
-    let (process, machine) = settings(args)?;
+    let (process, machine) = plan::settings::load(&sources(args)).map_err(|e| Failure {
+        path: e.origin,
+        cause: e.cause,
+    })?;
     // Then where the outputs go: a place holding an earlier plan fails before any work too.
     let outputs = Outputs::from_arg(&args.output, machine.kind)?;
+    refuse_earlier(&outputs, args)?;
+    let bar = Bar::new(path);
+    let file = brep::StepFile::read(path).map_err(|e| Failure::new(path, e))?;
+    bar.0.inc(1);
+    bar.0.set_prefix("planning");
+    let progress = |p: Progress| bar.progress(p);
+    let part_stem = path
+        .file_stem()
+        .map_or("part".into(), |s| s.to_string_lossy().into_owned());
+    let options = Options {
+        source: path.display().to_string(),
+        stem: outputs.stem(&part_stem),
+        placement: placement(args),
+        keep_going: args.keep_going,
+        allow_collisions: args.allow_collisions,
+        allow_unreachable: args.allow_unreachable,
+        strict: args.strict,
+        progress: Some(&progress),
+    };
+    // The program goes to its files as the post makes it, under temporary names until every
+    // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise.
+    let mut staged = Staged::new(&outputs);
+    let mut csv = staged
+        .open("toolpath.csv")
+        .map_err(|e| Failure::new(&outputs.dir, format!("cannot write toolpath.csv: {e}")))?;
+    let result = plan::plan_file_into(
+        &file,
+        &process,
+        &machine,
+        &options,
+        &mut staged,
+        Some(&mut csv),
+    );
+    drop(csv);
+    bar.0.inc(1);
+    bar.0.set_prefix("writing");
+    bar.0.set_message("outputs");
+    let process_file = args.process.as_deref().unwrap_or(path);
+    let plan = result.map_err(|e| refused(e, path, process_file, &bar))?;
+    tell_placement(&plan, path, &bar);
+    let warnings = print_warnings(&plan, path, &bar);
+    let summary = write_plan(plan, &outputs, staged, args, warnings)?;
+    bar.0.inc(1);
+    drop(bar);
+    emit(&summary)
+}
+
+/// The settings' sources as the command line gives them.
+fn sources(args: &PlanArgs) -> plan::settings::Sources {
+    plan::settings::Sources {
+        part: args.part.clone(),
+        process: args.process.clone(),
+        machine: args.machine.clone(),
+        machine_profile: args.machine_profile.clone(),
+        set: args.set.clone(),
+    }
+}
+
+/// How the part is to stand, by `--base-face` and `--orient`.
+fn placement(args: &PlanArgs) -> Placement {
+    match (args.base_face, args.orient.as_deref()) {
+        (Some(id), _) => Placement::BaseFace(id),
+        (None, Some("auto")) => Placement::Auto,
+        _ => Placement::AsModelled,
+    }
+}
+
+/// An output holding an earlier plan is refused unless `--force`.
+fn refuse_earlier(outputs: &Outputs, args: &PlanArgs) -> Result<(), Failure> {
     let earlier = outputs.earlier();
     if !earlier.is_empty() && !args.force {
         return Err(Failure::new(
@@ -26,144 +99,96 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             ),
         ));
     }
-    // A feature's bad parameters are reported against the process file (or the part without one).
-    let process_file = args.process.as_deref().unwrap_or(path);
-    // One bar over the whole run (hidden when stderr is not a terminal): reading the part, each
-    // feature, the stages after them (plan::STAGES) and writing the outputs, with the time
-    // elapsed; cleared when the run ends, however it ends.
-    let bar = Bar(crate::progress_bar(
-        "{prefix} {bar:30} {pos}/{len} {msg} [{elapsed}]",
-    ));
-    bar.0.set_length(1);
-    bar.0.set_prefix("reading");
-    bar.0.set_message(path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    ));
-    let auto = args.orient.as_deref() == Some("auto");
-    let (part, placement) = crate::placement::read_placed(path, args.base_face, auto)?;
-    bar.0.inc(1);
-    bar.0.set_prefix("planning");
-    if let Some(p) = &placement {
+    Ok(())
+}
+
+/// The line of a plan not made, or refused: a refusal's lines first (one per feature, or the
+/// warnings `--strict` refuses).
+fn refused(e: PlanError, path: &Path, process_file: &Path, bar: &Bar) -> Failure {
+    let say = |line: &str| {
+        bar.0
+            .suspend(|| eprintln!("features: {}: {line}", path.display()))
+    };
+    match e {
+        PlanError::Process(e) => Failure::new(process_file, e),
+        PlanError::Refused { gate, plan } => {
+            let cause = match gate {
+                Gate::SelfCheck(problems) => {
+                    problems.iter().for_each(|p| say(&p.to_string()));
+                    format!("the plan fails its self-check for {} feature(s) (listed above); nothing written (--keep-going writes it anyway)", problems.len())
+                }
+                Gate::Collisions(lines) => {
+                    lines.iter().for_each(|l| say(l));
+                    format!("the print head collides in {} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)", lines.len())
+                }
+                Gate::Strict(n) => {
+                    tell_placement(&plan, path, bar);
+                    print_warnings(&plan, path, bar);
+                    format!("{n} warning(s) (listed above) and --strict: nothing written")
+                }
+                Gate::Unreachable(n) => {
+                    tell_placement(&plan, path, bar);
+                    print_warnings(&plan, path, bar);
+                    format!("{n} point(s) out of the arm's reach or joint limits (listed above): nothing written (--allow-unreachable writes the program anyway)")
+                }
+            };
+            Failure::new(path, cause)
+        }
+        e => Failure::new(path, e),
+    }
+}
+
+/// Where the part stands, when it was turned.
+fn tell_placement(plan: &Plan, path: &Path, bar: &Bar) {
+    if let Some(p) = &plan.report.placement {
         let d = p.down;
         bar.0.suspend(|| {
             eprintln!(
-            "features: {}: standing on face #{} (outward normal {:.4} {:.4} {:.4} turned down; {})",
-            path.display(),
-            p.base_face,
-            d[0],
-            d[1],
-            d[2],
-            p.rule
-        )
+                "features: {}: standing on face #{} (outward normal {:.4} {:.4} {:.4} turned down; {})",
+                path.display(),
+                p.base_face,
+                d[0],
+                d[1],
+                d[2],
+                p.rule
+            )
         });
     }
-    // Reading, the features, the stages after them, writing.
-    let progress = |p: Progress| match p {
-        Progress::Start { features } => bar
-            .0
-            .set_length(1 + features + plan::STAGES.len() as u64 + 1),
-        Progress::Feature { id } => bar.0.set_message(format!("feature {id}")),
-        Progress::FeatureDone => {
-            // The feature's fills are freed: their pages go back before the next is laid.
-            crate::memory::release_freed();
-            bar.0.inc(1)
-        }
-        Progress::Planned => {}
-        Progress::Stage(name) => {
-            if name != plan::STAGES[0] {
-                bar.0.inc(1);
-            }
-            bar.0.set_message(name);
-        }
-    };
-    let part_stem = path
-        .file_stem()
-        .map_or("part".into(), |s| s.to_string_lossy().into_owned());
-    let options = Options {
-        source: path.display().to_string(),
-        stem: outputs.stem(&part_stem),
-        keep_going: args.keep_going,
-        allow_collisions: args.allow_collisions,
-        progress: Some(&progress),
-    };
-    // The program goes to its files as the post makes it, under temporary names until every
-    // check below has passed (dropped on any failure: nothing written).
-    let mut staged = Staged::new(&outputs);
-    // toolpath.csv likewise, written beside the program as the plan ends.
-    let mut csv = staged
-        .open("toolpath.csv")
-        .map_err(|e| Failure::new(&outputs.dir, format!("cannot write toolpath.csv: {e}")))?;
-    let result = plan::plan_into(
-        &part,
-        &process,
-        &machine,
-        &options,
-        &mut staged,
-        Some(&mut csv),
-    );
-    drop(csv);
-    bar.0.inc(1);
-    bar.0.set_prefix("writing");
-    bar.0.set_message("outputs");
-    let mut plan = result.map_err(|e| match e {
-        PlanError::Process(e) => Failure::new(process_file, e),
-        PlanError::SelfCheck(problems) => {
-            for p in &problems {
-                bar.0.suspend(|| eprintln!("features: {}: {p}", path.display()));
-            }
-            let n = problems.len();
-            Failure::new(path, format!("the plan fails its self-check for {n} feature(s) (listed above); nothing written (--keep-going writes it anyway)"))
-        }
-        PlanError::Collisions(lines) => {
-            for l in &lines {
-                bar.0.suspend(|| eprintln!("features: {}: {l}", path.display()));
-            }
-            let n = lines.len();
-            Failure::new(path, format!("the print head collides in {n} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)"))
-        }
-        e => Failure::new(path, e),
-    })?;
-    // Every warning on stderr, one line each, as plan.json holds them; before anything is
-    // written, since --strict and unreachable points stop the plan here.
-    let warnings: Vec<String> = plan.warnings().iter().map(|w| w.to_string()).collect();
+}
+
+/// Every warning on stderr, one line each, as plan.json holds them; their count.
+fn print_warnings(plan: &Plan, path: &Path, bar: &Bar) -> usize {
+    let warnings = plan.warnings();
     for w in &warnings {
         bar.0
             .suspend(|| eprintln!("features: {}: warning: {w}", path.display()));
     }
-    if args.strict && !warnings.is_empty() {
-        return Err(Failure::new(
-            path,
-            format!(
-                "{} warning(s) (listed above) and --strict: nothing written",
-                warnings.len()
-            ),
-        ));
-    }
-    let unreachable = plan.report.unreachable_points();
-    if unreachable > 0 && !args.allow_unreachable {
-        return Err(Failure::new(
-            path,
-            format!("{unreachable} point(s) out of the arm's reach or joint limits (listed above): nothing written (--allow-unreachable writes the program anyway)"),
-        ));
-    }
-    // Everything is ready: write the files.
+    warnings.len()
+}
+
+/// Writes the plan's files: the staged program and toolpath.csv, the preview, the colliding
+/// moves left (when any), and plan.json last (a folder with plan.json holds a whole plan); the
+/// closing line to print.
+fn write_plan(
+    mut plan: Plan,
+    outputs: &Outputs,
+    staged: Staged,
+    args: &PlanArgs,
+    warnings: usize,
+) -> Result<String, Failure> {
+    let path = &args.part;
     let dir = &outputs.dir;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
     if args.force {
         outputs.clear_earlier()?;
     }
-    plan.report.placement = placement;
-    // toolpath.csv and the program, as staged.
-    let staged_names = staged.names();
-    // The preview: the features and the path, in one page that opens offline.
     let preview_name = outputs.name("preview.html");
     let page = crate::preview::plan_page(&plan, &path.display().to_string());
-    // The colliding moves left, one line each, where there are any.
     let collisions_name =
         (!plan.collisions.left.is_empty()).then(|| outputs.name("collisions.csv"));
-    plan.report.outputs = staged_names
+    plan.report.outputs = staged
+        .names()
         .into_iter()
         .chain(std::iter::once(preview_name.clone()))
         .chain(collisions_name.clone())
@@ -187,12 +212,16 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             }),
         )?;
     }
-    // The report last: a folder with plan.json holds a whole plan.
     let report = outputs.name("plan.json");
     written(
         &report,
         write_atomic(&dir.join(&report), |w| w.write_all(json.as_bytes())),
     )?;
+    Ok(summary_line(&plan, args, outputs, warnings))
+}
+
+/// The closing line: what was planned and where it went.
+fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize) -> String {
     let print: f64 = plan.features().iter().map(|f| f.print_length_mm).sum();
     let widened: f64 = plan.features().iter().map(|f| f.widened_volume_mm3).sum();
     let vol = widened
@@ -206,24 +235,60 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     } else {
         String::new()
     };
-    bar.0.inc(1);
-    drop(bar);
     // Where it went: the folder, or the program file `-o` named.
     let to = match &args.output {
-        o if o.is_dir() => dir.display().to_string(),
+        o if o.is_dir() => outputs.dir.display().to_string(),
         o => o.display().to_string(),
     };
-    emit(&format!(
-        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {} warning(s) -> {to}\n",
-        path.display(),
+    format!(
+        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
+        args.part.display(),
         plan.features().len(),
         plan.toolpath.points.len(),
-        warnings.len(),
-    ))
+    )
 }
 
-/// The run's progress bar, cleared when dropped (the run ended, or failed).
+/// The run's progress bar over reading the part, each feature, the stages after them
+/// ([`Stage::AFTER_FEATURES`]) and writing the outputs, with the time elapsed (hidden when
+/// stderr is not a terminal); cleared when dropped (the run ended, or failed).
 struct Bar(indicatif::ProgressBar);
+
+impl Bar {
+    fn new(path: &Path) -> Bar {
+        let bar = Bar(crate::progress_bar(
+            "{prefix} {bar:30} {pos}/{len} {msg} [{elapsed}]",
+        ));
+        bar.0.set_length(1);
+        bar.0.set_prefix("reading");
+        bar.0.set_message(path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        ));
+        bar
+    }
+
+    /// Shows where the plan is.
+    fn progress(&self, p: Progress) {
+        match p {
+            Progress::Start { features } => self
+                .0
+                .set_length(1 + features + Stage::AFTER_FEATURES.len() as u64 + 1),
+            Progress::Feature { id } => self.0.set_message(format!("feature {id}")),
+            Progress::FeatureDone => {
+                // The feature's fills are freed: their pages go back before the next is laid.
+                crate::memory::release_freed();
+                self.0.inc(1)
+            }
+            Progress::Planned => {}
+            Progress::Stage(stage) => {
+                if stage != Stage::AFTER_FEATURES[0] {
+                    self.0.inc(1);
+                }
+                self.0.set_message(stage.name());
+            }
+        }
+    }
+}
 
 impl Drop for Bar {
     fn drop(&mut self) {

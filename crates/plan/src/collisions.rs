@@ -4,7 +4,7 @@
 //! parents) printed layer by layer in turn where that leaves fewer collisions, and colliding
 //! print moves cleared by tilting the tool axis inside the orientation's tolerance cone.
 
-use crate::report::{round, CollisionEntry, FeatureReport, HitEntry};
+use crate::report::{round, CollisionEntry, FeatureEntry, HitEntry};
 use collide::{interleave, tilt_and_route, Collision, Obstacle, Table, TiltLimits, Travels};
 use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
@@ -31,14 +31,14 @@ pub fn table(path: &ToolPath, machine: &MachineProfile) -> Table {
 
 /// Runs of features in build order with the same parents (siblings, none built on another),
 /// two or more, as file-wide ids.
-pub fn sibling_groups(features: &[FeatureReport]) -> Vec<Vec<usize>> {
+pub fn sibling_groups(features: &[FeatureEntry]) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = vec![];
     for (i, f) in features.iter().enumerate() {
-        let parents = &f.feature.parents;
-        let joins = i > 0 && !parents.is_empty() && features[i - 1].feature.parents == *parents;
+        let parents = &f.parents;
+        let joins = i > 0 && !parents.is_empty() && features[i - 1].parents == *parents;
         match groups.last_mut() {
-            Some(g) if joins => g.push(f.feature.id),
-            _ => groups.push(vec![f.feature.id]),
+            Some(g) if joins => g.push(f.id),
+            _ => groups.push(vec![f.id]),
         }
     }
     groups.retain(|g| g.len() > 1);
@@ -158,7 +158,7 @@ pub fn avoid(
     path: &mut ToolPath,
     planned: &[V3],
     machine: &MachineProfile,
-    features: &[FeatureReport],
+    features: &[FeatureEntry],
     limits: Option<TiltLimits>,
 ) -> Avoided {
     let head = machine.head;

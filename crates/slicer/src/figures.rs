@@ -51,9 +51,8 @@ impl FeatureFigures {
 /// Figures of a freeform feature's layers, beyond [`FeatureFigures`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FreeformFigures {
-    /// `native` (the surface's parameters), `projection` (tangent-plane chart) or `translate`
-    /// (levels translated along one direction, where the reference's offsets fold).
-    pub chart: &'static str,
+    /// The chart the feature's layers were laid in.
+    pub chart: LayerChart,
     /// Smallest radius of a concave valley of the reference under the feature, mm (infinite
     /// when it curves away from the feature everywhere).
     pub concave_radius: f64,
@@ -64,7 +63,49 @@ pub struct FreeformFigures {
     pub overhang_points: usize,
     /// First and last layer (1-based) with such points.
     pub overhang_layers: Option<(usize, usize)>,
-    /// `offset` (offsets of the reference surface) or `transition` (layers morphing the base
-    /// into the top).
-    pub layers: &'static str,
+    /// The layers the feature got.
+    pub layers: Layering,
+}
+
+/// The chart a curved feature's layers were laid in.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LayerChart {
+    /// The reference surface's own parameters.
+    #[default]
+    Native,
+    /// A tangent-plane projection.
+    Projection,
+    /// Levels translated along one direction, where the reference's offsets fold.
+    Translate,
+}
+
+impl LayerChart {
+    /// Its name in `plan.json`: `native`, `projection` or `translate`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LayerChart::Native => "native",
+            LayerChart::Projection => "projection",
+            LayerChart::Translate => "translate",
+        }
+    }
+}
+
+/// The layers a curved feature got (`layer_strategy` in `plan.json`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Layering {
+    /// Offsets of the reference surface.
+    #[default]
+    Offset,
+    /// Layers morphing the base into the top (seed 000, Eq. 4–8).
+    Transition,
+}
+
+impl Layering {
+    /// Its name in `plan.json`: `offset` or `transition`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Layering::Offset => "offset",
+            Layering::Transition => "transition",
+        }
+    }
 }

@@ -33,8 +33,8 @@ use crate::chart::{choose_chart, mapped_mesh, refined, translate_chart, MAX_MAPP
 use crate::error::PlanError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
-use crate::figures::FeatureFigures;
 pub use crate::figures::FreeformFigures;
+use crate::figures::{FeatureFigures, LayerChart, Layering};
 use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
@@ -248,14 +248,14 @@ pub fn fill_freeform<'a>(
     };
     let mut ff = FreeformFigures {
         chart: match chart.kind {
-            _ if chart.along.is_some() => "translate",
-            ChartKind::Native { .. } => "native",
-            ChartKind::Ortho { .. } => "projection",
+            _ if chart.along.is_some() => LayerChart::Translate,
+            ChartKind::Native { .. } => LayerChart::Native,
+            ChartKind::Ortho { .. } => LayerChart::Projection,
         },
         concave_radius,
         overhang_points: 0,
         overhang_layers: None,
-        layers: "offset",
+        layers: Layering::Offset,
     };
     // The top faces, for transition layers and side-surface-tangent walls.
     let sst = params.wall_orientation == WallOrientation::Sst && params.fixed_tool_axis.is_none();
@@ -312,7 +312,7 @@ pub fn fill_freeform<'a>(
             let h0 = field.band_of().map_or(0.0, |b| b.1);
             heights = vec![h0; *k];
             heights.extend(std::iter::repeat_n(t, *n));
-            ff.layers = "transition";
+            ff.layers = Layering::Transition;
             *k
         }
         None => heights.len(),

@@ -9,5 +9,5 @@ pub mod write;
 
 mod part;
 
-pub use part::{read_step, read_step_bytes, read_step_turned, turn_down, StepPart};
+pub use part::{read_step, read_step_bytes, read_step_turned, turn_down, StepFile, StepPart};
 pub use read::translate;

@@ -1,6 +1,7 @@
 //! Reading a STEP file into a B-rep: the parser and the translator in turn.
 
 use super::error::ReadError;
+use super::p21::P21File;
 use crate::topology::Brep;
 use std::path::Path;
 
@@ -15,18 +16,12 @@ pub struct StepPart {
 
 /// Reads a STEP file from disk.
 pub fn read_step(path: impl AsRef<Path>) -> Result<StepPart, ReadError> {
-    let bytes = std::fs::read(path.as_ref())?;
-    read_step_bytes(&bytes)
+    StepFile::read(path)?.part()
 }
 
 /// Reads a STEP file from memory.
 pub fn read_step_bytes(bytes: &[u8]) -> Result<StepPart, ReadError> {
-    let file = super::p21::parse(bytes)?;
-    let brep = super::read::translate(&file)?;
-    Ok(StepPart {
-        brep,
-        schemas: file.schemas(),
-    })
+    StepFile::from_bytes(bytes)?.part()
 }
 
 /// Reads a STEP file from disk with every solid turned so that the unit direction `down` (in
@@ -34,13 +29,47 @@ pub fn read_step_bytes(bytes: &[u8]) -> Result<StepPart, ReadError> {
 /// whose outward normal is `down`. The turn is the least rotation doing so (about
 /// `down` × −Z; half a turn about X when `down` is +Z), about the file's origin.
 pub fn read_step_turned(path: impl AsRef<Path>, down: [f64; 3]) -> Result<StepPart, ReadError> {
-    let bytes = std::fs::read(path.as_ref())?;
-    let file = super::p21::parse(&bytes)?;
-    let brep = super::read::translate_turned(&file, Some(turn_down(down)))?;
-    Ok(StepPart {
-        brep,
-        schemas: file.schemas(),
-    })
+    StepFile::read(path)?.turned(down)
+}
+
+/// A STEP file parsed once: translated into a part as it stands ([`StepFile::part`]) or turned
+/// onto a face ([`StepFile::turned`]) as often as placements need, without reading or parsing
+/// the file again.
+#[derive(Debug)]
+pub struct StepFile {
+    file: P21File,
+}
+
+impl StepFile {
+    /// Parses a STEP file from disk.
+    pub fn read(path: impl AsRef<Path>) -> Result<StepFile, ReadError> {
+        let bytes = std::fs::read(path.as_ref())?;
+        StepFile::from_bytes(&bytes)
+    }
+
+    /// Parses a STEP file from memory.
+    pub fn from_bytes(bytes: &[u8]) -> Result<StepFile, ReadError> {
+        Ok(StepFile {
+            file: super::p21::parse(bytes)?,
+        })
+    }
+
+    /// The part as modelled.
+    pub fn part(&self) -> Result<StepPart, ReadError> {
+        Ok(StepPart {
+            brep: super::read::translate(&self.file)?,
+            schemas: self.file.schemas(),
+        })
+    }
+
+    /// The part with every solid turned so that the unit direction `down` (file frame) points
+    /// down, −Z ([`turn_down`], as [`read_step_turned`]).
+    pub fn turned(&self, down: [f64; 3]) -> Result<StepPart, ReadError> {
+        Ok(StepPart {
+            brep: super::read::translate_turned(&self.file, Some(turn_down(down)))?,
+            schemas: self.file.schemas(),
+        })
+    }
 }
 
 /// The least rotation (a matrix, rows first) taking the unit vector `n` onto −Z (Rodrigues).

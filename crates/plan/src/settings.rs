@@ -1,15 +1,54 @@
-//! The settings of `features plan`: the process file and the machine profile, read and checked
-//! before any work, so that a bad one fails at once.
+//! The settings of a plan: the process file and the machine profile with the `--set`
+//! overrides, read and checked before any work, so that a bad one fails at once.
 
-use crate::{Failure, PlanArgs};
-use plan::Process;
+use crate::report::SettingsEntry;
+use crate::Process;
 use robot_post::machine::{MachineKind, MachineProfile};
+use slicer::params::LayerParams;
+use std::path::{Path, PathBuf};
+
+/// Where a plan's settings come from (the command line's `--process`, `--machine`,
+/// `--machine-profile` and `--set`).
+#[derive(Debug, Clone, Default)]
+pub struct Sources {
+    /// The part (a bad feature parameter is reported against it when there is no process
+    /// file).
+    pub part: PathBuf,
+    /// The process file; `None`: the defaults.
+    pub process: Option<PathBuf>,
+    /// A built-in machine's name; `None` (and no profile): `marlin`.
+    pub machine: Option<String>,
+    /// A machine profile file, instead of a built-in machine.
+    pub machine_profile: Option<PathBuf>,
+    /// `KEY=VALUE` overrides, in order.
+    pub set: Vec<String>,
+}
+
+/// Why the settings could not be had: where (a file, `--set KEY=VALUE`, `--machine`) and why.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{origin}: {cause}")]
+pub struct SettingsError {
+    /// The file, the override or the option at fault.
+    pub origin: String,
+    /// What is wrong.
+    pub cause: String,
+}
+
+impl SettingsError {
+    fn new(origin: &Path, cause: impl std::fmt::Display) -> SettingsError {
+        SettingsError {
+            origin: origin.display().to_string(),
+            cause: cause.to_string(),
+        }
+    }
+}
+
+type Failure = SettingsError;
 
 /// The process file and the machine profile of a plan, with the `--set` overrides, checked,
 /// in the order a user fixes them.
-pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
-    let path = &args.part;
-    let settings = args.process.as_deref().unwrap_or(path);
+pub fn load(args: &Sources) -> Result<(Process, MachineProfile), SettingsError> {
+    let settings = args.process.as_deref().unwrap_or(&args.part);
     let sets = args
         .set
         .iter()
@@ -59,8 +98,8 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
                 } else {
                     format!("unknown machine `{name}`: the built-in ones are marlin, delta5 and kuka (a profile file goes to --machine-profile)")
                 };
-                Failure {
-                    path: "--machine".into(),
+                SettingsError {
+                    origin: "--machine".into(),
                     cause: hint,
                 }
             })?;
@@ -74,16 +113,18 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
             "built-in marlin".into(),
         ),
     };
-    let mut machine = MachineProfile::from_toml(&machine_text).map_err(|e| Failure {
-        path: machine_source.clone(),
+    let mut machine = MachineProfile::from_toml(&machine_text).map_err(|e| SettingsError {
+        origin: machine_source.clone(),
         cause: with_suggestion(&e.to_string()),
     })?;
     let machine_sets: Vec<&Set> = sets.iter().filter(|s| s.machine).collect();
     if !machine_sets.is_empty() {
-        let mut table = machine_text.parse::<toml::Table>().map_err(|e| Failure {
-            path: machine_source.clone(),
-            cause: e.message().trim().to_string(),
-        })?;
+        let mut table = machine_text
+            .parse::<toml::Table>()
+            .map_err(|e| SettingsError {
+                origin: machine_source.clone(),
+                cause: e.message().trim().to_string(),
+            })?;
         for set in machine_sets {
             set.apply(&mut table)?;
             let text = toml::to_string(&table).map_err(|e| set.failure(e))?;
@@ -98,6 +139,26 @@ pub fn settings(args: &PlanArgs) -> Result<(Process, MachineProfile), Failure> {
         .validate_for_nozzle(machine.nozzle_diameter)
         .map_err(|e| Failure::new(settings, e))?;
     Ok((process, machine))
+}
+
+/// The settings of a plan, every key: the process's defaults with `base`'s values, each
+/// overridden feature's full parameters, the smoothing, and the machine profile.
+pub fn entry(process: &Process, machine: &MachineProfile, base: &LayerParams) -> SettingsEntry {
+    let json = |v: Result<serde_json::Value, serde_json::Error>| v.unwrap_or_default();
+    let mut features = serde_json::Map::new();
+    for (_, key) in process.feature_keys() {
+        let p = base.patched(&process.features[key]);
+        features.insert(key.clone(), json(serde_json::to_value(p)));
+    }
+    SettingsEntry {
+        version: env!("CARGO_PKG_VERSION"),
+        process: serde_json::json!({
+            "defaults": json(serde_json::to_value(base)),
+            "features": features,
+            "orientation": json(serde_json::to_value(&process.orientation)),
+        }),
+        machine: json(serde_json::to_value(machine)),
+    }
 }
 
 /// One `--set KEY=VALUE`: a process key (`uniform_layer_height` is `[defaults]`'s;
@@ -117,8 +178,8 @@ struct Set {
 
 impl Set {
     fn parse(given: &str) -> Result<Set, Failure> {
-        let fail = |cause: &str| Failure {
-            path: format!("--set {given}"),
+        let fail = |cause: &str| SettingsError {
+            origin: format!("--set {given}"),
             cause: cause.to_string(),
         };
         let (key, value) = given
@@ -168,8 +229,8 @@ impl Set {
                 }
             }
         }
-        Failure {
-            path: format!("--set {}", self.given),
+        SettingsError {
+            origin: format!("--set {}", self.given),
             cause,
         }
     }

@@ -1,0 +1,142 @@
+//! The report, built once from the stages' values after the last one ([`Stages::assemble`]).
+
+use crate::estimate::Estimate;
+use crate::extract::Extracted;
+use crate::gates::Passed;
+use crate::head::Checked;
+use crate::lay::LaidFeature;
+use crate::report::{
+    round, FeatureReport, FreeformEntry, PlacementEntry, PlanReport, PostEntry, SettingsEntry,
+    PLAN_SCHEMA,
+};
+use crate::warning::{texts, Warning, WarningKind};
+use crate::{Options, Plan};
+use robot_post::machine::MachineProfile;
+use robot_post::{PostFigures, Program};
+use slicer::orient::OrientationFigures;
+
+/// What the stages up to the head check made, carried to the gates, the post and the report.
+#[derive(Debug)]
+pub struct Stages {
+    /// The extract stage's features.
+    pub extracted: Extracted,
+    /// How the place stage turned the part.
+    pub placement: Option<PlacementEntry>,
+    /// What the lay stage laid, per feature in build order.
+    pub features: Vec<LaidFeature>,
+    /// The lay stage's warnings of the part.
+    pub warnings: Vec<Warning>,
+    /// The head-check stage's path and collisions.
+    pub checked: Checked,
+}
+
+impl Stages {
+    /// The plan, its report made from every stage's value: `program` is the post's (`None`:
+    /// refused before it), `passed` what the gates let pass.
+    pub fn assemble(
+        self,
+        machine: &MachineProfile,
+        options: &Options,
+        program: Option<&Program>,
+        passed: Passed,
+        est: &Estimate,
+        settings: SettingsEntry,
+    ) -> Plan {
+        let Stages {
+            extracted,
+            placement,
+            features,
+            warnings,
+            checked,
+        } = self;
+        let reports = features
+            .into_iter()
+            .map(|f| feature_report(f, &checked, program))
+            .collect();
+        // The part's warnings: the lay stage's, extraction's, the post's, then what the
+        // gates let pass.
+        let mut all = warnings;
+        all.extend(
+            extracted
+                .assembly
+                .all_warnings()
+                .into_iter()
+                .map(|w| Warning::part(WarningKind::Extraction(w))),
+        );
+        if let Some(p) = program {
+            all.extend(
+                p.warnings
+                    .iter()
+                    .map(|w| Warning::part(WarningKind::Post(w.clone()))),
+            );
+        }
+        all.extend(passed.warnings);
+        let report = PlanReport {
+            schema: PLAN_SCHEMA,
+            source: options.source.clone(),
+            machine: machine.name.clone(),
+            complete: passed.complete,
+            features: reports,
+            warnings: texts(&all),
+            estimated_time_s: round(est.time_s, 1e1),
+            filament_mm: round(est.filament_mm, 1e2),
+            filament_g: round(est.filament_g, 1e2),
+            settings,
+            placement,
+            outputs: vec![],
+        };
+        Plan {
+            report,
+            toolpath: checked.toolpath,
+            program: vec![],
+            assembly: extracted.assembly,
+            collisions: checked.avoided,
+        }
+    }
+}
+
+/// One feature's report from what the stages made of it.
+fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) -> FeatureReport {
+    let id = f.planned.id;
+    let mut warnings = f.warnings;
+    warnings.extend(
+        checked
+            .warnings
+            .iter()
+            .filter(|w| w.feature == Some(id))
+            .cloned(),
+    );
+    FeatureReport {
+        feature: f.entry,
+        layers: f.layers,
+        points: checked.points.get(&id).copied().unwrap_or(0),
+        print_length_mm: round(f.print_length, 1e3),
+        travel_length_mm: round(f.travel_length, 1e3),
+        extruded_volume_mm3: round(f.extruded, 1e3),
+        widened_volume_mm3: round(f.widened, 1e3),
+        thickness_min_mm: round(f.thickness.0, 1e6),
+        thickness_mean_mm: round(f.thickness.1, 1e6),
+        thickness_max_mm: round(f.thickness.2, 1e6),
+        freeform: f.freeform.map(|ff| FreeformEntry {
+            chart: ff.chart.as_str().to_string(),
+            overhang_points: ff.overhang_points,
+            concave_radius_mm: ff
+                .concave_radius
+                .is_finite()
+                .then(|| round(ff.concave_radius, 1e3)),
+            layer_strategy: ff.layers.as_str().to_string(),
+        }),
+        warnings: texts(&warnings),
+        orientation: checked.orientation.get(&id).map(|o| OrientationFigures {
+            step_max_deg_before: round(o.step_max_deg_before, 1e6),
+            step_max_deg_after: round(o.step_max_deg_after, 1e6),
+            rate_max_deg_per_mm_before: round(o.rate_max_deg_per_mm_before, 1e6),
+            rate_max_deg_per_mm_after: round(o.rate_max_deg_per_mm_after, 1e6),
+        }),
+        post: program.and_then(|p| p.figures.get(&id)).map(|k| match k {
+            PostFigures::Delta5(k) => PostEntry::delta5(k),
+            PostFigures::Kuka(k) => PostEntry::kuka(k),
+        }),
+        collision: checked.collisions.get(&id).cloned().unwrap_or_default(),
+    }
+}

@@ -1,0 +1,80 @@
+//! Why a part was not planned ([`PlanError`]), and why a plan that was made is refused
+//! ([`Gate`]).
+
+use crate::Plan;
+use slicer::verify::PlanProblem;
+
+/// Why a part could not be planned, or why its plan is refused. Each message is one line.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// The part could not be stood on the plate as asked.
+    #[error(transparent)]
+    Place(#[from] crate::place::PlaceError),
+    /// The part's features could not be recognised.
+    #[error(transparent)]
+    Extract(#[from] features::ExtractError),
+    /// A feature's parameters (process file) are wrong.
+    #[error(transparent)]
+    Process(#[from] crate::ProcessError),
+    /// A feature could not be planned.
+    #[error(transparent)]
+    Feature(#[from] slicer::planar::PlanError),
+    /// The post could not write the program.
+    #[error(transparent)]
+    Post(#[from] robot_post::PostError),
+    /// `toolpath.csv` could not be written ([`crate::plan_into`]'s `csv`).
+    #[error("cannot write toolpath.csv: {0}")]
+    Csv(#[source] std::io::Error),
+    /// The part needs more bead than one plan holds ([`crate::MAX_BEAD_KM`]), estimated
+    /// before any layer is made: nothing planned.
+    #[error("the part's features hold {volume_m3:.3} m^3: at these layer heights and bead spacings that is at least {bead_km:.0} km of bead, more than the {} km one plan holds (is the file's length unit right?); nothing planned", crate::MAX_BEAD_KM)]
+    TooBig {
+        /// The features' volume, m³.
+        volume_m3: f64,
+        /// The bead they need at the least, km.
+        bead_km: f64,
+    },
+    /// The plan was made, and a gate refuses it: the plan is here to show why (its report
+    /// says `"complete": false`), but no program was written.
+    #[error("{gate}")]
+    Refused {
+        /// What refused it.
+        gate: Gate,
+        /// The plan refused.
+        plan: Box<Plan>,
+    },
+}
+
+/// A gate that refuses a plan ([`crate::gates`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Gate {
+    /// The self-check fails (and [`crate::Options::keep_going`] is off): a feature has no
+    /// layer, or its extruded volume is off its volume × fill.
+    SelfCheck(Vec<PlanProblem>),
+    /// The head meets material or the table on some moves (and
+    /// [`crate::Options::allow_collisions`] is off): one line per feature.
+    Collisions(Vec<String>),
+    /// The plan has warnings and [`crate::Options::strict`] is on.
+    Strict(usize),
+    /// Points the robot cannot reach (and [`crate::Options::allow_unreachable`] is off).
+    Unreachable(usize),
+}
+
+impl std::fmt::Display for Gate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Gate::SelfCheck(p) => {
+                write!(
+                    f,
+                    "the plan fails its self-check for {} feature(s)",
+                    p.len()
+                )
+            }
+            Gate::Collisions(l) => write!(f, "the head collides in {} feature(s)", l.len()),
+            Gate::Strict(n) => write!(f, "{n} warning(s) and strict"),
+            Gate::Unreachable(n) => {
+                write!(f, "{n} point(s) out of the arm's reach or joint limits")
+            }
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! The lay stage: every feature's layers filled (the bulk of the work: a few features at a time
+//! in parallel) and laid in build order, each from where the one before ended, then joined into
+//! one tool path (the sequence stage).
+
+use crate::extract::{Extracted, Slot};
+use crate::report::FeatureEntry;
+use crate::warning::{Warning, WarningKind};
+use crate::{PlanError, Process, Progress};
+use brep::math::P3;
+use rayon::prelude::*;
+use robot_post::machine::MachineProfile;
+use slicer::figures::{FreeformFigures, Layering};
+use slicer::params::{LayerParams, LayerStrategy};
+use slicer::toolpath::{MoveKind, PathPoint, ToolPath};
+use slicer::verify::{PlannedFeature, VOLUME_TOLERANCE};
+use slicer::{fill_feature, FeaturePlan};
+
+/// What was laid for one feature, as the report gives it.
+#[derive(Debug, Clone)]
+pub struct LaidFeature {
+    /// What the feature is.
+    pub entry: FeatureEntry,
+    /// What the self-check compares.
+    pub planned: PlannedFeature,
+    /// Layers that print.
+    pub layers: usize,
+    /// Points laid.
+    pub points: usize,
+    /// Printed length, mm.
+    pub print_length: f64,
+    /// Travel length, mm.
+    pub travel_length: f64,
+    /// Bead volume planned (Eq. 1 filament × filament area), mm³.
+    pub extruded: f64,
+    /// Bead volume added by widening narrow beads, mm³.
+    pub widened: f64,
+    /// Thinnest, mean and thickest layer, mm.
+    pub thickness: (f64, f64, f64),
+    /// The freeform planner's figures (curved features).
+    pub freeform: Option<FreeformFigures>,
+    /// The feature's warnings.
+    pub warnings: Vec<Warning>,
+}
+
+/// What the lay stage returns.
+#[derive(Debug)]
+pub struct Laid {
+    /// The features laid, in build order.
+    pub features: Vec<LaidFeature>,
+    /// Their paths joined in build order, with their file-wide ids (the sequence stage).
+    pub toolpath: ToolPath,
+    /// Warnings of the part (features below the build plate).
+    pub warnings: Vec<Warning>,
+}
+
+/// Fills and lays every feature of `extracted` in build order. Features are filled a few at a
+/// time in parallel, as many as there are threads, so memory holds no more than that many
+/// fills; then laid one after the other, each from where the one before ended.
+pub fn lay(
+    extracted: &Extracted,
+    process: &Process,
+    machine: &MachineProfile,
+    tell: &dyn Fn(Progress),
+) -> Result<Laid, PlanError> {
+    let base = process.base();
+    let window = rayon::current_num_threads().max(1);
+    let mut plans = vec![];
+    let mut cursor: Option<P3> = None;
+    let mut features = vec![];
+    let mut warnings = vec![];
+    for chunk in extracted.order.chunks(window) {
+        let fills: Vec<Result<_, PlanError>> = chunk
+            .par_iter()
+            .map(|&slot| {
+                let t = &extracted.assembly.trees[slot.tree];
+                let params = process.params_for(&base, extracted.id(slot))?;
+                let fill = fill_feature(t, extracted.feature(slot), &params, machine.bead())?;
+                Ok((params, fill))
+            })
+            .collect();
+        for (&slot, fill) in chunk.iter().zip(fills) {
+            let id = extracted.id(slot);
+            tell(Progress::Feature { id });
+            let (params, fill) = fill?;
+            let plan = fill.lay(cursor);
+            let (plan, fallback) =
+                offset_if_transition_misses(extracted, slot, &params, plan, cursor, machine)?;
+            cursor = plan.exit().map(P3::from).or(cursor);
+            let (laid, below) = laid_feature(extracted, slot, &params, &plan, fallback, machine);
+            let mut plan = plan;
+            let mut laid = laid.widen(&mut plan.points, machine);
+            laid.warnings.extend(below.clone());
+            warnings.extend(below);
+            features.push(laid);
+            plans.push((id, plan));
+            tell(Progress::FeatureDone);
+        }
+    }
+    tell(Progress::Planned);
+    Ok(Laid {
+        features,
+        toolpath: slicer::sequence(plans),
+        warnings,
+    })
+}
+
+/// Transition layers chosen by `auto` that miss the feature's volume by more than the
+/// self-check allows: the feature is laid on offset layers instead, with the miss.
+fn offset_if_transition_misses(
+    extracted: &Extracted,
+    slot: Slot,
+    params: &LayerParams,
+    plan: FeaturePlan,
+    cursor: Option<P3>,
+    machine: &MachineProfile,
+) -> Result<(FeaturePlan, Option<f64>), PlanError> {
+    let transition = plan
+        .freeform
+        .is_some_and(|ff| ff.layers == Layering::Transition);
+    if params.layer_strategy != LayerStrategy::Auto || !transition {
+        return Ok((plan, None));
+    }
+    let f = extracted.feature(slot);
+    let bead = machine.bead();
+    let expected = f.volume * params.filling_ratio;
+    let rel = plan.figures.filament * bead.filament_area()
+        / expected.max(crate::tolerance::VOLUME_MM3)
+        - 1.0;
+    if rel.abs() <= VOLUME_TOLERANCE {
+        return Ok((plan, None));
+    }
+    let offset_params = LayerParams {
+        layer_strategy: LayerStrategy::Offset,
+        ..params.clone()
+    };
+    let t = &extracted.assembly.trees[slot.tree];
+    let plan = fill_feature(t, f, &offset_params, bead)?.lay(cursor);
+    Ok((plan, Some(rel)))
+}
+
+/// The figures of feature `slot` as laid in `plan`, and the part's warning when it reaches
+/// below the build plate.
+fn laid_feature(
+    extracted: &Extracted,
+    slot: Slot,
+    params: &LayerParams,
+    plan: &FeaturePlan,
+    fallback: Option<f64>,
+    machine: &MachineProfile,
+) -> (LaidFeature, Option<Warning>) {
+    let id = extracted.id(slot);
+    let f = extracted.feature(slot);
+    let t = &extracted.assembly.trees[slot.tree];
+    let fig = &plan.figures;
+    let extruded = fig.filament * machine.bead().filament_area();
+    let mut warnings: Vec<Warning> = fig
+        .warnings
+        .iter()
+        .map(|w| Warning::feature(id, WarningKind::Planner(w.clone())))
+        .collect();
+    warnings
+        .extend(fallback.map(|missed| Warning::feature(id, WarningKind::OffsetLayers { missed })));
+    // Below the build plate (the base feature's reference plane): any point of the feature,
+    // planned or not (a planar layer starts at its reference plane, so what lies below that is
+    // not printed).
+    let below = extracted.plates[slot.tree].as_ref().and_then(|plate| {
+        let planned = plan
+            .points
+            .iter()
+            .map(|q| -plate.height(&P3::from(q.p)))
+            .fold(0.0f64, f64::max);
+        let depth = planned.max(fig.below_plate);
+        (depth > crate::tolerance::BELOW_PLATE_MM)
+            .then(|| Warning::feature(id, WarningKind::BelowPlate { depth }))
+    });
+    let laid = LaidFeature {
+        entry: FeatureEntry::new(t, f, slot.offset),
+        planned: PlannedFeature {
+            id,
+            kind: f.kind.as_str().to_string(),
+            volume: f.volume,
+            fill: params.filling_ratio,
+            layers: fig.layers,
+            extruded,
+        },
+        layers: fig.layers,
+        points: fig.points,
+        print_length: fig.print_length,
+        travel_length: fig.travel_length,
+        extruded,
+        widened: 0.0,
+        thickness: fig.thickness,
+        freeform: plan.freeform,
+        warnings,
+    };
+    (laid, below)
+}
+
+impl LaidFeature {
+    /// Printability (issue 21): every print point whose bead is narrower than the machine's
+    /// `min_bead_width` (a thin wall's or a blade tip's, which the nozzle lays poorly) is
+    /// widened to it, its filament scaled with the width (Eq. 1 is linear in it), so the nozzle
+    /// lays a bead it can and the material it takes is counted. The self-check keeps comparing
+    /// what was planned for the feature's volume; the report gives the volume added apart
+    /// (`widened_volume_mm3`), and the program and the estimate carry it.
+    fn widen(mut self, points: &mut [PathPoint], machine: &MachineProfile) -> LaidFeature {
+        let min_bead = machine.min_bead_width();
+        let (mut narrow, mut prints, mut thinnest, mut added) = (0, 0, f64::INFINITY, 0.0);
+        for q in points.iter_mut().filter(|q| q.kind == MoveKind::Print) {
+            prints += 1;
+            if q.width < min_bead && q.width > 0.0 {
+                narrow += 1;
+                thinnest = thinnest.min(q.width);
+                let e = q.e * min_bead / q.width;
+                added += e - q.e;
+                q.e = e;
+                q.width = min_bead;
+            }
+        }
+        self.widened = added * machine.bead().filament_area();
+        if narrow > 0 {
+            let id = self.planned.id;
+            // The widening's line comes before the below-plate one, after the planner's.
+            self.warnings.push(Warning::feature(
+                id,
+                WarningKind::Widened {
+                    points: narrow,
+                    prints,
+                    min_bead,
+                    thinnest,
+                    added_mm3: self.widened,
+                    extruded_mm3: self.extruded,
+                },
+            ));
+        }
+        self
+    }
+}

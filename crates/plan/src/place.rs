@@ -1,0 +1,238 @@
+//! The place stage: how the part stands on the build plate: as modelled (its −Z down), on a
+//! chosen planar face (`--base-face ID`), or on the planar face the rule of `--orient auto`
+//! picks. The file is parsed once ([`brep::StepFile`]) and translated turned for each
+//! candidate; the winner's features come out extracted.
+//!
+//! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
+//! outward is a candidate (the 8 with the largest planar area facing that way). The part is
+//! turned so that the candidate points down and its features are extracted; a feature *needs a
+//! tool axis below the horizon* when its build direction (the normal of its reference plane,
+//! into the feature) points below the horizontal plane (z < −0.001). The candidate with the
+//! fewest such features wins; ties go to the larger planar area facing down, then to the
+//! candidate first in the file.
+
+use crate::report::PlacementEntry;
+use brep::math::V3;
+use brep::mesh::{mesh_faces, MeshOptions};
+use brep::topology::{Brep, FaceId};
+use brep::{StepFile, StepPart};
+use features::{extract_all, Assembly, ExtractOptions};
+
+/// How many candidate directions `--orient auto` tries.
+const CANDIDATES: usize = 8;
+
+/// A build direction whose z is below this points below the horizon.
+const BELOW_HORIZON_Z: f64 = -1e-3;
+
+/// Two planar faces' outward normals whose dot product exceeds this point the same way.
+const SAME_DIRECTION_DOT: f64 = 1.0 - 1e-9;
+
+/// A `down` whose z is below this already points down (−Z): the part stands as modelled.
+const STANDS_Z: f64 = -1.0 + 1e-12;
+
+/// How the part is to stand on the plate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Placement {
+    /// As modelled: its −Z down.
+    #[default]
+    AsModelled,
+    /// On the planar face with this STEP `#id` (`--base-face`).
+    BaseFace(u64),
+    /// On the planar face the rule of `--orient auto` picks.
+    Auto,
+}
+
+/// Why the part could not be stood as asked. Each message is one line.
+#[derive(Debug, thiserror::Error)]
+pub enum PlaceError {
+    /// The file could not be read into a part.
+    #[error(transparent)]
+    Read(#[from] brep::ReadError),
+    /// `--base-face` names no face of the file.
+    #[error("--base-face {0}: no face #{0} in the file")]
+    NoFace(u64),
+    /// `--base-face` names a face that is not planar.
+    #[error("--base-face {id}: face #{id} is not planar (a {kind} face): the part stands on a planar face")]
+    NotPlanar {
+        /// The face's STEP `#id`.
+        id: u64,
+        /// Its surface's kind.
+        kind: String,
+    },
+    /// `--orient auto` found no planar face.
+    #[error("--orient auto: the part has no planar face to stand on")]
+    NoPlanarFace,
+    /// No candidate's features could be extracted.
+    #[error("--orient auto: the features of no candidate placement could be extracted")]
+    NoCandidate,
+}
+
+/// The part stood on the plate, with what `plan.json` records of it.
+#[derive(Debug)]
+pub struct Placed {
+    /// The part as it stands.
+    pub part: StepPart,
+    /// Its features, when the placement extracted them (`--orient auto`).
+    pub assembly: Option<Assembly>,
+    /// How it was turned; `None`: as modelled.
+    pub entry: Option<PlacementEntry>,
+}
+
+/// Stands the part of `file` as `how` says.
+pub fn place(file: &StepFile, how: Placement) -> Result<Placed, PlaceError> {
+    let part = file.part()?;
+    match how {
+        Placement::AsModelled => Ok(Placed {
+            part,
+            assembly: None,
+            entry: None,
+        }),
+        Placement::BaseFace(id) => base_face(file, part, id),
+        Placement::Auto => auto(file, part),
+    }
+}
+
+/// The part on its planar face `#id`.
+fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceError> {
+    let b = &part.brep;
+    let face = (0..b.faces.len())
+        .map(|k| FaceId(k as u32))
+        .find(|&f| b.face(f).step_id == id)
+        .ok_or(PlaceError::NoFace(id))?;
+    let down = b.plane_normal(face).ok_or_else(|| PlaceError::NotPlanar {
+        id,
+        kind: features::extract::surface_kind(b.face_surface(face)),
+    })?;
+    let d = [down.x, down.y, down.z];
+    let part = if stands(down) { part } else { file.turned(d)? };
+    Ok(Placed {
+        part,
+        assembly: None,
+        entry: Some(entry(id, d, "base-face".into())),
+    })
+}
+
+/// The part on the face the rule of `--orient auto` picks (module docs).
+fn auto(file: &StepFile, part: StepPart) -> Result<Placed, PlaceError> {
+    let candidates = candidates(&part.brep);
+    if candidates.is_empty() {
+        return Err(PlaceError::NoPlanarFace);
+    }
+    // (features needing an axis below the horizon, −area, index) for each candidate, with the
+    // part turned onto it and its features.
+    let mut best: Option<(RankKey, &Candidate, StepPart, Assembly)> = None;
+    for (k, c) in candidates.iter().enumerate() {
+        let turned = file.turned([c.down.x, c.down.y, c.down.z])?;
+        let Ok(assembly) = extract_all(&turned.brep, &ExtractOptions::default()) else {
+            continue;
+        };
+        let below = assembly
+            .trees
+            .iter()
+            .flat_map(|t| t.features.iter())
+            .filter(|f| f.reference.normal.is_some_and(|n| n[2] < BELOW_HORIZON_Z))
+            .count();
+        let key = (below, -c.area, k);
+        if best
+            .as_ref()
+            .is_none_or(|(b, ..)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
+        {
+            best = Some((key, c, turned, assembly));
+        }
+    }
+    let ((below, _, _), c, turned, assembly) = best.ok_or(PlaceError::NoCandidate)?;
+    let rule = format!(
+        "auto: of {} planar directions, the one leaving the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
+        candidates.len(),
+        c.area
+    );
+    let d = [c.down.x, c.down.y, c.down.z];
+    Ok(Placed {
+        // The part as modelled when the winner already points down.
+        part: if stands(c.down) { part } else { turned },
+        assembly: Some(assembly),
+        entry: Some(entry(c.face_id, d, rule)),
+    })
+}
+
+/// A candidate's rank: features needing an axis below the horizon, −planar area down, its
+/// index (least first).
+type RankKey = (usize, f64, usize);
+
+/// Whether `down` already points down (−Z): the part stands as modelled.
+fn stands(down: V3) -> bool {
+    down.z < STANDS_Z
+}
+
+/// What plan.json records of standing the part on face `face`, whose outward normal `down` is
+/// turned to −Z.
+fn entry(face: u64, down: [f64; 3], rule: String) -> PlacementEntry {
+    let r = |x: f64| crate::report::round(x, 1e9);
+    PlacementEntry {
+        base_face: face,
+        down: down.map(r),
+        rotation: brep::turn_down(down).map(|row| row.map(r)),
+        rule,
+    }
+}
+
+/// A direction the part may stand on.
+struct Candidate {
+    /// Outward normal of its planar faces, in the file's frame.
+    down: V3,
+    /// Their area, mm².
+    area: f64,
+    /// STEP `#id` of the largest of them.
+    face_id: u64,
+}
+
+/// The directions planar faces point outward, largest planar area first (at most
+/// [`CANDIDATES`]), each with its largest face.
+fn candidates(b: &Brep) -> Vec<Candidate> {
+    let mut out: Vec<(Candidate, f64)> = vec![];
+    for k in 0..b.faces.len() {
+        let f = FaceId(k as u32);
+        let Some(n) = b.plane_normal(f) else {
+            continue;
+        };
+        let area = face_area(b, f);
+        match out
+            .iter_mut()
+            .find(|(c, _)| c.down.dot(&n) > SAME_DIRECTION_DOT)
+        {
+            Some((c, largest)) => {
+                c.area += area;
+                if area > *largest {
+                    *largest = area;
+                    c.face_id = b.face(f).step_id;
+                }
+            }
+            None => out.push((
+                Candidate {
+                    down: n,
+                    area,
+                    face_id: b.face(f).step_id,
+                },
+                area,
+            )),
+        }
+    }
+    let mut out: Vec<Candidate> = out.into_iter().map(|(c, _)| c).collect();
+    out.sort_by(|a, c| c.area.total_cmp(&a.area));
+    out.truncate(CANDIDATES);
+    out
+}
+
+/// A face's area from its mesh (0 when it does not mesh).
+fn face_area(b: &Brep, f: FaceId) -> f64 {
+    let Ok(m) = mesh_faces(b, &[f], &MeshOptions::default()) else {
+        return 0.0;
+    };
+    m.triangles()
+        .iter()
+        .map(|t| {
+            let [a, c, d] = t.map(|i| m.positions[i as usize]);
+            0.5 * (c - a).cross(&(d - a)).norm()
+        })
+        .sum()
+}

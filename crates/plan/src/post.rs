@@ -1,0 +1,71 @@
+//! The post stage: the printing time and filament estimated (the program's header gives them
+//! first, as slicers do, then the settings), and the machine's program written into the
+//! caller's sink, with `toolpath.csv` beside it on another thread.
+
+use crate::estimate::{self, Estimate};
+use crate::report::SettingsEntry;
+use crate::{Options, PlanError};
+use robot_post::machine::MachineProfile;
+use robot_post::{Job, Program, ProgramSink};
+use slicer::toolpath::ToolPath;
+
+/// The header notes of a program: the estimate, then every setting.
+pub fn notes(est: &Estimate, settings: &SettingsEntry) -> Vec<String> {
+    let mut notes = vec![
+        format!(
+            "estimated printing time (normal mode) = {}",
+            estimate::hms(est.time_s)
+        ),
+        format!("filament used [mm] = {:.2}", est.filament_mm),
+        format!("filament used [g] = {:.2}", est.filament_g),
+    ];
+    notes.extend(settings.lines());
+    notes
+}
+
+/// Writes `toolpath`'s program for `machine` into `sink`, headed by `notes`, and with `csv`
+/// its `toolpath.csv` ([`ToolPath::write_csv`]) at the same time on another thread (the two
+/// texts are the bulk of a large plan's writing).
+pub fn post(
+    toolpath: &ToolPath,
+    machine: &MachineProfile,
+    options: &Options,
+    notes: &[String],
+    sink: &mut dyn ProgramSink,
+    csv: Option<&mut (dyn std::io::Write + Send)>,
+) -> Result<Program, PlanError> {
+    let job = Job {
+        source: &options.source,
+        stem: &options.stem,
+        notes,
+    };
+    let post = machine.post();
+    let (program, csv) = match csv {
+        // The program on this thread, toolpath.csv on another (its blocks of lines made by
+        // the thread pool, idle while the post writes).
+        Some(w) => std::thread::scope(|scope| {
+            let lines =
+                scope.spawn(move || toolpath.write_csv(&mut &mut *w).and_then(|()| w.flush()));
+            let program = post.post_to(toolpath, &job, sink);
+            // A panic in the writer is a panic of the plan, as on this thread.
+            let csv = lines
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p));
+            (program, csv)
+        }),
+        None => (post.post_to(toolpath, &job, sink), Ok(())),
+    };
+    let program = program?;
+    csv.map_err(PlanError::Csv)?;
+    Ok(program)
+}
+
+/// A sink that keeps nothing: the post run only for its checks (a refused plan asks whether
+/// the machine would also refuse it).
+pub struct Discard;
+
+impl ProgramSink for Discard {
+    fn file(&mut self, _name: &str) -> std::io::Result<Box<dyn std::io::Write + '_>> {
+        Ok(Box::new(std::io::sink()))
+    }
+}
