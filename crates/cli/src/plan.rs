@@ -13,19 +13,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let path = &args.part;
     // Settings first: a bad process or machine file fails before any work.
     let (process, machine) = settings(args)?;
-    // Then where the outputs go: a place holding an earlier plan fails before any work too.
-    let outputs = Outputs::from_arg(&args.output, machine.kind)?;
-    let earlier = outputs.earlier();
-    if !earlier.is_empty() && !args.force {
-        return Err(Failure::new(
-            &args.output,
-            format!(
-                "holds an earlier plan ({} file(s), e.g. {}): --force replaces it, or choose another output",
-                earlier.len(),
-                earlier[0].display()
-            ),
-        ));
-    }
+    // Then where the outputs go: a place holding files no plan wrote fails before any work too.
+    let outputs = Outputs::from_arg(args.output.as_deref(), path, machine.kind)?;
+    let earlier = outputs.claim(args.force)?;
     // A feature's bad parameters are reported against the process file (or the part without one).
     let process_file = args.process.as_deref().unwrap_or(path);
     // One bar over the whole run (hidden when stderr is not a terminal): reading the part, each
@@ -151,9 +141,6 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let dir = &outputs.dir;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
-    if args.force {
-        outputs.clear_earlier()?;
-    }
     plan.report.placement = placement;
     // toolpath.csv and the program, as staged.
     let staged_names = staged.names();
@@ -193,6 +180,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         &report,
         write_atomic(&dir.join(&report), |w| w.write_all(json.as_bytes())),
     )?;
+    // The earlier plan's files this one did not write again.
+    outputs.remove_stale(&earlier, &plan.report.outputs)?;
     let print: f64 = plan.features().iter().map(|f| f.print_length_mm).sum();
     let widened: f64 = plan.features().iter().map(|f| f.widened_volume_mm3).sum();
     let vol = widened
@@ -209,10 +198,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     bar.0.inc(1);
     drop(bar);
     // Where it went: the folder, or the program file `-o` named.
-    let to = match &args.output {
-        o if o.is_dir() => dir.display().to_string(),
-        o => o.display().to_string(),
-    };
+    let to = outputs.shown();
     emit(&format!(
         "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {} warning(s) -> {to}\n",
         path.display(),
