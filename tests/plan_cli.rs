@@ -340,8 +340,76 @@ fn a_program_file_as_output_gets_its_outputs_beside_it() {
     assert!(names.iter().all(|n| !n.starts_with("box.src")), "{names:?}");
 }
 
+/// The names a plan's `plan.json` lists under `outputs`, and `plan.json` itself, sorted.
+fn listed_outputs(report: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(report).expect("plan.json");
+    let v: Value = serde_json::from_str(&text).expect("plan.json is JSON");
+    let name = report.file_name().and_then(|n| n.to_str()).expect("a name");
+    let mut names: Vec<String> = v["outputs"]
+        .as_array()
+        .expect("outputs")
+        .iter()
+        .filter_map(|n| n.as_str().map(str::to_string))
+        .chain(std::iter::once(name.to_string()))
+        .collect();
+    names.sort();
+    names
+}
+
+/// The arguments of the README's first command after `cargo run ... --`, its comment dropped.
+fn readme_first_command() -> Vec<String> {
+    let readme = std::fs::read_to_string(fixture("../README.md")).expect("README.md");
+    let first = readme
+        .lines()
+        .skip_while(|l| !l.starts_with("```sh"))
+        .nth(1)
+        .expect("a sh block in the README");
+    let command = first.split(" # ").next().unwrap_or(first);
+    let (cargo, args) = command
+        .split_once(" -- ")
+        .expect("the first command runs the binary through cargo");
+    assert!(cargo.starts_with("cargo run"), "{first}");
+    args.split_whitespace().map(str::to_string).collect()
+}
+
 #[test]
-fn an_earlier_plan_is_refused_unless_forced_and_then_cleared() {
+fn the_readmes_first_command_runs_twice_and_leaves_one_plan() {
+    let args = readme_first_command();
+    assert_eq!(args.first().map(String::as_str), Some("plan"), "{args:?}");
+    let o_at = args
+        .iter()
+        .position(|a| a == "-o")
+        .expect("-o in the README's command");
+    let out_name = args[o_at + 1].clone();
+    // Run where a fresh clone would, but in a scratch folder: the part's path (relative to the
+    // repository) made absolute, the output as the README names it.
+    let s = Scratch::new("readme");
+    let root = fixture("..");
+    let run = || {
+        let mut c = Command::new(BIN);
+        c.current_dir(s.path(""));
+        for a in &args {
+            if a.ends_with(".step") {
+                c.arg(root.join(a));
+            } else {
+                c.arg(a);
+            }
+        }
+        c.output().expect("runs")
+    };
+    let first = run();
+    assert!(first.status.success(), "{}", stderr(&first));
+    let out = s.path(&out_name);
+    assert_eq!(s.names(&out_name), listed_outputs(&out.join("plan.json")));
+    let second = run();
+    assert!(second.status.success(), "second run: {}", stderr(&second));
+    // The second plan replaced the first: the folder holds exactly what its plan.json lists.
+    assert_eq!(s.names(&out_name), listed_outputs(&out.join("plan.json")));
+    assert_eq!(s.names(""), [out_name]);
+}
+
+#[test]
+fn an_earlier_plan_is_replaced_and_its_stale_files_removed() {
     let s = Scratch::new("earlier");
     let out = s.path("out");
     let o_arg = out.to_str().unwrap();
@@ -352,23 +420,109 @@ fn an_earlier_plan_is_refused_unless_forced_and_then_cleared() {
     assert!(first
         .iter()
         .any(|n| n.starts_with("two_solids") && n.ends_with(".src")));
-    let before = std::fs::read(out.join("plan.json")).unwrap();
-    // Planning into it again is refused, and leaves it as it was.
+    // Planning another part into it replaces that plan: none of its modules is left.
     let o = plan("box.step", &["--machine", "kuka", "-o", o_arg]);
-    assert_refused(&o, &["earlier plan", "--force"]);
-    assert_eq!(s.names("out"), first);
-    assert_eq!(std::fs::read(out.join("plan.json")).unwrap(), before);
-    // --force removes what the earlier plan wrote, and nothing else.
-    std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let o = plan("box.step", &["--machine", "kuka", "--force", "-o", o_arg]);
     assert!(o.status.success(), "{}", stderr(&o));
     let after = s.names("out");
     assert!(
         after.iter().all(|n| !n.starts_with("two_solids")),
         "{after:?}"
     );
-    assert!(after.contains(&"notes.txt".to_string()));
     assert!(after.contains(&"box.src".to_string()), "{after:?}");
+    assert_eq!(after, listed_outputs(&out.join("plan.json")));
+    // Under a program file's stem likewise, beside files of other names.
+    let gcode = s.path("box.gcode");
+    let g_arg = gcode.to_str().unwrap();
+    let o = plan("box.step", &["--machine", "delta5", "-o", g_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(s.names("").contains(&"box.kinematic_error.svg".to_string()));
+    let o = plan("box.step", &["--machine", "marlin", "-o", g_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut stem: Vec<String> = s
+        .names("")
+        .into_iter()
+        .filter(|n| n.starts_with("box."))
+        .collect();
+    stem.sort();
+    assert_eq!(
+        stem,
+        listed_outputs(&s.path("box.plan.json")),
+        "the delta5 plan's svg removed"
+    );
+}
+
+#[test]
+fn an_output_holding_files_no_plan_wrote_is_refused_unless_forced() {
+    let s = Scratch::new("foreign");
+    let out = s.path("out");
+    let o_arg = out.to_str().unwrap();
+    let o = plan("box.step", &["-o", o_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = std::fs::read(out.join("plan.json")).unwrap();
+    // A file of the user's beside the plan: refused, naming it, the folder left as it was.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let names = s.names("out");
+    let o = plan("box.step", &["-o", o_arg]);
+    assert_refused(&o, &["no plan wrote", "notes.txt", "--force"]);
+    assert_eq!(s.names("out"), names);
+    assert_eq!(std::fs::read(out.join("plan.json")).unwrap(), before);
+    // --force replaces the plan and leaves the file.
+    let o = plan("two_solids.step", &["--force", "-o", o_arg]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    let mut expected = listed_outputs(&out.join("plan.json"));
+    expected.push("notes.txt".into());
+    expected.sort();
+    assert_eq!(s.names("out"), expected);
+    // Without an earlier plan, a file the plan would write over is refused too; other files
+    // (a log the run's own output goes to) are not.
+    let mine = s.path("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("program.gcode"), "G28\n").unwrap();
+    let o = plan("box.step", &["-o", mine.to_str().unwrap()]);
+    assert_refused(&o, &["no plan wrote", "program.gcode", "--force"]);
+    assert_eq!(
+        std::fs::read_to_string(mine.join("program.gcode")).unwrap(),
+        "G28\n"
+    );
+    let logged = s.path("logged");
+    std::fs::create_dir_all(&logged).unwrap();
+    std::fs::write(logged.join("stdout"), "").unwrap();
+    let o = plan("box.step", &["-o", logged.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn without_o_the_plan_goes_to_the_parts_stem_and_o_dash_is_refused() {
+    let s = Scratch::new("default_o");
+    let run = |args: &[&str]| {
+        Command::new(BIN)
+            .current_dir(s.path(""))
+            .arg("plan")
+            .arg(fixture("box.step"))
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(s.names(""), ["box_plan"]);
+    assert_eq!(
+        s.names("box_plan"),
+        listed_outputs(&s.path("box_plan/plan.json"))
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("-> box_plan"));
+    // Again: the earlier plan is replaced.
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // `-o -` is not a folder named `-`.
+    let o = run(&["-o", "-"]);
+    assert_refused(&o, &["standard output", "give -o a folder"]);
+    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+    assert_eq!(s.names(""), ["box_plan"]);
 }
 
 #[test]

@@ -196,3 +196,99 @@ fn eq_1_is_written_once() {
     }
     assert_eq!(found.len(), 1, "Eq. 1 at {found:?}");
 }
+
+/// Most lines the README may have: a map of the project, the reference lives in `docs/`.
+const README_MAX_LINES: usize = 150;
+
+#[test]
+fn the_readme_is_a_map_of_at_most_150_lines() {
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let lines = readme.lines().count();
+    assert!(
+        lines <= README_MAX_LINES,
+        "README.md has {lines} lines, at most {README_MAX_LINES}: move reference text to docs/"
+    );
+    for page in ["plan.md", "profiles.md", "design.md", "measurements.md"] {
+        assert!(
+            readme.contains(&format!("](docs/{page})")),
+            "README.md links docs/{page}"
+        );
+    }
+}
+
+/// GitHub's anchor of a heading: lower case, letters, digits, `-` and `_` kept, spaces made
+/// `-`, everything else dropped.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The anchors of a Markdown file's headings (outside fenced code).
+fn anchors(text: &str) -> BTreeSet<String> {
+    let mut fenced = false;
+    let mut out = BTreeSet::new();
+    for line in text.lines() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            out.insert(anchor(line.trim_start_matches('#')));
+        }
+    }
+    out
+}
+
+/// The targets of a Markdown file's inline links `](target)`.
+fn link_targets(text: &str) -> Vec<String> {
+    text.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split_once(')').map(|(t, _)| t.to_string()))
+        .collect()
+}
+
+#[test]
+fn every_link_of_the_readme_and_docs_reaches_a_file_and_heading() {
+    let mut pages = vec![root().join("README.md")];
+    let docs = root().join("docs");
+    for e in std::fs::read_dir(&docs).expect("docs/").flatten() {
+        if e.path().extension().is_some_and(|x| x == "md") {
+            pages.push(e.path());
+        }
+    }
+    let mut broken = vec![];
+    for page in &pages {
+        let text = std::fs::read_to_string(page).expect("a page");
+        for target in link_targets(&text) {
+            if target.starts_with("http://") || target.starts_with("https://") {
+                continue;
+            }
+            let (file, heading) = match target.split_once('#') {
+                Some((f, h)) => (f, Some(h)),
+                None => (target.as_str(), None),
+            };
+            let path = if file.is_empty() {
+                page.clone()
+            } else {
+                page.parent().expect("a folder").join(file)
+            };
+            if !path.exists() {
+                broken.push(format!("{}: {target} (no such file)", page.display()));
+                continue;
+            }
+            if let Some(h) = heading {
+                let linked = std::fs::read_to_string(&path).unwrap_or_default();
+                if !anchors(&linked).contains(h) {
+                    broken.push(format!("{}: {target} (no such heading)", page.display()));
+                }
+            }
+        }
+    }
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}

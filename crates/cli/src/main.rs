@@ -61,10 +61,11 @@ enum Command {
     Extract(ExtractArgs),
     /// Plan layers and paths for every feature and write the machine program.
     #[command(
-        after_help = "Examples:\n  features plan part.step -o out/                      Marlin G-code, toolpath.csv, plan.json in out/\n  \
+        after_help = "Examples:\n  features plan part.step                              Marlin G-code, toolpath.csv, plan.json in part_plan/\n  \
+                            features plan part.step -o out/                      the same in out/ (an earlier plan there is replaced)\n  \
                             features plan part.step --machine delta5 -o part.gcode   5-axis program part.gcode, beside it part.toolpath.csv, part.plan.json\n  \
                             features plan part.step --machine kuka -o cell/          KRL modules for a KUKA cell\n  \
-                            features plan part.step --process profiles/process.toml --strict -o out/ --force"
+                            features plan part.step --process profiles/process.toml --strict -o out/"
     )]
     Plan(PlanArgs),
     /// Write a web page that shows the features a part is built from (WebGL, works offline).
@@ -122,17 +123,18 @@ pub struct PlanArgs {
     /// Machine profile (TOML) instead of a built-in one (see profiles/*.toml)
     #[arg(long, value_name = "FILE")]
     pub machine_profile: Option<PathBuf>,
-    /// Output folder, or the program file [required]
+    /// Output folder, or the program file [default: ./<part stem>_plan/]
     ///
     /// A folder (created if missing) gets toolpath.csv, plan.json and the machine program
     /// (program.gcode, or the KRL modules named by the part). A path ending in .gcode (Marlin,
     /// delta5) or .src (KUKA) is the program file itself, and the other outputs go beside it
-    /// under its stem: `-o box.gcode` writes box.gcode, box.toolpath.csv and box.plan.json. A
-    /// place that holds an earlier plan is refused unless --force.
+    /// under its stem: `-o box.gcode` writes box.gcode, box.toolpath.csv and box.plan.json. An
+    /// earlier plan there is replaced (its files the new plan does not write are removed); a
+    /// place that holds files no plan wrote is refused unless --force. `-o -` is refused.
     #[arg(short, long, value_name = "DIR|FILE.gcode|FILE.src")]
-    pub output: PathBuf,
-    /// Replace an earlier plan at the output: its files (those its plan.json lists) are removed
-    /// first, so none is left beside the new ones
+    pub output: Option<PathBuf>,
+    /// Write the plan where files no plan wrote are (beside an earlier plan, or of the plan's
+    /// names): those of the new plan's names are replaced, the others left as they are
     #[arg(long)]
     pub force: bool,
     /// Treat every warning as an error: exit 2 and write nothing when the plan has one

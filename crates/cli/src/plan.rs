@@ -17,9 +17,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         path: e.origin,
         cause: e.cause,
     })?;
-    // Then where the outputs go: a place holding an earlier plan fails before any work too.
-    let outputs = Outputs::from_arg(&args.output, machine.kind)?;
-    refuse_earlier(&outputs, args)?;
+    // Then where the outputs go: a place holding files no plan wrote fails before any work too.
+    let outputs = Outputs::from_arg(args.output.as_deref(), path, machine.kind)?;
+    let earlier = outputs.claim(args.force)?;
     let bar = Bar::new(path);
     let file = brep::StepFile::read(path).map_err(|e| Failure::new(path, e))?;
     bar.0.inc(1);
@@ -60,7 +60,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let plan = result.map_err(|e| refused(e, path, process_file, &bar))?;
     tell_placement(&plan, path, &bar);
     let warnings = print_warnings(&plan, path, &bar);
-    let summary = write_plan(plan, &outputs, staged, args, warnings)?;
+    let summary = write_plan(plan, &outputs, staged, &earlier, args, warnings)?;
     bar.0.inc(1);
     drop(bar);
     emit(&summary)
@@ -84,22 +84,6 @@ fn placement(args: &PlanArgs) -> Placement {
         (None, Some("auto")) => Placement::Auto,
         _ => Placement::AsModelled,
     }
-}
-
-/// An output holding an earlier plan is refused unless `--force`.
-fn refuse_earlier(outputs: &Outputs, args: &PlanArgs) -> Result<(), Failure> {
-    let earlier = outputs.earlier();
-    if !earlier.is_empty() && !args.force {
-        return Err(Failure::new(
-            &args.output,
-            format!(
-                "holds an earlier plan ({} file(s), e.g. {}): --force replaces it, or choose another output",
-                earlier.len(),
-                earlier[0].display()
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// The line of a plan not made, or refused: a refusal's lines first (one per feature, or the
@@ -167,12 +151,14 @@ fn print_warnings(plan: &Plan, path: &Path, bar: &Bar) -> usize {
 }
 
 /// Writes the plan's files: the staged program and toolpath.csv, the preview, the colliding
-/// moves left (when any), and plan.json last (a folder with plan.json holds a whole plan); the
+/// moves left (when any), and plan.json last (a folder with plan.json holds a whole plan);
+/// then the `earlier` plan's files this one did not write again are removed. Returns the
 /// closing line to print.
 fn write_plan(
     mut plan: Plan,
     outputs: &Outputs,
     staged: Staged,
+    earlier: &[std::path::PathBuf],
     args: &PlanArgs,
     warnings: usize,
 ) -> Result<String, Failure> {
@@ -180,9 +166,6 @@ fn write_plan(
     let dir = &outputs.dir;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
-    if args.force {
-        outputs.clear_earlier()?;
-    }
     let preview_name = outputs.name("preview.html");
     let page = crate::preview::plan_page(&plan, &path.display().to_string());
     let collisions_name =
@@ -217,6 +200,7 @@ fn write_plan(
         &report,
         write_atomic(&dir.join(&report), |w| w.write_all(json.as_bytes())),
     )?;
+    outputs.remove_stale(earlier, &plan.report.outputs)?;
     Ok(summary_line(&plan, args, outputs, warnings))
 }
 
@@ -236,10 +220,7 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
         String::new()
     };
     // Where it went: the folder, or the program file `-o` named.
-    let to = match &args.output {
-        o if o.is_dir() => outputs.dir.display().to_string(),
-        o => o.display().to_string(),
-    };
+    let to = outputs.shown();
     format!(
         "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
         args.part.display(),

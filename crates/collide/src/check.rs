@@ -23,7 +23,7 @@ pub enum Travels {
     Skip,
 }
 
-/// [`check`], re-routing each colliding travel over the material: from its start up its tool
+/// [`check`](crate::check()), re-routing each colliding travel over the material: from its start up its tool
 /// axis, across at one height, and down the next point's axis, by the least lift (a share of the head's
 /// length, or clear of the highest material) that makes all three moves clear. A travel no lift
 /// clears (or whose head collides at either end) is left as planned and reported. With

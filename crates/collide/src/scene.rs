@@ -48,7 +48,7 @@ pub struct Collision {
 pub struct Scene {
     shape: HeadShape,
     table: Option<Table>,
-    /// What lies before the move being checked, but for [`Scene::pending`].
+    /// What lies before the move being checked, but for the beads still pending (`Scene::pending`).
     pub deposit: Deposit,
     /// Ranges of the path whose beads lie before the move too but are not in `deposit` yet
     /// ([`Scene::deposit`], [`Scene::flush`]): a head above them all cannot meet them.

@@ -89,7 +89,7 @@ impl TiltLimits {
     }
 }
 
-/// A path after [`tilt`].
+/// A path after [`tilt`](crate::tilt()).
 #[derive(Debug, Clone)]
 pub struct Tilted {
     /// The path, its tool axes tilted where that clears moves (positions and all else as

@@ -281,7 +281,8 @@ pub struct PlanReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<PlacementEntry>,
     /// The files the plan was written to, beside `plan.json` (set by whoever writes them; the
-    /// command line lists them so that `--force` can clear them before the next plan).
+    /// command line lists them so that the next plan there replaces them, its stale files
+    /// removed).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub outputs: Vec<String>,
 }

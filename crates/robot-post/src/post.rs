@@ -72,7 +72,7 @@ pub enum PostFigures {
     Kuka(KukaFigures),
 }
 
-/// The Marlin post ([`marlin`]): `program.gcode`.
+/// The Marlin post ([`marlin`](crate::marlin())): `program.gcode`.
 #[derive(Debug, Clone, Copy)]
 pub struct MarlinPost<'a>(pub &'a MachineProfile);
 
@@ -102,7 +102,7 @@ impl Post for MarlinPost<'_> {
     }
 }
 
-/// The 5-axis post ([`delta5`]): `program.gcode` and `kinematic_error.svg`, kinematic figures
+/// The 5-axis post ([`delta5`](crate::delta5())): `program.gcode` and `kinematic_error.svg`, kinematic figures
 /// per feature.
 #[derive(Debug, Clone, Copy)]
 pub struct Delta5Post<'a>(pub &'a MachineProfile);
@@ -123,7 +123,7 @@ impl Post for Delta5Post<'_> {
     }
 }
 
-/// The KUKA post ([`kuka`]): the KRL files named after the job's stem, reach figures per
+/// The KUKA post ([`kuka`](crate::kuka())): the KRL files named after the job's stem, reach figures per
 /// feature, and its warnings.
 #[derive(Debug, Clone, Copy)]
 pub struct KukaPost<'a>(pub &'a MachineProfile);

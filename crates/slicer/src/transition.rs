@@ -3,10 +3,10 @@
 //! has no stair-steps.
 //!
 //! - **Base, top, sides (section 3.1, Fig. 4).** B is where the feature grows from: its
-//!   reference region, `d = 0` in the chart of the reference surface (see [`crate::chart`]).
+//!   reference region, `d = 0` in the chart of the reference surface (see `crate::chart`).
 //!   T is the feature's faces that look the way it grows: the faces other than its healing
 //!   faces whose area-weighted normal, in chart space `(s, t, d)`, points up (`d`-share at
-//!   least [`TOP_SHARE`]). The rest are the sides S_i.
+//!   least `TOP_SHARE`). The rest are the sides S_i.
 //! - **Correspondence.** B and T of a real part are trimmed faces of unrelated surfaces, not
 //!   the aligned `(u, v)` patches the paper assumes. The correspondence is the chart's: the
 //!   point of T over chart point `q` is the one met along the reference's normal N(q), at
@@ -24,8 +24,9 @@
 //!   thickness lies in `[h_min/N, h_max/N]`: N must be in
 //!   `[ceil(h_max / max_layer_height), floor(h_min / min_layer_height)]`; it is the number of
 //!   that range nearest `h_mean / uniform_layer_height`. An empty range (the top comes too
-//!   close to the base somewhere for one N) gets offset layers first: [`Levels::Hybrid`]; where
-//!   not even that keeps the bounds, [`Levels::Infeasible`].
+//!   close to the base somewhere for one N, `Levels::Infeasible`) gets offset layers first, then
+//!   a band of transition layers over them (`band`); where not even that keeps the bounds, the
+//!   feature is refused.
 //! - **Volume, Eq. 1.** A transition layer leans on the reference by the angle α between its
 //!   normal n_L and N: its beads are `t_N·cos α` thick across it, and a segment counts by its
 //!   length along the layer (not up the steps over a hybrid's staircase); `thickness` in the

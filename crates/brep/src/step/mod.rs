@@ -1,6 +1,6 @@
 //! STEP I/O: the Part 21 parser ([`p21`]), the translation of its entities into our B-rep
 //! ([`read`]), reading a file into a [`StepPart`] ([`read_step`]) and writing solids back
-//! ([`write`]).
+//! ([`mod@write`]).
 
 pub mod error;
 pub mod p21;

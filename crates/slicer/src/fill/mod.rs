@@ -277,7 +277,7 @@ fn ring_print_tolerance(tol: f64, width: f64) -> f64 {
 /// The role of infill lines `spacing` apart for beads `width` wide: [`Role::SolidInfill`]
 /// where the beads touch (spacing at most the width, the default `filling_ratio` 1),
 /// [`Role::InternalInfill`] where they are laid apart (the planners make a feature's bottom
-/// and top layers solid: [`crate::region_fill::solid_on_skins`]).
+/// and top layers solid: `region_fill::solid_on_skins`).
 pub fn infill_role(width: f64, spacing: f64) -> Role {
     if spacing <= width * (1.0 + 1e-6) {
         Role::SolidInfill

@@ -99,7 +99,7 @@ pub struct P21File {
 
 impl P21File {
     /// The entity `#id`, if the file defines it. Uses the index built by
-    /// [`parse`]; entities added to or moved in `entities` afterwards may not
+    /// [`parse`](super::parse); entities added to or moved in `entities` afterwards may not
     /// be found.
     pub fn get(&self, id: u64) -> Option<&Entity> {
         self.index
