@@ -309,7 +309,12 @@ fn tilted_axes_on_a_3_axis_printer_and_unknown_machines_are_refused_with_one_lin
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains(needle), "{err}");
-        assert!(!dir.exists(), "{name}: wrote output");
+        assert!(!dir.join("program.gcode").exists(), "{name}: wrote a program");
+        assert!(!dir.join("toolpath.csv").exists(), "{name}: wrote a tool path");
+        // A plan the machine refuses says why in its report; an unknown machine plans nothing.
+        let machine_refused = name != "box";
+        assert_eq!(dir.join("plan.json").exists(), machine_refused, "{name}: {err}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 
@@ -862,9 +867,22 @@ fn a_plan_that_loses_material_exits_2_naming_the_feature_and_writes_nothing() {
     assert_eq!(lines.len(), 1, "{stderr}");
     assert!(lines[0].contains("feature 0 (two5d)"), "{}", lines[0]);
     assert!(stderr.contains("fails its self-check"), "{stderr}");
-    for f in ["plan.json", "toolpath.csv", "program.gcode"] {
+    for f in ["toolpath.csv", "program.gcode"] {
         assert!(!dir.join(f).exists(), "{f} written");
     }
+    // The refused plan's report and preview show why (issue 31): not complete, the failing
+    // feature listed.
+    let report: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("plan.json")).expect("plan.json of the refused plan"),
+    )
+    .expect("json");
+    assert_eq!(report["complete"], false);
+    let failures = report["failures"].as_array().expect("failures");
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    assert_eq!(failures[0]["gate"], "selfcheck");
+    assert_eq!(failures[0]["feature"], 0);
+    assert!(dir.join("preview.html").exists());
+    assert!(stderr.contains("no program written; plan.json and preview.html show why"), "{stderr}");
 }
 
 #[test]
@@ -936,10 +954,15 @@ fn every_corpus_plan_passes_its_self_check_or_exits_2_naming_why() {
                 if !self_check && errors.len() != 1 {
                     failures.push(format!("{name}: exit 2 with {} error lines", errors.len()));
                 }
-                for f in ["plan.json", "toolpath.csv", "program.gcode"] {
+                for f in ["toolpath.csv", "program.gcode"] {
                     if out_dir.join(f).exists() {
                         failures.push(format!("{name}: {f} written on exit 2"));
                     }
+                }
+                // A refused plan's report says why; a plan not made writes none.
+                let report = out_dir.join("plan.json");
+                if self_check && !report.exists() {
+                    failures.push(format!("{name}: refused with no plan.json to show why"));
                 }
             }
             other => failures.push(format!("{name}: exit {other:?}: {stderr}")),

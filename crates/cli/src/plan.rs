@@ -57,7 +57,12 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     bar.0.set_prefix("writing");
     bar.0.set_message("outputs");
     let process_file = args.process.as_deref().unwrap_or(path);
-    let plan = result.map_err(|e| refused(e, path, process_file, &bar))?;
+    let refusal = Refusal {
+        outputs: &outputs,
+        earlier: &earlier,
+        bar: &bar,
+    };
+    let plan = result.map_err(|e| refusal.fail(e, path, process_file))?;
     tell_placement(&plan, path, &bar);
     let warnings = print_warnings(&plan, path, &bar);
     let summary = write_plan(plan, &outputs, staged, &earlier, args, warnings)?;
@@ -86,40 +91,114 @@ fn placement(args: &PlanArgs) -> Placement {
     }
 }
 
-/// The line of a plan not made, or refused: a refusal's lines first (one per feature, or the
-/// warnings `--strict` refuses).
-fn refused(e: PlanError, path: &Path, process_file: &Path, bar: &Bar) -> Failure {
-    let say = |line: &str| {
-        bar.0
-            .suspend(|| eprintln!("features: {}: {line}", path.display()))
-    };
-    match e {
-        PlanError::Process(e) => Failure::new(process_file, e),
-        PlanError::Refused { gate, plan } => {
-            let cause = match gate {
-                Gate::SelfCheck(problems) => {
-                    problems.iter().for_each(|p| say(&p.to_string()));
-                    format!("the plan fails its self-check for {} feature(s) (listed above); nothing written (--keep-going writes it anyway)", problems.len())
-                }
-                Gate::Collisions(lines) => {
-                    lines.iter().for_each(|l| say(l));
-                    format!("the print head collides in {} feature(s) (listed above); nothing written (--allow-collisions writes it anyway)", lines.len())
-                }
-                Gate::Strict(n) => {
-                    tell_placement(&plan, path, bar);
-                    print_warnings(&plan, path, bar);
-                    format!("{n} warning(s) (listed above) and --strict: nothing written")
-                }
-                Gate::Unreachable(n) => {
-                    tell_placement(&plan, path, bar);
-                    print_warnings(&plan, path, bar);
-                    format!("{n} point(s) out of the arm's reach or joint limits (listed above): nothing written (--allow-unreachable writes the program anyway)")
-                }
-            };
-            Failure::new(path, cause)
-        }
-        e => Failure::new(path, e),
+/// Where a refused plan's report and preview go.
+struct Refusal<'a> {
+    outputs: &'a Outputs,
+    earlier: &'a [std::path::PathBuf],
+    bar: &'a Bar,
+}
+
+impl Refusal<'_> {
+    /// The line of a plan not made, or refused: a refusal's lines first (one per feature, or
+    /// the warnings `--strict` refuses), and its `plan.json` and `preview.html` written to show
+    /// why (no program).
+    fn fail(&self, e: PlanError, path: &Path, process_file: &Path) -> Failure {
+        let bar = self.bar;
+        let say = |line: &str| {
+            bar.0
+                .suspend(|| eprintln!("features: {}: {line}", path.display()))
+        };
+        let (gate, plan) = match e {
+            PlanError::Process(e) => return Failure::new(process_file, e),
+            PlanError::Refused { gate, plan } => (gate, plan),
+            e => return Failure::new(path, e),
+        };
+        let (cause, allow) = match &gate {
+            Gate::SelfCheck(problems) => {
+                problems.iter().for_each(|p| say(&p.to_string()));
+                (
+                    format!(
+                        "the plan fails its self-check for {} feature(s) (listed above)",
+                        problems.len()
+                    ),
+                    " (--keep-going writes it anyway)",
+                )
+            }
+            Gate::Collisions(lines) => {
+                lines.iter().for_each(|l| say(l));
+                (
+                    format!(
+                        "the print head collides in {} feature(s) (listed above)",
+                        lines.len()
+                    ),
+                    " (--allow-collisions writes it anyway)",
+                )
+            }
+            Gate::Strict(n) => {
+                tell_placement(&plan, path, bar);
+                print_warnings(&plan, path, bar);
+                (format!("{n} warning(s) (listed above) and --strict"), "")
+            }
+            Gate::Unreachable(n) => {
+                tell_placement(&plan, path, bar);
+                print_warnings(&plan, path, bar);
+                (
+                    format!("{n} point(s) out of the arm's reach or joint limits (listed above)"),
+                    " (--allow-unreachable writes the program anyway)",
+                )
+            }
+            Gate::Machine(line) => (line.clone(), ""),
+        };
+        let written = match write_refused(&plan, self.outputs, self.earlier, path) {
+            Ok(names) => format!("no program written; {} show why", names.join(" and ")),
+            Err(f) => format!("nothing written ({}: {})", f.path, f.cause),
+        };
+        Failure::new(path, format!("{cause}: {written}{allow}"))
     }
+}
+
+/// A refused plan's report and preview (and its colliding moves, when any) written to show why,
+/// no program; the earlier plan's other files removed. Returns the names written.
+fn write_refused(
+    plan: &Plan,
+    outputs: &Outputs,
+    earlier: &[std::path::PathBuf],
+    path: &Path,
+) -> Result<Vec<String>, Failure> {
+    let dir = &outputs.dir;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
+    let written = |name: &str, r: std::io::Result<()>| {
+        r.map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))
+    };
+    let preview_name = outputs.name("preview.html");
+    let page = crate::preview::plan_page(plan, &path.display().to_string());
+    written(
+        &preview_name,
+        write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),
+    )?;
+    let mut report = plan.report.clone();
+    report.outputs = vec![preview_name.clone()];
+    if !plan.collisions.left.is_empty() {
+        let name = outputs.name("collisions.csv");
+        written(
+            &name,
+            write_atomic(&dir.join(&name), |w| {
+                plan::collisions::write_csv(&plan.collisions, w)
+            }),
+        )?;
+        report.outputs.push(name);
+    }
+    let json = report.to_json().map_err(|e| Failure::new(path, e))?;
+    let report_name = outputs.name("plan.json");
+    written(
+        &report_name,
+        write_atomic(&dir.join(&report_name), |w| w.write_all(json.as_bytes())),
+    )?;
+    outputs.remove_stale(earlier, &report.outputs)?;
+    let mut names = vec![report_name];
+    names.extend(report.outputs);
+    Ok(names)
 }
 
 /// Where the part stands, when it was turned.

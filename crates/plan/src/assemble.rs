@@ -83,6 +83,7 @@ impl Stages {
             filament_g: round(est.filament_g, 1e2),
             settings,
             placement,
+            failures: vec![],
             outputs: vec![],
         };
         Plan {

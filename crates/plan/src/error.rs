@@ -58,6 +58,22 @@ pub enum Gate {
     Strict(usize),
     /// Points the robot cannot reach (and [`crate::Options::allow_unreachable`] is off).
     Unreachable(usize),
+    /// The machine cannot make the path (its post's checks: the bed, the work envelope, a B/C
+    /// bed's limits, a 3-axis printer's tool axis): the post's line.
+    Machine(String),
+}
+
+impl Gate {
+    /// Its name in `plan.json`'s `failures`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Gate::SelfCheck(_) => "selfcheck",
+            Gate::Collisions(_) => "collisions",
+            Gate::Strict(_) => "strict",
+            Gate::Unreachable(_) => "reach",
+            Gate::Machine(_) => "machine",
+        }
+    }
 }
 
 impl std::fmt::Display for Gate {
@@ -75,6 +91,7 @@ impl std::fmt::Display for Gate {
             Gate::Unreachable(n) => {
                 write!(f, "{n} point(s) out of the arm's reach or joint limits")
             }
+            Gate::Machine(line) => f.write_str(line),
         }
     }
 }

@@ -5,9 +5,10 @@
 
 use crate::head::Checked;
 use crate::lay::LaidFeature;
+use crate::report::{FailureEntry, PostEntry};
 use crate::warning::{Warning, WarningKind};
 use crate::{Gate, Options, Plan};
-use slicer::verify::check_plan;
+use slicer::verify::{check_plan, PlanProblem};
 
 /// What the gates before the post let pass, as warnings of the part.
 #[derive(Debug, Default)]
@@ -66,4 +67,70 @@ pub fn after_post(plan: &Plan, options: &Options) -> Result<(), Gate> {
         return Err(Gate::Unreachable(unreachable));
     }
     Ok(())
+}
+
+/// What `plan.json` lists of a refusal by `gate`: each failure with its feature and, where the
+/// gate has one, its position.
+pub fn failures(gate: &Gate, plan: &Plan) -> Vec<FailureEntry> {
+    let entry = |feature: Option<usize>, position: Option<[f64; 3]>, text: String| FailureEntry {
+        gate: gate.name(),
+        feature,
+        position,
+        text,
+    };
+    match gate {
+        Gate::SelfCheck(problems) => problems
+            .iter()
+            .map(|p| {
+                let id = match p {
+                    PlanProblem::NoLayers { id, .. } | PlanProblem::Volume { id, .. } => *id,
+                };
+                entry(Some(id), None, p.to_string())
+            })
+            .collect(),
+        Gate::Collisions(lines) => plan
+            .features()
+            .iter()
+            .filter_map(|f| {
+                let first = f.collision.first_collision.as_ref()?;
+                let line = lines
+                    .iter()
+                    .find(|l| l.starts_with(&format!("feature {}:", f.feature.id)))?;
+                Some(entry(Some(f.feature.id), Some(first.position), line.clone()))
+            })
+            .collect(),
+        Gate::Strict(_) => plan
+            .warnings()
+            .iter()
+            .map(|w| entry(None, None, w.to_string()))
+            .collect(),
+        Gate::Unreachable(_) => plan
+            .features()
+            .iter()
+            .filter_map(|f| match f.post {
+                Some(PostEntry::Kuka {
+                    unreachable_points, ..
+                }) if unreachable_points > 0 => Some(entry(
+                    Some(f.feature.id),
+                    None,
+                    format!(
+                        "feature {}: {unreachable_points} point(s) out of the arm's reach or joint limits",
+                        f.feature.id
+                    ),
+                )),
+                _ => None,
+            })
+            .collect(),
+        Gate::Machine(line) => vec![entry(None, None, line.clone())],
+    }
+}
+
+/// `plan` refused by `gate`: its report says so (`"complete": false`, the `failures`).
+pub fn refused(gate: Gate, mut plan: Plan) -> crate::PlanError {
+    plan.report.complete = false;
+    plan.report.failures = failures(&gate, &plan);
+    crate::PlanError::Refused {
+        gate,
+        plan: Box::new(plan),
+    }
 }

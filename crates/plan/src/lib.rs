@@ -222,27 +222,31 @@ fn run(
     let settings = settings::entry(process, machine, &process.base());
     let est = estimate::estimate(&stages.checked.toolpath, machine);
     let notes = post::notes(&est, &settings);
-    let program = post::post(
+    let program = match post::post(
         &stages.checked.toolpath,
         machine,
         options,
         &notes,
         sink,
         csv,
-    )?;
+    ) {
+        Ok(program) => program,
+        Err(PlanError::Post(e)) => {
+            let plan = stages.assemble(machine, options, None, passed, &est, settings);
+            return Err(gates::refused(Gate::Machine(e.to_string()), plan));
+        }
+        Err(e) => return Err(e),
+    };
     let plan = stages.assemble(machine, options, Some(&program), passed, &est, settings);
     match gates::after_post(&plan, options) {
         Ok(()) => Ok(plan),
-        Err(gate) => Err(PlanError::Refused {
-            gate,
-            plan: Box::new(plan),
-        }),
+        Err(gate) => Err(gates::refused(gate, plan)),
     }
 }
 
 /// A plan refused by a gate before the post: the machine's own refusal first, when its post
 /// would refuse the path too (it is what a user fixes first), else the gate's, with the plan
-/// as far as it went (`"complete": false`).
+/// as far as it went (`"complete": false`, its `failures`).
 fn refuse(
     gate: Gate,
     stages: assemble::Stages,
@@ -253,7 +257,7 @@ fn refuse(
     let settings = settings::entry(process, machine, &process.base());
     let est = estimate::estimate(&stages.checked.toolpath, machine);
     let notes = post::notes(&est, &settings);
-    if let Err(e) = post::post(
+    let gate = match post::post(
         &stages.checked.toolpath,
         machine,
         options,
@@ -261,15 +265,15 @@ fn refuse(
         &mut post::Discard,
         None,
     ) {
-        return e;
-    }
+        Err(e) => Gate::Machine(e.to_string()),
+        Ok(_) => gate,
+    };
     let passed = gates::Passed {
         complete: false,
         warnings: vec![],
     };
-    let plan = stages.assemble(machine, options, None, passed, &est, settings);
-    PlanError::Refused {
+    gates::refused(
         gate,
-        plan: Box::new(plan),
-    }
+        stages.assemble(machine, options, None, passed, &est, settings),
+    )
 }

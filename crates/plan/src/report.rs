@@ -254,6 +254,20 @@ pub struct PlacementEntry {
     pub rule: String,
 }
 
+/// One reason a plan was refused, where it is (`failures` in `plan.json`, on a refused plan).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailureEntry {
+    /// The gate that refused it: `selfcheck`, `collisions`, `machine`, `reach` or `strict`.
+    pub gate: &'static str,
+    /// The feature it is about; `null`: the whole plan.
+    pub feature: Option<usize>,
+    /// Where (part coordinates, mm, rounded to 1e-3): the first colliding move's contact; `null`
+    /// where the gate names no place.
+    pub position: Option<[f64; 3]>,
+    /// What it is, one line.
+    pub text: String,
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -280,6 +294,10 @@ pub struct PlanReport {
     /// How the part was turned onto the plate, when it was (set by the caller that turned it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<PlacementEntry>,
+    /// Why the plan was refused, when it was (then `complete` is false and no program was
+    /// written).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failures: Vec<FailureEntry>,
     /// The files the plan was written to, beside `plan.json` (set by whoever writes them; the
     /// command line lists them so that the next plan there replaces them, its stale files
     /// removed).
