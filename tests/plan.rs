@@ -309,11 +309,21 @@ fn tilted_axes_on_a_3_axis_printer_and_unknown_machines_are_refused_with_one_lin
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains(needle), "{err}");
-        assert!(!dir.join("program.gcode").exists(), "{name}: wrote a program");
-        assert!(!dir.join("toolpath.csv").exists(), "{name}: wrote a tool path");
+        assert!(
+            !dir.join("program.gcode").exists(),
+            "{name}: wrote a program"
+        );
+        assert!(
+            !dir.join("toolpath.csv").exists(),
+            "{name}: wrote a tool path"
+        );
         // A plan the machine refuses says why in its report; an unknown machine plans nothing.
         let machine_refused = name != "box";
-        assert_eq!(dir.join("plan.json").exists(), machine_refused, "{name}: {err}");
+        assert_eq!(
+            dir.join("plan.json").exists(),
+            machine_refused,
+            "{name}: {err}"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
@@ -882,7 +892,10 @@ fn a_plan_that_loses_material_exits_2_naming_the_feature_and_writes_nothing() {
     assert_eq!(failures[0]["gate"], "selfcheck");
     assert_eq!(failures[0]["feature"], 0);
     assert!(dir.join("preview.html").exists());
-    assert!(stderr.contains("no program written; plan.json and preview.html show why"), "{stderr}");
+    assert!(
+        stderr.contains("no program written; plan.json and preview.html show why"),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -162,9 +162,18 @@ fn strict_turns_warnings_into_an_error_and_writes_nothing() {
     assert_refused(&o, &["--strict", "no program written"]);
     let err = stderr(&o);
     assert!(err.contains("in the air"), "{err}");
-    assert!(!out.join("program.gcode").exists(), "no program under --strict");
-    assert!(!out.join("toolpath.csv").exists(), "no tool path under --strict");
-    assert!(out.join("plan.json").exists(), "the refused plan's report shows why");
+    assert!(
+        !out.join("program.gcode").exists(),
+        "no program under --strict"
+    );
+    assert!(
+        !out.join("toolpath.csv").exists(),
+        "no tool path under --strict"
+    );
+    assert!(
+        out.join("plan.json").exists(),
+        "the refused plan's report shows why"
+    );
     // Without --strict the same plan is written, with the same warnings.
     let o = plan(
         "stacked_solids.step",
@@ -194,7 +203,10 @@ fn unreachable_robot_points_stop_the_plan_unless_allowed() {
         !out.join("capsule.src").exists() && !out.join("toolpath.csv").exists(),
         "no KRL written for an arm that cannot reach"
     );
-    assert!(out.join("plan.json").exists(), "the refused plan's report shows why");
+    assert!(
+        out.join("plan.json").exists(),
+        "the refused plan's report shows why"
+    );
     let o = plan(
         "capsule.step",
         &[

@@ -218,16 +218,29 @@ fn delta5_impeller_program_has_no_empty_moves_and_feeds_within_the_limit() {
         .filter(|l| l.starts_with("G1 X") && l.ends_with(" F12000.000"))
         .count();
     assert!(at_limit > 0);
-    let warning = err
+    // The count is plan.json's figure; a warning only where more than 1 % of the print moves
+    // are slowed (issue 31: a warning the user can do nothing about is a figure).
+    let report: serde_json::Value =
+        serde_json::from_str(&read(&out.join("plan.json"))).expect("plan.json");
+    assert_eq!(report["feed_clamped_moves"].as_u64(), Some(at_limit as u64));
+    let prints = own
         .lines()
-        .find(|l| l.contains("max_feed_mm_min"))
-        .unwrap_or_else(|| panic!("no feed warning in {err}"));
-    assert!(
-        warning.contains(&format!(
-            ": warning: {at_limit} print move(s) asked for a feed above"
-        )),
-        "{warning}"
+        .filter(|l| l.starts_with("G1 X") && l.contains(" E"))
+        .count();
+    let warning = err.lines().find(|l| l.contains("max_feed_mm_min"));
+    assert_eq!(
+        warning.is_some(),
+        at_limit * 100 > prints,
+        "{at_limit} of {prints}: {err}"
     );
+    if let Some(w) = warning {
+        assert!(
+            w.contains(&format!(
+                ": warning: {at_limit} print move(s) asked for a feed above"
+            )),
+            "{w}"
+        );
+    }
     assert!(program.contains(
         "; F: machine-axis feed (mm/min along the XYZ path, degrees/min for a move of B and C alone) scaled so the nozzle moves over the part at print_speed"
     ));

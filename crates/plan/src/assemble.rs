@@ -81,6 +81,7 @@ impl Stages {
             estimated_time_s: round(est.time_s, 1e1),
             filament_mm: round(est.filament_mm, 1e2),
             filament_g: round(est.filament_g, 1e2),
+            feed_clamped_moves: program.and_then(|p| p.feed_clamped_moves),
             settings,
             placement,
             failures: vec![],

@@ -289,6 +289,10 @@ pub struct PlanReport {
     pub filament_mm: f64,
     /// Its mass, g (`filament_density`, PLA's 1.24 g/cm³ by default).
     pub filament_g: f64,
+    /// Print moves the delta5 post slowed to the machine's `max_feed_mm_min` (a warning too
+    /// when more than 1 % of them); absent for other machines.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feed_clamped_moves: Option<usize>,
     /// The settings the plan was made with.
     pub settings: SettingsEntry,
     /// How the part was turned onto the plate, when it was (set by the caller that turned it).

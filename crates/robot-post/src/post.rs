@@ -61,6 +61,9 @@ pub struct Program {
     pub figures: BTreeMap<usize, PostFigures>,
     /// Things to know, one line each.
     pub warnings: Vec<String>,
+    /// Print moves slowed to the machine's `max_feed_mm_min` (the delta5 post's; `None` for
+    /// posts that scale no feed).
+    pub feed_clamped_moves: Option<usize>,
 }
 
 /// What a post measured of one feature.
@@ -87,6 +90,7 @@ fn measured<K>(
         files: vec![],
         figures: figures.into_iter().map(|(id, k)| (id, kind(k))).collect(),
         warnings,
+        feed_clamped_moves: None,
     }
 }
 
@@ -115,11 +119,10 @@ impl Post for Delta5Post<'_> {
         sink: &mut dyn ProgramSink,
     ) -> Result<Program, PostError> {
         let program = delta5_to(path, self.0, job.source, job.notes, sink)?;
-        Ok(measured(
-            program.figures,
-            PostFigures::Delta5,
-            program.warnings,
-        ))
+        Ok(Program {
+            feed_clamped_moves: Some(program.feed_clamped_moves),
+            ..measured(program.figures, PostFigures::Delta5, program.warnings)
+        })
     }
 }
 

@@ -86,6 +86,10 @@ use text::header;
 use toolpath::vec3::norm;
 use toolpath::{fixed, MoveKind, ToolPath};
 
+/// The share of a program's print moves that may be slowed to `max_feed_mm_min` before the
+/// post warns of it (issue 31: below it the count is a figure, `feed_clamped_moves`).
+pub const FEED_CLAMP_WARN_SHARE: f64 = 0.01;
+
 /// A 5-axis program and what the post measured of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Delta5Program {
@@ -96,8 +100,11 @@ pub struct Delta5Program {
     /// The kinematic error along the printed path as a stand-alone SVG: one colour per
     /// feature, axes labelled, the goal as a dashed line.
     pub error_plot_svg: String,
-    /// Things to know, one line each (feeds clamped to `max_feed_mm_min`).
+    /// Things to know, one line each (feeds clamped to `max_feed_mm_min`, when more than
+    /// [`FEED_CLAMP_WARN_SHARE`] of the print moves were).
     pub warnings: Vec<String>,
+    /// Print moves whose feed was clamped to `max_feed_mm_min`.
+    pub feed_clamped_moves: usize,
     /// table = part + offset (mm), as in the header.
     pub offset: [f64; 3],
     /// Machine Z of the safe height used for large reorientations.
@@ -235,7 +242,10 @@ pub fn delta5_to(
     let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
     write_file(sink, "kinematic_error.svg", error_plot_svg.as_bytes())?;
     let mut warnings = Vec::new();
-    if w.clamped.0 > 0 {
+    // A few clamped moves (the short ones B and C turn fast on, nearly every part has some)
+    // are a figure; a warning only where a share the user would notice is slowed.
+    let print_moves: usize = figures.values().map(|k| k.print_moves).sum();
+    if w.clamped.0 as f64 > FEED_CLAMP_WARN_SHARE * print_moves as f64 {
         warnings.push(format!(
             "{} print move(s) asked for a feed above max_feed_mm_min {} mm/min (up to F{}) and were slowed to it: the nozzle moves over the part slower than print_speed there",
             w.clamped.0,
@@ -248,6 +258,7 @@ pub fn delta5_to(
         figures,
         error_plot_svg: String::new(),
         warnings,
+        feed_clamped_moves: w.clamped.0,
         offset,
         safe_z,
     })
