@@ -2,7 +2,12 @@
 //! a plan writes and the one `features preview` writes. `.ci/run` installs Debian's chromium
 //! when it is missing and sets `FEATURES_REQUIRE_BROWSER=1`, so there the browser must be
 //! found; elsewhere a machine without Chromium skips these tests and says so.
+//!
+//! A refused plan's page (issue 31) is built here directly with `preview::html`; set
+//! `FEATURES_KEEP_PREVIEW=DIR` to keep that page and its screenshot in `DIR` to look at.
 
+use preview::{FeatureMesh, HeadShape, MachineShape, Mark, MarkKind, Preview};
+use slicer::toolpath::{MoveKind, PathPoint, Role, ToolPath};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -38,6 +43,10 @@ fn chromium() -> Option<PathBuf> {
 }
 
 fn headless(browser: &Path, page: &Path, extra: &[&str]) -> std::process::Output {
+    headless_url(browser, &format!("file://{}", page.display()), extra)
+}
+
+fn headless_url(browser: &Path, url: &str, extra: &[&str]) -> std::process::Output {
     Command::new(browser)
         .args([
             "--headless",
@@ -49,7 +58,7 @@ fn headless(browser: &Path, page: &Path, extra: &[&str]) -> std::process::Output
             "--virtual-time-budget=10000",
         ])
         .args(extra)
-        .arg(format!("file://{}", page.display()))
+        .arg(url)
         .output()
         .expect("chromium runs")
 }
@@ -141,5 +150,337 @@ fn a_plans_preview_opens_offline_and_draws() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_draws(&browser, &alone, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A screenshot's pixels, RGB(A) rows.
+struct Shot {
+    w: usize,
+    h: usize,
+    px: usize,
+    buf: Vec<u8>,
+}
+
+impl Shot {
+    /// Takes the screenshot of `page` (written to `dir/name.html`), at 1000 × 700.
+    fn of(browser: &Path, page: &str, dir: &Path, name: &str) -> Shot {
+        let file = dir.join(format!("{name}.html"));
+        std::fs::write(&file, page).unwrap();
+        let png = dir.join(format!("{name}.png"));
+        let out = headless(
+            browser,
+            &file,
+            &[&format!("--screenshot={}", png.display())],
+        );
+        assert!(png.is_file(), "{}", String::from_utf8_lossy(&out.stderr));
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        Shot {
+            w: info.width as usize,
+            h: info.height as usize,
+            px: info.color_type.samples(),
+            buf,
+        }
+    }
+
+    /// Pixels of the view (right of the 300 px side panel) for which `keep` holds.
+    fn count(&self, keep: impl Fn([u8; 3]) -> bool) -> usize {
+        let mut n = 0;
+        for y in 0..self.h {
+            for x in VIEW_LEFT..self.w {
+                let i = (y * self.w + x) * self.px;
+                n += usize::from(keep([self.buf[i], self.buf[i + 1], self.buf[i + 2]]));
+            }
+        }
+        n
+    }
+
+    /// Pure red pixels: the marks' colour, which nothing else on the page is drawn in.
+    fn red(&self) -> usize {
+        self.count(|c| c[0] >= 220 && c[1] <= 40 && c[2] <= 40)
+    }
+
+    /// Pixels off the view's background (245, 246, 249).
+    fn drawn(&self) -> usize {
+        let bg = [245i32, 246, 249];
+        self.count(|c| (0..3).any(|k| (i32::from(c[k]) - bg[k]).abs() > 12))
+    }
+}
+
+/// First pixel column of the view, past the side panel.
+const VIEW_LEFT: usize = 320;
+
+/// Pure red pixels a single mark (a dot of 9 × 9 px, a 5 px thick segment) covers at least.
+const MIN_MARK_PIXELS: usize = 30;
+
+/// A box's surface as a feature mesh.
+fn box_mesh(id: usize, label: &str, lo: [f32; 3], hi: [f32; 3]) -> FeatureMesh {
+    let positions = (0..8)
+        .map(|k| {
+            [
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ]
+        })
+        .collect();
+    let quads = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    FeatureMesh {
+        id,
+        label: label.into(),
+        positions,
+        triangles,
+    }
+}
+
+/// A small two-feature path: rectangular rings on a 40 × 30 × 4 mm plate, then circles of a
+/// boss (radius 6 mm, 12 mm high) on it, 0.4 mm layers.
+fn synthetic_path() -> ToolPath {
+    let mut points = vec![];
+    let mut push = |feature: usize, layer: usize, p: [f64; 3], kind: MoveKind| {
+        points.push(PathPoint {
+            feature,
+            layer,
+            kind,
+            p,
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.4,
+            width: 0.45,
+            role: Role::Perimeter,
+        })
+    };
+    for layer in 0..10 {
+        let z = 0.4 * (layer + 1) as f64;
+        for ring in 0..4 {
+            let d = 0.5 * ring as f64;
+            let corners = [
+                [d, d],
+                [40.0 - d, d],
+                [40.0 - d, 30.0 - d],
+                [d, 30.0 - d],
+                [d, d],
+            ];
+            for (k, c) in corners.iter().enumerate() {
+                let kind = if k == 0 {
+                    MoveKind::Travel
+                } else {
+                    MoveKind::Print
+                };
+                push(0, layer, [c[0], c[1], z], kind);
+            }
+        }
+    }
+    for layer in 0..30 {
+        let z = 4.0 + 0.4 * (layer + 1) as f64;
+        for k in 0..=36 {
+            let t = std::f64::consts::TAU * k as f64 / 36.0;
+            let kind = if k == 0 {
+                MoveKind::Travel
+            } else {
+                MoveKind::Print
+            };
+            push(
+                1,
+                layer,
+                [20.0 + 6.0 * t.cos(), 15.0 + 6.0 * t.sin(), z],
+                kind,
+            );
+        }
+    }
+    ToolPath { points }
+}
+
+/// One mark of each kind, all inside the part's box (so that they do not move the view).
+fn one_of_each() -> Vec<Mark> {
+    vec![
+        Mark {
+            kind: MarkKind::Collision,
+            feature: Some(1),
+            text: "move 412: the body meets the table 3.1 mm deep".into(),
+            points: vec![[32.0, 15.0, 10.0], [26.0, 15.0, 10.0]],
+        },
+        Mark {
+            kind: MarkKind::Unsupported,
+            feature: Some(1),
+            text: "layer 20: 14.0 mm² unsupported".into(),
+            points: vec![
+                [8.0, 4.0, 12.0],
+                [14.0, 4.0, 12.0],
+                [14.0, 9.0, 12.0],
+                [8.0, 9.0, 12.0],
+            ],
+        },
+        Mark {
+            kind: MarkKind::Unreachable,
+            feature: Some(0),
+            text: "point 77 is out of the arm's reach".into(),
+            points: vec![[36.0, 26.0, 4.0]],
+        },
+        Mark {
+            kind: MarkKind::SelfCheck,
+            feature: Some(1),
+            text: "self-check: deposited volume -6.2 % of the feature's".into(),
+            points: vec![[14.0, 21.0, 16.0], [20.0, 22.0, 16.0], [26.0, 21.0, 16.0]],
+        },
+        Mark {
+            kind: MarkKind::Machine,
+            feature: None,
+            text: "needs B 126.254 degrees, outside the B limits".into(),
+            points: vec![[2.0, 28.0, 0.4], [20.0, 28.0, 0.4]],
+        },
+    ]
+}
+
+/// The page of a refused plan of [`synthetic_path`] with `marks`, the bed and the head (or
+/// neither).
+fn refused_page(path: &ToolPath, marks: Vec<Mark>, machine: bool) -> String {
+    let s = 0.5f64.sqrt();
+    preview::html(&Preview {
+        title: "synthetic plate and boss".into(),
+        features: vec![
+            box_mesh(0, "two5d plate", [0.0, 0.0, 0.0], [40.0, 30.0, 4.0]),
+            box_mesh(1, "two5d boss", [14.0, 9.0, 4.0], [26.0, 21.0, 16.0]),
+        ],
+        path: Some(path),
+        figures: vec![("features".into(), "2".into())],
+        refusal: Some(
+            "5 problems: collisions, unsupported beads, reach, self-check, B limits".into(),
+        ),
+        marks,
+        machine: machine.then_some(MachineShape::Bed {
+            min: [-20.0, -20.0],
+            max: [60.0, 50.0],
+            z: 0.0,
+        }),
+        head: machine.then_some(HeadShape {
+            tip: [32.0, 15.0, 10.0],
+            axis: [s, 0.0, s],
+            tip_radius: 0.5,
+            half_angle_deg: 30.0,
+            cone_length: 8.0,
+            body_radius: 20.0,
+            body_length: 60.0,
+        }),
+    })
+}
+
+/// The value of `attribute` on the page's `<body>` in a DOM dump.
+fn body_attribute(dom: &str, attribute: &str) -> Option<String> {
+    let body = dom.split("<body").nth(1)?.split('>').next()?;
+    let v = body
+        .split(&format!("{attribute}=\""))
+        .nth(1)?
+        .split('"')
+        .next()?;
+    Some(v.to_string())
+}
+
+#[test]
+fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
+    let Some(browser) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("features-refused-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = synthetic_path();
+    let marks = one_of_each();
+    let page = refused_page(&path, marks.clone(), true);
+    for bad in ["http:", "https:", "//"] {
+        assert!(!page.contains(bad), "the page refers to `{bad}`");
+    }
+
+    // The Problems panel lists every mark's text, and the figures say why the plan was refused.
+    let file = dir.join("refused.html");
+    std::fs::write(&file, &page).unwrap();
+    let dom = headless(&browser, &file, &["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    assert_eq!(
+        body_attribute(&dom, "data-marks"),
+        Some(marks.len().to_string())
+    );
+    let list = dom
+        .split("id=\"problemlist\"")
+        .nth(1)
+        .and_then(|s| s.split("id=\"problemsleft\"").next())
+        .expect("a Problems list");
+    for m in &marks {
+        assert!(
+            list.contains(&m.text),
+            "the Problems panel lacks `{}`",
+            m.text
+        );
+        assert!(list.contains(m.kind.name()));
+    }
+    assert!(dom.contains("refused: 5 problems"), "no refusal line");
+    // `#problem=N` selects the N-th problem (as a click on it does) and centres the view there.
+    let url = format!("file://{}#problem=2", file.display());
+    let dom = headless_url(&browser, &url, &["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    assert!(
+        dom.contains("class=\"sel\" data-mark=\"2\"")
+            || dom.contains("data-mark=\"2\" class=\"sel\""),
+        "the third problem is not selected"
+    );
+
+    // Red where the marks are, and nowhere without them.
+    let full = Shot::of(&browser, &page, &dir, "refused");
+    let without = Shot::of(
+        &browser,
+        &refused_page(&path, vec![], true),
+        &dir,
+        "unmarked",
+    );
+    assert_eq!(without.red(), 0, "red drawn with no marks");
+    assert!(
+        full.red() >= marks.len() * MIN_MARK_PIXELS,
+        "{} red pixels",
+        full.red()
+    );
+    for m in &marks {
+        let one = Shot::of(
+            &browser,
+            &refused_page(&path, vec![m.clone()], true),
+            &dir,
+            "one",
+        );
+        assert!(
+            one.red() >= MIN_MARK_PIXELS && one.red() < full.red(),
+            "{}: {} red pixels of {}",
+            m.kind.name(),
+            one.red(),
+            full.red()
+        );
+    }
+    // The bed and the head are drawn: more of the view is off the background with them.
+    let bare = Shot::of(&browser, &refused_page(&path, vec![], false), &dir, "bare");
+    assert!(
+        without.drawn() > bare.drawn() + bare.drawn() / 10,
+        "{} pixels drawn with the machine, {} without",
+        without.drawn(),
+        bare.drawn()
+    );
+    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
+        let keep = PathBuf::from(keep);
+        std::fs::create_dir_all(&keep).unwrap();
+        for f in ["refused.html", "refused.png"] {
+            std::fs::copy(dir.join(f), keep.join(f)).unwrap();
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

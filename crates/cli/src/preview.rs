@@ -74,6 +74,7 @@ pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
             ),
             ("warnings".into(), plan.warnings().len().to_string()),
         ],
+        ..Preview::default()
     })
 }
 
@@ -100,6 +101,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Failure> {
         ],
         features,
         path: None,
+        ..Preview::default()
     });
     write_atomic(&args.output, |w| w.write_all(page.as_bytes()))
         .map_err(|e| Failure::new(&args.output, format!("cannot write: {e}")))?;

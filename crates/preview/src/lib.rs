@@ -8,6 +8,11 @@
 //! - tool axes as short ticks at a chosen density; orbit (drag), pan (shift-drag or right-drag)
 //!   and zoom (wheel); a legend and the plan's figures beside the view.
 //!
+//! A refused plan's page also shows why: its failures ([`Mark`]s) in red over everything and
+//! listed in a "Problems" panel (a click centres the view on one), the machine's bed or table
+//! ([`MachineShape`]) and the head at the first failure ([`HeadShape`]), and a "refused" line
+//! over the figures. Red is kept for them: no feature colour or colour ramp is red.
+//!
 //! What is drawn is decimated, never what is printed: at most [`MAX_DRAWN_POINTS`] path points
 //! (every k-th point of a long run, the ends of every path kept) and the meshes as the caller
 //! gives them (coarse).
@@ -15,8 +20,12 @@
 #![warn(missing_docs)]
 
 mod encode;
+mod machine;
+mod marks;
 
 use encode::{base64_f32, base64_u32};
+pub use machine::{HeadShape, MachineShape};
+pub use marks::{Mark, MarkKind, MAX_MARKS, MAX_MARK_POINTS};
 use std::fmt::Write as _;
 use toolpath::{MoveKind, ToolPath};
 
@@ -50,6 +59,19 @@ pub struct Preview<'a> {
     pub path: Option<&'a ToolPath>,
     /// Figures shown beside the view: (name, value) in order.
     pub figures: Vec<(String, String)>,
+    /// Why the plan was refused, shown first among the figures as `refused: <reason>` (when
+    /// this is `None` but there are marks: `refused: see Problems`).
+    pub refusal: Option<String>,
+    /// The failures, in the tool path's frame: drawn in red over everything (no depth test)
+    /// and listed in the Problems panel, the first [`MAX_MARKS`] of them (the panel says how
+    /// many more there were).
+    pub marks: Vec<Mark>,
+    /// The machine's bed or turning table, in the tool path's frame, drawn grey and
+    /// translucent.
+    pub machine: Option<MachineShape>,
+    /// The print head (at the first failure), in the tool path's frame, drawn red and
+    /// translucent with a wire frame.
+    pub head: Option<HeadShape>,
 }
 
 /// The preview as one HTML document.
@@ -79,74 +101,99 @@ fn drawn(path: &ToolPath) -> Vec<usize> {
 
 /// The data the viewer reads: JSON with base64 arrays of little-endian f32 and u32.
 fn data_json(p: &Preview) -> String {
-    let mut meshes = vec![];
-    for f in &p.features {
-        let pos: Vec<f32> = f.positions.iter().flatten().copied().collect();
-        let tri: Vec<u32> = f.triangles.iter().flatten().copied().collect();
-        meshes.push(serde_json::json!({
-            "id": f.id,
-            "label": f.label,
-            "positions": base64_f32(&pos),
-            "triangles": base64_u32(&tri),
-        }));
-    }
-    let mut path = serde_json::Value::Null;
-    if let Some(tp) = p.path {
-        let keep = drawn(tp);
-        // A layer number over the whole build order: it counts up where the feature or its
-        // layer changes.
-        let mut count = 0u32;
-        let global: Vec<u32> = tp
-            .points
-            .iter()
-            .enumerate()
-            .map(|(i, b)| {
-                if i > 0 {
-                    let a = &tp.points[i - 1];
-                    if a.feature != b.feature || a.layer != b.layer {
-                        count += 1;
-                    }
-                }
-                count
-            })
-            .collect();
-        let mut xyz = Vec::with_capacity(3 * keep.len());
-        let mut axis = Vec::with_capacity(3 * keep.len());
-        let mut thick = Vec::with_capacity(keep.len());
-        let mut info = Vec::with_capacity(3 * keep.len());
-        for &i in &keep {
-            let q = &tp.points[i];
-            xyz.extend(q.p.map(|x| x as f32));
-            axis.extend(q.axis.map(|x| x as f32));
-            thick.push(q.thickness as f32);
-            info.push(q.feature as u32);
-            info.push(global[i]);
-            info.push(u32::from(q.kind == MoveKind::Print));
-        }
-        path = serde_json::json!({
-            "points": keep.len(),
-            "planned_points": tp.points.len(),
-            "xyz": base64_f32(&xyz),
-            "axis": base64_f32(&axis),
-            "thickness": base64_f32(&thick),
-            "info": base64_u32(&info),
-            "layers": count + 1,
-        });
-    }
     let figures: Vec<serde_json::Value> = p
         .figures
         .iter()
         .map(|(k, v)| serde_json::json!([k, v]))
         .collect();
+    let refusal = match (&p.refusal, p.marks.is_empty()) {
+        (Some(r), _) => serde_json::json!(r),
+        (None, false) => serde_json::json!("see Problems"),
+        (None, true) => serde_json::Value::Null,
+    };
     let json = serde_json::json!({
         "title": p.title,
-        "features": meshes,
-        "path": path,
+        "features": meshes_json(&p.features),
+        "path": p.path.map_or(serde_json::Value::Null, path_json),
         "figures": figures,
         "max_drawn_points": MAX_DRAWN_POINTS,
+        "refusal": refusal,
+        "marks": marks::marks_json(&p.marks),
+        "machine": p.machine.as_ref().map_or(serde_json::Value::Null, |m| machine::machine_overlay(m).json()),
+        "head": p.head.as_ref().map_or(serde_json::Value::Null, head_json),
     });
     // Inside a <script> element: no `</` may close it early.
     json.to_string().replace("</", "<\\/")
+}
+
+/// The head as the viewer reads it: its overlay and its tip (which the view frames).
+fn head_json(h: &HeadShape) -> serde_json::Value {
+    let mut j = machine::head_overlay(h).json();
+    if let Some(o) = j.as_object_mut() {
+        o.insert("tip".into(), serde_json::json!(h.tip));
+    }
+    j
+}
+
+/// The features' meshes as the viewer reads them.
+fn meshes_json(features: &[FeatureMesh]) -> Vec<serde_json::Value> {
+    features
+        .iter()
+        .map(|f| {
+            let pos: Vec<f32> = f.positions.iter().flatten().copied().collect();
+            let tri: Vec<u32> = f.triangles.iter().flatten().copied().collect();
+            serde_json::json!({
+                "id": f.id,
+                "label": f.label,
+                "positions": base64_f32(&pos),
+                "triangles": base64_u32(&tri),
+            })
+        })
+        .collect()
+}
+
+/// The drawn points of the path as the viewer reads them.
+fn path_json(tp: &ToolPath) -> serde_json::Value {
+    let keep = drawn(tp);
+    // A layer number over the whole build order: it counts up where the feature or its
+    // layer changes.
+    let mut count = 0u32;
+    let global: Vec<u32> = tp
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            if i > 0 {
+                let a = &tp.points[i - 1];
+                if a.feature != b.feature || a.layer != b.layer {
+                    count += 1;
+                }
+            }
+            count
+        })
+        .collect();
+    let mut xyz = Vec::with_capacity(3 * keep.len());
+    let mut axis = Vec::with_capacity(3 * keep.len());
+    let mut thick = Vec::with_capacity(keep.len());
+    let mut info = Vec::with_capacity(3 * keep.len());
+    for &i in &keep {
+        let q = &tp.points[i];
+        xyz.extend(q.p.map(|x| x as f32));
+        axis.extend(q.axis.map(|x| x as f32));
+        thick.push(q.thickness as f32);
+        info.push(q.feature as u32);
+        info.push(global[i]);
+        info.push(u32::from(q.kind == MoveKind::Print));
+    }
+    serde_json::json!({
+        "points": keep.len(),
+        "planned_points": tp.points.len(),
+        "xyz": base64_f32(&xyz),
+        "axis": base64_f32(&axis),
+        "thickness": base64_f32(&thick),
+        "info": base64_u32(&info),
+        "layers": count + 1,
+    })
 }
 
 /// Text for HTML.
@@ -203,6 +250,7 @@ mod tests {
             }],
             path: Some(&path),
             figures: vec![("features".into(), "1".into())],
+            ..Preview::default()
         });
         assert!(page.starts_with("<!DOCTYPE html>"));
         assert!(page.contains("a &lt;part&gt;.step"));
