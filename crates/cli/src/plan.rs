@@ -58,6 +58,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     bar.0.set_message("outputs");
     let process_file = args.process.as_deref().unwrap_or(path);
     let refusal = Refusal {
+        machine: &machine,
         outputs: &outputs,
         earlier: &earlier,
         bar: &bar,
@@ -93,6 +94,7 @@ fn placement(args: &PlanArgs) -> Placement {
 
 /// Where a refused plan's report and preview go.
 struct Refusal<'a> {
+    machine: &'a robot_post::MachineProfile,
     outputs: &'a Outputs,
     earlier: &'a [std::path::PathBuf],
     bar: &'a Bar,
@@ -149,7 +151,7 @@ impl Refusal<'_> {
             }
             Gate::Machine(line) => (line.clone(), ""),
         };
-        let written = match write_refused(&plan, self.outputs, self.earlier, path) {
+        let written = match write_refused(&plan, self, path, &cause) {
             Ok(names) => format!("no program written; {} show why", names.join(" and ")),
             Err(f) => format!("nothing written ({}: {})", f.path, f.cause),
         };
@@ -161,10 +163,11 @@ impl Refusal<'_> {
 /// no program; the earlier plan's other files removed. Returns the names written.
 fn write_refused(
     plan: &Plan,
-    outputs: &Outputs,
-    earlier: &[std::path::PathBuf],
+    to: &Refusal,
     path: &Path,
+    why: &str,
 ) -> Result<Vec<String>, Failure> {
+    let (outputs, earlier) = (to.outputs, to.earlier);
     let dir = &outputs.dir;
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
@@ -172,7 +175,7 @@ fn write_refused(
         r.map_err(|e| Failure::new(&dir.join(name), format!("cannot write: {e}")))
     };
     let preview_name = outputs.name("preview.html");
-    let page = crate::preview::plan_page(plan, &path.display().to_string());
+    let page = crate::preview::refused_page(plan, &path.display().to_string(), to.machine, why);
     written(
         &preview_name,
         write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),

@@ -5,7 +5,8 @@ use crate::mesh::write_atomic;
 use crate::{emit, Failure, PreviewArgs};
 use brep::mesh::{mesh_faces, MeshOptions};
 use features::{extract_all, Assembly, ExtractOptions};
-use preview::{FeatureMesh, Preview};
+use preview::{FeatureMesh, HeadShape, MachineShape, Mark, MarkKind, Preview};
+use robot_post::{MachineKind, MachineProfile};
 use std::io::Write as _;
 
 /// Chord tolerance of the meshes drawn, as a share of the part's size (at least 0.05 mm).
@@ -43,12 +44,123 @@ pub fn feature_meshes(assembly: &Assembly) -> Vec<FeatureMesh> {
 
 /// The `preview.html` of a plan: its features, its tool path and its figures.
 pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
+    preview::html(&plan_preview(plan, title))
+}
+
+/// The `preview.html` of a refused plan (issue 31): the plan's page with every failure of its
+/// report marked in red (colliding moves, the features the self-check or reach refuses at
+/// their first point), the machine's bed or turning table drawn, and the head at the first
+/// colliding move.
+pub fn refused_page(plan: &plan::Plan, title: &str, machine: &MachineProfile, why: &str) -> String {
+    let mut page = plan_preview(plan, title);
+    page.refusal = Some(why.to_string());
+    page.marks = marks(plan);
+    page.machine = Some(machine_shape(plan, machine));
+    page.head = plan.collisions.left.first().and_then(|c| {
+        let q = plan.toolpath.points.get(c.index)?;
+        let h = &machine.head;
+        Some(HeadShape {
+            tip: q.p,
+            axis: q.axis,
+            tip_radius: h.nozzle_tip_radius,
+            half_angle_deg: h.nozzle_cone_half_angle_deg,
+            cone_length: h.nozzle_length,
+            body_radius: h.body_radius,
+            body_length: h.body_length,
+        })
+    });
+    preview::html(&page)
+}
+
+/// The failures of a refused plan as red marks: each colliding move (its two ends), and each
+/// failure of the report that names a feature but no move, at its position or the feature's
+/// first point.
+fn marks(plan: &plan::Plan) -> Vec<Mark> {
+    let pts = &plan.toolpath.points;
+    let mut out: Vec<Mark> = plan
+        .collisions
+        .left
+        .iter()
+        .map(|c| {
+            let end = pts.get(c.index).map(|q| q.p).unwrap_or(c.at);
+            let start = c.index.checked_sub(1).and_then(|i| pts.get(i)).map(|q| q.p);
+            let hits = match c.hits {
+                collide::Obstacle::Feature(f) => format!("feature {f}"),
+                collide::Obstacle::Table => "the table".to_string(),
+            };
+            Mark {
+                kind: MarkKind::Collision,
+                feature: Some(c.feature),
+                text: format!(
+                    "feature {}: the head hits {hits} at ({:.3}, {:.3}, {:.3})",
+                    c.feature, c.at[0], c.at[1], c.at[2]
+                ),
+                points: start.into_iter().chain([end]).collect(),
+            }
+        })
+        .collect();
+    for f in &plan.report.failures {
+        if f.gate == "collisions" {
+            continue;
+        }
+        let at = f.position.or_else(|| {
+            let id = f.feature?;
+            pts.iter().find(|q| q.feature == id).map(|q| q.p)
+        });
+        out.push(Mark {
+            kind: match f.gate {
+                "selfcheck" => MarkKind::SelfCheck,
+                "reach" => MarkKind::Unreachable,
+                "unsupported" => MarkKind::Unsupported,
+                _ => MarkKind::Machine,
+            },
+            feature: f.feature,
+            text: f.text.clone(),
+            points: at.into_iter().collect(),
+        });
+    }
+    out
+}
+
+/// The machine's table where its post places the part: delta5's turning disc, else the bed
+/// under the part (Marlin's of its size about the part, as the post centres it; a KUKA cell's
+/// table plane shown 50 mm past the part).
+fn machine_shape(plan: &plan::Plan, machine: &MachineProfile) -> MachineShape {
+    match plan::collisions::table(&plan.toolpath, machine) {
+        collide::Table::Disc { centre, z, radius } => MachineShape::Table { centre, z, radius },
+        collide::Table::Plane { z } => {
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for q in &plan.toolpath.points {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(q.p[k]);
+                    hi[k] = hi[k].max(q.p[k]);
+                }
+            }
+            if !lo[0].is_finite() {
+                (lo, hi) = ([0.0; 2], [0.0; 2]);
+            }
+            let half = match machine.kind {
+                MachineKind::Marlin => [0.5 * machine.bed_size[0], 0.5 * machine.bed_size[1]],
+                _ => [0.5 * (hi[0] - lo[0]) + 50.0, 0.5 * (hi[1] - lo[1]) + 50.0],
+            };
+            let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+            MachineShape::Bed {
+                min: [mid[0] - half[0], mid[1] - half[1]],
+                max: [mid[0] + half[0], mid[1] + half[1]],
+                z,
+            }
+        }
+    }
+}
+
+/// A plan's page as [`plan_page`] draws it.
+fn plan_preview<'a>(plan: &'a plan::Plan, title: &str) -> Preview<'a> {
     let f = plan.features();
     let layers: usize = f.iter().map(|x| x.layers).sum();
     let print: f64 = f.iter().map(|x| x.print_length_mm).sum();
     let travel: f64 = f.iter().map(|x| x.travel_length_mm).sum();
     let volume: f64 = f.iter().map(|x| x.extruded_volume_mm3).sum();
-    preview::html(&Preview {
+    Preview {
         title: title.to_string(),
         features: feature_meshes(&plan.assembly),
         path: Some(&plan.toolpath),
@@ -75,7 +187,7 @@ pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
             ("warnings".into(), plan.warnings().len().to_string()),
         ],
         ..Preview::default()
-    })
+    }
 }
 
 /// Runs `features preview`: the extracted features alone.
