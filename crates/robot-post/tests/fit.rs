@@ -2,7 +2,7 @@
 //! work envelope, and the least move on the KUKA table that brings every point into reach.
 
 use robot_post::fit::{
-    envelope_excess, reach_shift, turn_to_fit, turned, unreachable_points, FitError,
+    bounding_path, envelope_excess, reach_shift, turn_to_fit, turned, unreachable_points, FitError,
 };
 use robot_post::fit::{reach::FINE_SHIFT_MM, turn::FINE_STEP_DEG};
 use robot_post::placement::bed_offset;
@@ -168,4 +168,76 @@ fn a_part_in_reach_is_not_moved_and_one_far_out_is_refused() {
         Err(FitError::NoShift { unreachable, .. }) => assert!(unreachable > 0),
         other => panic!("{other:?}"),
     }
+}
+
+#[test]
+fn the_kuka_post_moves_the_part_by_part_position_and_warns_off_the_table() {
+    let part = rectangle(10.0, 10.0, 1.0, UP);
+    let m = MachineProfile::builtin(MachineKind::Kuka);
+    let offset = |m: &MachineProfile| -> (Vec<f64>, Vec<String>) {
+        let program = robot_post::kuka(&part, m, "part", "part.step").expect("post");
+        let line = program.files[0]
+            .1
+            .lines()
+            .find(|l| l.contains("part offset"))
+            .expect("offset line")
+            .to_string();
+        let xyz = line
+            .split_whitespace()
+            .filter_map(|w| w.get(1..).and_then(|v| v.parse::<f64>().ok()))
+            .take(3)
+            .collect();
+        (xyz, program.warnings)
+    };
+    let (centred, warnings) = offset(&m);
+    assert!(!warnings.iter().any(|w| w.contains("part_position")));
+    let mut moved = m.clone();
+    let half_table = m.bed_size[0] / 2.0;
+    // 20 mm in from the table's edge: on the table, no warning.
+    let dx = half_table - 5.0 - W / 2.0 - 20.0;
+    moved.kuka.as_mut().expect("kuka").part_position = [-dx, 7.5];
+    let (xyz, warnings) = offset(&moved);
+    assert!(
+        (xyz[0] - centred[0] + dx).abs() < 1e-3,
+        "{xyz:?} {centred:?}"
+    );
+    assert!(
+        (xyz[1] - centred[1] - 7.5).abs() < 1e-3,
+        "{xyz:?} {centred:?}"
+    );
+    assert_eq!(xyz[2], centred[2]);
+    assert!(!warnings.iter().any(|w| w.contains("part_position")));
+    // 20 mm past it: the part overhangs by 20 mm, written with a warning.
+    moved.kuka.as_mut().expect("kuka").part_position = [dx + 40.0, 0.0];
+    let (_, warnings) = offset(&moved);
+    let w = warnings
+        .iter()
+        .find(|w| w.contains("part_position"))
+        .expect("warned");
+    assert!(w.contains("by up to 20.000 mm"), "{w}");
+}
+
+#[test]
+fn the_corners_of_a_bar_fit_turned_as_its_beads_do() {
+    // The bar's box corners, before any path is planned: no bead width, so (200 × cos a +
+    // 20 × sin a) ≤ 160 at the least turn a, and a slightly smaller turn than its beads need.
+    let corners = [
+        [0.0, 0.0, 0.0],
+        [200.0, 0.0, 0.0],
+        [200.0, 20.0, 0.0],
+        [0.0, 20.0, 0.0],
+        [0.0, 0.0, 10.0],
+        [200.0, 20.0, 10.0],
+    ];
+    let m = marlin_bed(160.0, 160.0);
+    let fit = turn_to_fit(&bounding_path(&corners), &m).expect("a turn fits");
+    let a = fit.angle_deg.abs().to_radians();
+    assert!(200.0 * a.cos() + 20.0 * a.sin() <= 160.0 + 1e-3, "{fit:?}");
+    let b = (fit.angle_deg.abs() - FINE_STEP_DEG).to_radians();
+    assert!(200.0 * b.cos() + 20.0 * b.sin() > 160.0, "{fit:?}");
+    let beads = turn_to_fit(&rectangle(200.0, 20.0, 5.0, UP), &m).expect("fits");
+    assert!(
+        fit.angle_deg.abs() <= beads.angle_deg.abs(),
+        "{fit:?} {beads:?}"
+    );
 }

@@ -15,7 +15,7 @@ pub mod reach;
 pub mod turn;
 
 pub use reach::{reach_shift, unreachable_points, ReachShift};
-pub use turn::{envelope_excess, turn_to_fit, turned, TurnFit};
+pub use turn::{bounding_path, envelope_excess, turn_to_fit, turned, TurnFit};
 
 use crate::sink::ProgramSink;
 use crate::PostError;

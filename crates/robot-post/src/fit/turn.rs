@@ -11,7 +11,7 @@ use super::{Discard, FitError};
 use crate::machine::{MachineKind, MachineProfile};
 use crate::placement::{bed_offset, bed_overhang_xy};
 use crate::PostError;
-use toolpath::{MoveKind, ToolPath};
+use toolpath::{MoveKind, PathPoint, Role, ToolPath};
 
 /// Step (degrees) of the coarse search over turns.
 pub const COARSE_STEP_DEG: f64 = 1.0;
@@ -37,6 +37,29 @@ pub struct TurnFit {
     /// By how much (mm) the part as modelled (turned by 0) leaves the bed or envelope, by
     /// the cheap test of [`envelope_excess`]; 0 when it fits.
     pub excess_at_zero_mm: f64,
+}
+
+/// A travel-only path through `points` (part coordinates, Z up from the plate), tool axis +Z:
+/// the part's bounding points (its hull or box corners) given to [`turn_to_fit`] before any
+/// tool path is planned. The posts place a travel-only path by all its points, so the turn
+/// found fits the points themselves (no bead width); on `delta5` it is the turn for a part
+/// printed with the bed level throughout.
+pub fn bounding_path(points: &[[f64; 3]]) -> ToolPath {
+    let points = points
+        .iter()
+        .map(|&p| PathPoint {
+            feature: 0,
+            layer: 0,
+            kind: MoveKind::Travel,
+            p,
+            axis: [0.0, 0.0, 1.0],
+            e: 0.0,
+            thickness: 0.0,
+            width: 0.0,
+            role: Role::Perimeter,
+        })
+        .collect();
+    ToolPath { points }
 }
 
 /// `path` with every point and tool axis turned by `angle_deg` (counter-clockwise seen from
