@@ -197,7 +197,17 @@ pub fn reach_shift(path: &ToolPath, m: &MachineProfile) -> Result<ReachShift, Fi
         gaps.map_or(0.0, |g| g.overhang([here[0] + s[0], here[1] + s[1]])) <= on_table + EDGE_SLACK
     };
     let at = |s: [f64; 2]| [offset[0] + s[0], offset[1] + s[1], offset[2]];
-    let r_max = m.bed_size[0].max(m.bed_size[1]) / 2.0;
+    // No farther than the table's half size, nor than the arm's whole span: a move past
+    // that cannot bring a point nearer to the arm than the part's own size.
+    let arm = &cell.arm;
+    let tool = cell.tool.to_array();
+    let span = arm.a1.abs()
+        + arm.b.abs()
+        + arm.c2
+        + arm.a2.hypot(arm.c3)
+        + arm.c4.abs()
+        + tool[0].hypot(tool[1]).hypot(tool[2]);
+    let r_max = (m.bed_size[0].max(m.bed_size[1]) / 2.0).min(span);
     let passes = |s: [f64; 2], sample: &mut Vec<usize>| -> bool {
         if !allowed(s) {
             return false;
