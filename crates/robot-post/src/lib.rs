@@ -10,6 +10,8 @@
 //! - [`delta5`](mod@delta5): 5-axis G-code for a printer with a tilting and rotating bed.
 //! - [`kuka`](mod@kuka): KRL programs for a KUKA robot cell; [`krl`] reads them back.
 //! - [`placement`]: where a post puts the part on the machine.
+//! - [`fit`]: placements the machine can print, searched for: the least turn about the build
+//!   direction that fits the bed or envelope, the least move on a KUKA table into the arm's reach.
 //! - [`custom`]: the profile's start and end G-code and their placeholders.
 //!
 //! Every fallible function returns a [`PostError`] whose message is one line.
@@ -19,6 +21,7 @@
 pub mod custom;
 pub mod delta5;
 pub mod error;
+pub mod fit;
 mod gcode;
 mod kind;
 pub mod krl;

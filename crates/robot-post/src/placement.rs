@@ -86,6 +86,80 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
     Ok(offset)
 }
 
+/// How far (mm) the part reaches past the bed's edge in X or Y when placed by
+/// [`bed_offset`]'s rule (XY bounding-box centre of the placed points on the bed centre) and
+/// then moved by `shift`: the largest overhang over the four edges, print points taken with
+/// half their bead width; 0 when it stays on the bed, and for an empty path.
+pub fn bed_overhang_xy(path: &ToolPath, m: &MachineProfile, shift: [f64; 2]) -> f64 {
+    bed_gaps_xy(path, m).map_or(0.0, |g| g.overhang(shift))
+}
+
+/// The gaps (mm) between the part, placed by [`bed_offset`]'s rule, and the bed's edges in X
+/// and Y: `low[k]` from the bed's low edge to the part, `high[k]` from the part to the high
+/// edge (negative where the part overhangs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BedGaps {
+    /// Gap at the low edge, X and Y (mm).
+    pub low: [f64; 2],
+    /// Gap at the high edge, X and Y (mm).
+    pub high: [f64; 2],
+}
+
+impl BedGaps {
+    /// The largest overhang (mm, 0 when none) of the part moved by `shift`.
+    pub fn overhang(&self, shift: [f64; 2]) -> f64 {
+        (0..2)
+            .map(|k| (-(self.low[k] + shift[k])).max(-(self.high[k] - shift[k])))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The [`BedGaps`] of `path` on `m`'s bed; `None` for an empty path.
+pub fn bed_gaps_xy(path: &ToolPath, m: &MachineProfile) -> Option<BedGaps> {
+    let (plo, phi) = xy_box(placed_points(path), false)?;
+    let (lo, hi) = xy_box(path.points.iter(), true)?;
+    let centre = if m.bed_origin_centre {
+        [0.0, 0.0]
+    } else {
+        [m.bed_size[0] / 2.0, m.bed_size[1] / 2.0]
+    };
+    let mut gaps = BedGaps {
+        low: [0.0; 2],
+        high: [0.0; 2],
+    };
+    for k in 0..2 {
+        let offset = centre[k] - (plo[k] + phi[k]) / 2.0;
+        let half = m.bed_size[k] / 2.0;
+        gaps.low[k] = lo[k] + offset - (centre[k] - half);
+        gaps.high[k] = centre[k] + half - (hi[k] + offset);
+    }
+    Some(gaps)
+}
+
+/// The XY bounding box of `points`, print points grown by half their bead width when
+/// `beads`; `None` without points.
+fn xy_box<'a>(
+    points: impl Iterator<Item = &'a PathPoint>,
+    beads: bool,
+) -> Option<([f64; 2], [f64; 2])> {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut any = false;
+    for q in points {
+        any = true;
+        let r = if beads && q.kind == MoveKind::Print {
+            q.width.max(0.0) / 2.0
+        } else {
+            0.0
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(q.p[k] - r);
+            hi[k] = hi[k].max(q.p[k] + r);
+        }
+    }
+    any.then_some((lo, hi))
+}
+
 /// `v` rounded to 0.001, so the offset written in the header is exact.
 fn round3(v: f64) -> f64 {
     (v * 1000.0).round() / 1000.0

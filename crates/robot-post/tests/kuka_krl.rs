@@ -946,6 +946,11 @@ fn kuka_profile_keys_are_checked() {
         ),
         ("C = 0.0 }\n# `$TOOL`", "C = nan }\n# `$TOOL`", "kuka.base"),
         ("c4 = 80.0", "c4 = 80.0\nc5 = 1.0", "c5"),
+        (
+            "part_position = [0.0, 0.0]",
+            "part_position = [0.0, inf]",
+            "kuka.part_position",
+        ),
     ];
     for (from, to, needle) in cases {
         assert!(text.contains(from), "{from}");

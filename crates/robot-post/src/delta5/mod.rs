@@ -318,3 +318,38 @@ fn walk(
     }
     Ok(())
 }
+
+/// How far (mm) the nozzle positions of the path's points leave the work envelope (X and Y
+/// within `bed_size` around the bed centre, Z within `z_min`..`bed_size` Z) as [`delta5`]
+/// places the part ([`table_offset`]) and turns the bed (its bed angles, C patched inside the
+/// singularity cone): the largest excess over the points and the three axes, 0 when every
+/// point is inside. A point below the table surface counts by how far it is below.
+///
+/// A cheap stand-in for the post's check, which also checks the moves between the points
+/// (sub-moves, hops, travels at the safe height): [`crate::fit`] searches with it and
+/// confirms its choice with the post.
+///
+/// Errors as [`delta5`]'s: not a valid `delta5` profile, a non-finite point, a tool axis
+/// outside the B limits.
+pub fn envelope_excess(path: &ToolPath, m: &MachineProfile) -> Result<f64, PostError> {
+    let g = m.delta5_table()?;
+    path.check_finite()?;
+    let offset = table_offset(path);
+    let poses = plan_poses(&path.points, g, &m.name)?;
+    let (x0, y0) = if m.bed_origin_centre {
+        (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
+    } else {
+        (0.0, 0.0)
+    };
+    let lo = [x0, y0, g.z_min];
+    let hi = [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]];
+    let mut excess: f64 = 0.0;
+    for (q, pose) in path.points.iter().zip(&poses) {
+        excess = excess.max(-(q.p[2] + offset[2]));
+        let xyz = to_machine(q.p, pose.b, pose.c, g, offset);
+        for k in 0..3 {
+            excess = excess.max(lo[k] - xyz[k]).max(xyz[k] - hi[k]);
+        }
+    }
+    Ok(excess)
+}

@@ -89,6 +89,12 @@ pub struct ArmModel {
 pub struct KukaCell {
     /// `$BASE`: the work table's frame in the robot's base frame.
     pub base: KrlFrame,
+    /// Where on the table the part goes: the table point (`$BASE` X and Y, mm) its XY
+    /// bounding-box centre is placed on. Optional: `[0, 0]`, the table's origin, when left
+    /// out. [`crate::fit::reach_shift`] finds the least move of it that brings every point
+    /// into the arm's reach.
+    #[serde(default, skip_serializing_if = "is_origin")]
+    pub part_position: [f64; 2],
     /// `$TOOL`: the nozzle tip in the flange frame, Z along the nozzle.
     pub tool: KrlFrame,
     /// Home position A1..A6 (degrees), where the program starts and ends (`PTP`).
@@ -125,6 +131,10 @@ pub struct KukaCell {
     pub arm: ArmModel,
 }
 
+fn is_origin(p: &[f64; 2]) -> bool {
+    *p == [0.0, 0.0]
+}
+
 fn default_feed_output() -> u32 {
     1
 }
@@ -155,6 +165,16 @@ impl KukaCell {
             if let Some(x) = v[3..].iter().find(|x| x.abs() > 360.0) {
                 return Err(bad(field, format!("A, B, C must be within ±360°, got {x}")));
             }
+        }
+        if let Some(x) = self
+            .part_position
+            .iter()
+            .find(|x| !(x.is_finite() && x.abs() <= 1e5))
+        {
+            return Err(bad(
+                "kuka.part_position",
+                format!("must be within ±100000 mm, got {x}"),
+            ));
         }
         for (field, v, max) in [
             ("kuka.print_vel_cp", self.print_vel_cp, 3.0),

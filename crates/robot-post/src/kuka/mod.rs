@@ -6,7 +6,9 @@
 //! - **Frames.** `$BASE` is the work table's frame in the robot's base frame (`$WORLD`, with a
 //!   null `$ROBROOT`): the profile's `[kuka.base]`, Z up from the table top. The part is placed
 //!   on the table by the rule of [`crate::placement::bed_offset`] (XY bounding-box centre on the
-//!   table centre, lowest bead bottom on the table top); LIN targets are tool poses in `$BASE`,
+//!   table centre, lowest bead bottom on the table top), then moved by the cell's
+//!   `part_position` (`$BASE` X and Y, `[0, 0]` when left out; [`crate::fit::reach_shift`]
+//!   finds the least move that brings every point into reach); LIN targets are tool poses in `$BASE`,
 //!   part point + offset, and the offset is written in a header comment
 //!   `; part offset X.. Y.. Z.. (base = part + offset)`. `$TOOL` is the nozzle tip in the
 //!   flange frame (`[kuka.tool]`), with its Z axis along the nozzle, out of the extruder into
@@ -81,6 +83,7 @@ use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
 use checks::Reach;
 use krl_text::write_files;
+pub(crate) use motion::start_frame;
 use motion::{placement, Planner, Step};
 use toolpath::vec3::{norm, scale};
 use toolpath::ToolPath;
@@ -181,4 +184,10 @@ pub fn kuka_to(
         figures,
         warnings,
     })
+}
+
+/// The part offset [`kuka`] places the part with (`$BASE` = part + offset, the cell's
+/// `part_position` included), its warnings dropped.
+pub(crate) fn part_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostError> {
+    placement(path, m, &mut Vec::new())
 }

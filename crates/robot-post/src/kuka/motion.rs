@@ -11,7 +11,7 @@ use crate::placement::bed_offset;
 use crate::PostError;
 use std::collections::VecDeque;
 use toolpath::vec3::{add, cross, norm, scale, sub, V3};
-use toolpath::{MoveKind, ToolPath};
+use toolpath::{fixed, MoveKind, ToolPath};
 
 /// Largest orientation change of one LIN of a travel (degrees): a travel that turns the tool
 /// further is split into several LINs.
@@ -37,30 +37,50 @@ pub(super) enum Step {
     },
 }
 
-/// The part offset (part + offset = `$BASE` coordinates): [`bed_offset`]'s placement; a part
-/// larger than the table is placed the same way, with a warning.
+/// The part offset (part + offset = `$BASE` coordinates): [`bed_offset`]'s placement moved
+/// by the cell's `part_position` (`[0, 0]` leaves it centred on the table's origin); a part
+/// larger than the table, or moved off it, is placed the same way, with a warning.
 pub(super) fn placement(
     path: &ToolPath,
     m: &MachineProfile,
     warnings: &mut Vec<String>,
 ) -> Result<[f64; 3], PostError> {
-    match bed_offset(path, m) {
-        Ok(o) => Ok(o),
+    let shift = m.kuka.as_ref().map_or([0.0; 2], |c| c.part_position);
+    let centred = match bed_offset(path, m) {
+        Ok(o) => o,
         Err(e @ PostError::DoesNotFit { .. }) => {
             warnings.push(format!("{e} (written anyway: the arm's reach decides)"));
             let mut open = m.clone();
             open.bed_origin_centre = true;
             open.bed_size = [f64::INFINITY; 3];
             let o = bed_offset(path, &open)?;
-            let shift = if m.bed_origin_centre {
+            let centre = if m.bed_origin_centre {
                 [0.0, 0.0]
             } else {
                 [m.bed_size[0] / 2.0, m.bed_size[1] / 2.0]
             };
-            Ok([o[0] + shift[0], o[1] + shift[1], o[2]])
+            return Ok([
+                o[0] + centre[0] + shift[0],
+                o[1] + centre[1] + shift[1],
+                o[2],
+            ]);
         }
-        Err(e) => Err(e),
+        Err(e) => Err(e)?,
+    };
+    if shift != [0.0, 0.0] {
+        let over = crate::placement::bed_overhang_xy(path, m, shift);
+        if over > 0.0 {
+            warnings.push(format!(
+                "the part, moved by part_position [{}, {}], overhangs the {} mm table of `{}` by up to {} mm (written anyway: the arm's reach decides)",
+                fixed(shift[0], 3),
+                fixed(shift[1], 3),
+                m.bed_size.map(|v| fixed(v, 0)).join("x"),
+                m.name,
+                fixed(over, 3)
+            ));
+        }
     }
+    Ok([centred[0] + shift[0], centred[1] + shift[1], centred[2]])
 }
 
 /// The motions of the program, planned as they are asked for: travels, print moves, speeds
@@ -289,7 +309,7 @@ impl HeightMap {
 /// The tool frame at the start of a path: Z along `z` (unit, `$BASE`), X the horizontal
 /// direction from the nozzle at `p` back to the robot's A1 axis made normal to Z (or, when
 /// the tool points along that direction, the horizontal normal to it).
-pub(super) fn start_frame(z: V3, p: V3, base: &Pose) -> Mat3 {
+pub(crate) fn start_frame(z: V3, p: V3, base: &Pose) -> Mat3 {
     let world = base.apply(p);
     let back = [-world[0], -world[1], 0.0];
     let back = if norm(back) < 1.0 {
