@@ -204,8 +204,20 @@ fn write_refused(
     Ok(names)
 }
 
-/// Where the part stands, when it was turned.
+/// Where the part stands, when it was turned or moved.
 fn tell_placement(plan: &Plan, path: &Path, bar: &Bar) {
+    if let Some(m) = &plan.report.moved_on_table {
+        bar.0.suspend(|| {
+            eprintln!(
+                "features: {}: {} point(s) out of the arm's reach where the profile places the part: moved {:.1} mm on the table, to part_position [{}, {}]",
+                path.display(),
+                m.unreachable_before,
+                m.distance_mm,
+                m.part_position[0],
+                m.part_position[1]
+            )
+        });
+    }
     if let Some(p) = &plan.report.placement {
         let d = p.down;
         bar.0.suspend(|| {

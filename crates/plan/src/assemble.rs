@@ -6,14 +6,23 @@ use crate::gates::Passed;
 use crate::head::Checked;
 use crate::lay::LaidFeature;
 use crate::report::{
-    round, FeatureReport, FreeformEntry, PlacementEntry, PlanReport, PostEntry, SettingsEntry,
-    PLAN_SCHEMA,
+    round, FeatureReport, FreeformEntry, MovedEntry, PlacementEntry, PlanReport, PostEntry,
+    SettingsEntry, PLAN_SCHEMA,
 };
 use crate::warning::{texts, Warning, WarningKind};
 use crate::{Options, Plan};
 use robot_post::machine::MachineProfile;
 use robot_post::{PostFigures, Program};
 use slicer::orient::OrientationFigures;
+
+/// What the post stage made: the program, and where the part was moved into reach first.
+#[derive(Debug, Clone, Copy)]
+pub struct Posted<'a> {
+    /// The post's program (its figures and warnings).
+    pub program: &'a Program,
+    /// Where the part was moved on a KUKA table, when it was.
+    pub moved: Option<&'a crate::reach::Moved>,
+}
 
 /// What the stages up to the head check made, carried to the gates, the post and the report.
 #[derive(Debug)]
@@ -31,13 +40,13 @@ pub struct Stages {
 }
 
 impl Stages {
-    /// The plan, its report made from every stage's value: `program` is the post's (`None`:
+    /// The plan, its report made from every stage's value: `posted` is the post's (`None`:
     /// refused before it), `passed` what the gates let pass.
     pub fn assemble(
         self,
         machine: &MachineProfile,
         options: &Options,
-        program: Option<&Program>,
+        posted: Option<Posted>,
         passed: Passed,
         est: &Estimate,
         settings: SettingsEntry,
@@ -49,6 +58,7 @@ impl Stages {
             warnings,
             checked,
         } = self;
+        let program = posted.map(|p| p.program);
         let reports = features
             .into_iter()
             .map(|f| feature_report(f, &checked, program))
@@ -84,6 +94,11 @@ impl Stages {
             feed_clamped_moves: program.and_then(|p| p.feed_clamped_moves),
             settings,
             placement,
+            moved_on_table: posted.and_then(|p| p.moved).map(|m| MovedEntry {
+                part_position: m.part_position.map(|x| round(x, 1e3)),
+                distance_mm: round(m.distance_mm, 1e3),
+                unreachable_before: m.unreachable_before,
+            }),
             failures: vec![],
             outputs: vec![],
         };

@@ -27,6 +27,7 @@ pub mod lay;
 pub mod place;
 pub mod post;
 pub mod process;
+pub mod reach;
 pub mod report;
 pub mod settings;
 pub mod smooth;
@@ -219,6 +220,9 @@ fn run(
         Err(gate) => return Err(refuse(gate, stages, process, machine, options)),
     };
     tell(Progress::Stage(Stage::Post));
+    // A KUKA part out of the arm's reach is moved on the table first.
+    let moved = reach::into_reach(&stages.checked.toolpath, machine, options);
+    let machine = moved.as_ref().map_or(machine, |m| &m.machine);
     let settings = settings::entry(process, machine, &process.base());
     let est = estimate::estimate(&stages.checked.toolpath, machine);
     let notes = post::notes(&est, &settings);
@@ -237,7 +241,11 @@ fn run(
         }
         Err(e) => return Err(e),
     };
-    let plan = stages.assemble(machine, options, Some(&program), passed, &est, settings);
+    let posted = assemble::Posted {
+        program: &program,
+        moved: moved.as_ref(),
+    };
+    let plan = stages.assemble(machine, options, Some(posted), passed, &est, settings);
     match gates::after_post(&plan, options) {
         Ok(()) => Ok(plan),
         Err(gate) => Err(gates::refused(gate, plan)),

@@ -268,6 +268,17 @@ pub struct FailureEntry {
     pub text: String,
 }
 
+/// Where the plan moved the part on a KUKA cell's table to bring every point into reach.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MovedEntry {
+    /// The cell's `part_position` the program is written for (`$BASE` X, Y, mm).
+    pub part_position: [f64; 2],
+    /// How far from the profile's place, mm.
+    pub distance_mm: f64,
+    /// Points out of reach at the profile's place.
+    pub unreachable_before: usize,
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -298,6 +309,9 @@ pub struct PlanReport {
     /// How the part was turned onto the plate, when it was (set by the caller that turned it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<PlacementEntry>,
+    /// Where the part was moved on a KUKA table into reach, when it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub moved_on_table: Option<MovedEntry>,
     /// Why the plan was refused, when it was (then `complete` is false and no program was
     /// written).
     #[serde(skip_serializing_if = "Vec::is_empty")]
