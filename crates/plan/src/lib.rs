@@ -14,6 +14,7 @@ pub mod collisions;
 pub mod estimate;
 pub mod process;
 pub mod report;
+pub mod support;
 
 pub use process::{Process, ProcessError};
 pub use report::{FeatureEntry, FeatureReport, PlanReport, SettingsEntry};
@@ -53,6 +54,10 @@ pub enum PlanError {
     /// layer, or its extruded volume is off its volume × fill.
     #[error("the plan fails its self-check for {} feature(s)", .0.len())]
     SelfCheck(Vec<PlanProblem>),
+    /// Some layers are not held up within the overhang limit (and [`Options::keep_going`] is
+    /// off): one line per feature ([`support::line`]).
+    #[error("{} feature(s) have unsupported layers", .0.len())]
+    Unsupported(Vec<String>),
     /// The head meets material or the table on some moves (and
     /// [`Options::allow_collisions`] is off): one line per feature.
     #[error("the head collides in {} feature(s)", .0.len())]
@@ -245,6 +250,8 @@ pub fn plan_into(
             bead_km: bead_mm * 1e-6,
         });
     }
+    // What holds up each planar layer, from the features alone (issue 31).
+    let mut held = support::planar(&assembly, process, bead.width)?;
     // Features are filled (sectioned and filled layer by layer: the bulk of the work) a few
     // at a time in parallel, as many as there are threads, so memory holds no more than that
     // many fills; then laid one after the other, each from where the one before ended.
@@ -335,6 +342,19 @@ pub fn plan_into(
                     warnings.push(w);
                 }
             }
+            if let Some(ff) = &plan.freeform {
+                let (angle_deg, kind) = (params.overhang_angle_deg, f.kind);
+                let support = ff.support;
+                held.insert(
+                    id,
+                    support::Held {
+                        support,
+                        angle_deg,
+                        kind,
+                    },
+                );
+            }
+            let unsupported = held.get(&id).map_or(0.0, |h| h.support.area_mm2);
             reports.push(FeatureReport {
                 feature: FeatureEntry::new(t, f, offset),
                 layers: fig.layers,
@@ -346,6 +366,7 @@ pub fn plan_into(
                 thickness_min_mm: round(fig.thickness.0, 1e6),
                 thickness_mean_mm: round(fig.thickness.1, 1e6),
                 thickness_max_mm: round(fig.thickness.2, 1e6),
+                unsupported_area_mm2: round(unsupported, 1e3),
                 freeform: plan.freeform.map(|ff| FreeformEntry {
                     chart: ff.chart.to_string(),
                     overhang_points: ff.overhang_points,
@@ -459,6 +480,14 @@ pub fn plan_into(
         }
         warnings.extend(problems.iter().map(|p| p.to_string()));
     }
+    // Support: every layer held up (issue 31).
+    let unsupported = support::lines(&held);
+    if !unsupported.is_empty() {
+        if !options.keep_going {
+            return Err(PlanError::Unsupported(unsupported));
+        }
+        warnings.extend(unsupported.iter().cloned());
+    }
     let collided = collisions::lines(&collided);
     if !collided.is_empty() {
         if !options.allow_collisions {
@@ -470,7 +499,7 @@ pub fn plan_into(
         schema: PLAN_SCHEMA,
         source: options.source.clone(),
         machine: machine.name.clone(),
-        complete: problems.is_empty(),
+        complete: problems.is_empty() && unsupported.is_empty(),
         features: reports,
         warnings,
         estimated_time_s: round(est.time_s, 1e1),
