@@ -3,11 +3,13 @@
 //!
 //! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
 //! outward is a candidate (the 8 with the largest planar area facing that way). The part is
-//! read turned so that the candidate points down and its features are extracted; a feature
-//! *needs a tool axis below the horizon* when its build direction (the normal of its reference
-//! plane, into the feature) points below the horizontal plane (z < −0.001). The candidate with
-//! the fewest such features wins; ties go to the larger planar area facing down, then to the
-//! candidate first in the file.
+//! read turned so that the candidate points down and its features are extracted. Printability
+//! first: the candidate whose planar layers leave the least area unsupported within the
+//! overhang limit (`plan::support::planar_area`, issue 31: none, where any candidate has
+//! none) wins. Then a feature *needs a tool axis below the horizon* when its build direction
+//! (the normal of its reference plane, into the feature) points below the horizontal plane
+//! (z < −0.001): the candidate with the fewest such features wins; ties go to the larger
+//! planar area facing down, then to the candidate first in the file.
 
 use crate::Failure;
 use brep::math::V3;
@@ -22,10 +24,14 @@ use std::path::Path;
 const CANDIDATES: usize = 8;
 
 /// Reads `path` standing as `--base-face` or `--orient` say, with what plan.json records.
+///
+/// `process` and `bead_width` (mm) measure each candidate's support for `--orient auto`.
 pub fn read_placed(
     path: &Path,
     base_face: Option<u64>,
     auto: bool,
+    process: &plan::Process,
+    bead_width: f64,
 ) -> Result<(StepPart, Option<PlacementEntry>), Failure> {
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     if let Some(id) = base_face {
@@ -63,9 +69,9 @@ pub fn read_placed(
             "--orient auto: the part has no planar face to stand on",
         ));
     }
-    // (features needing an axis below the horizon, −area, index) for each candidate, with the
-    // part read turned onto it.
-    let mut best: Option<((usize, f64, usize), &Candidate, StepPart)> = None;
+    // (unsupported area, features needing an axis below the horizon, −area, index) for each
+    // candidate, with the part read turned onto it.
+    let mut best: Option<((f64, usize, f64, usize), &Candidate, StepPart)> = None;
     for (k, c) in candidates.iter().enumerate() {
         let turned = brep::read_step_turned(path, [c.down.x, c.down.y, c.down.z])
             .map_err(|e| Failure::new(path, e))?;
@@ -78,7 +84,10 @@ pub fn read_placed(
             .flat_map(|t| t.features.iter())
             .filter(|f| f.reference.normal.is_some_and(|n| n[2] < -1e-3))
             .count();
-        let key = (below, -c.area, k);
+        // A candidate whose support cannot be measured ranks after every one that can.
+        let unsupported =
+            plan::support::planar_area(&assembly, process, bead_width).unwrap_or(f64::INFINITY);
+        let key = (unsupported, below, -c.area, k);
         if best
             .as_ref()
             .is_none_or(|(b, _, _)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
@@ -86,14 +95,14 @@ pub fn read_placed(
             best = Some((key, c, turned));
         }
     }
-    let Some(((below, _, _), c, turned)) = best else {
+    let Some(((unsupported, below, _, _), c, turned)) = best else {
         return Err(Failure::new(
             path,
             "--orient auto: the features of no candidate placement could be extracted",
         ));
     };
     let rule = format!(
-        "auto: of {} planar directions, the one leaving the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
+        "auto: of {} planar directions, the one leaving the least unsupported area ({unsupported:.1} mm^2), then the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
         candidates.len(),
         c.area
     );

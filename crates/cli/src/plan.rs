@@ -41,7 +41,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         |n| n.to_string_lossy().into_owned(),
     ));
     let auto = args.orient.as_deref() == Some("auto");
-    let (part, placement) = crate::placement::read_placed(path, args.base_face, auto)?;
+    let (part, placement) =
+        crate::placement::read_placed(path, args.base_face, auto, &process, machine.bead().width)?;
     bar.0.inc(1);
     bar.0.set_prefix("planning");
     if let Some(p) = &placement {
@@ -114,6 +115,13 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             }
             let n = problems.len();
             Failure::new(path, format!("the plan fails its self-check for {n} feature(s) (listed above); nothing written (--keep-going writes it anyway)"))
+        }
+        PlanError::Unsupported(lines) => {
+            for l in &lines {
+                bar.0.suspend(|| eprintln!("features: {}: {l}", path.display()));
+            }
+            let n = lines.len();
+            Failure::new(path, format!("{n} feature(s) have layers nothing holds up within the overhang limit (listed above); nothing written (--keep-going writes it anyway)"))
         }
         PlanError::Collisions(lines) => {
             for l in &lines {
