@@ -459,6 +459,11 @@ impl FreeformFill<'_> {
         let mut cursor = entry;
         let cursor = &mut cursor;
         let mut prev_regions: Vec<Region> = vec![];
+        // A band of transition layers over offset layers: each point of its first layer rests
+        // on the last offset layer laid there (the offset layers stop where the band takes
+        // over, point by point), so it is held by any of them, not by the last one alone.
+        let banded = blend.is_some() && offset_layers > 0;
+        let mut offset_regions: Vec<Region> = vec![];
         let mut layers = vec![];
         let mut points: Vec<PathPoint> = vec![];
         // Print points whose fixed axis points against the layer normal, and the worst angle.
@@ -474,6 +479,13 @@ impl FreeformFill<'_> {
             let thick = |q: Point2, dl: f64| match levels {
                 Some((field, n)) => (field.height(q) - field.lower(q)) / n,
                 None => dl,
+            };
+            if banded && layer < offset_layers {
+                offset_regions.extend(regions.iter().cloned());
+            }
+            let held_by = match banded && layer == offset_layers {
+                true => Some(&offset_regions),
+                false => None,
             };
             let below = std::mem::replace(&mut prev_regions, regions);
             let start = cursor
@@ -517,6 +529,12 @@ impl FreeformFill<'_> {
                         if off > 0.5 * bead.width {
                             unheld += 1;
                         }
+                        let off = match held_by {
+                            Some(r) if off > limit => {
+                                outside_regions(r, x.q) * chart.stretch(x.q, z)
+                            }
+                            _ => off,
+                        };
                         if off > limit {
                             unsupported += bead_share(&pts, i) * x.w;
                         }
