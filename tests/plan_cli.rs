@@ -27,12 +27,14 @@ fn every_warning_of_the_plan_is_one_line_on_stderr() {
     let out = s.path("imp");
     let o = plan(
         "impeller.step",
-        // The blades, printed along the hub's normal, meet the head's body (issue 18): those
-        // collisions are warnings here like the rest.
+        // The blades, printed along the hub's normal, meet the head's body (issue 18), and
+        // their edges on the hub's flank overhang (issue 31): those are warnings here like the
+        // rest.
         &[
             "--machine",
             "delta5",
             "--allow-collisions",
+            "--keep-going",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -152,9 +154,11 @@ fn strict_turns_warnings_into_an_error_and_writes_nothing() {
         "stacked_solids.step",
         // The overlapping solids also collide (the later is printed inside the earlier): let
         // those be warnings, which --strict then refuses with the rest.
+        // The floating box is unsupported (issue 31): --keep-going makes that a warning too.
         &[
             "--strict",
             "--allow-collisions",
+            "--keep-going",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -166,7 +170,12 @@ fn strict_turns_warnings_into_an_error_and_writes_nothing() {
     // Without --strict the same plan is written, with the same warnings.
     let o = plan(
         "stacked_solids.step",
-        &["--allow-collisions", "-o", out.to_str().unwrap()],
+        &[
+            "--allow-collisions",
+            "--keep-going",
+            "-o",
+            out.to_str().unwrap(),
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("in the air"));
@@ -594,9 +603,20 @@ fn a_part_modelled_on_its_side_stands_on_the_face_chosen_or_picked() {
         "{}",
         stderr(&o)
     );
-    // --orient auto stands it on a planar face: nothing below the plate.
+    // --orient auto stands it on a planar face: nothing below the plate. No face leaves every
+    // layer held up (issue 31: on this one, 386 mm^2 in 16 layers, 128.5 of it in layer 18):
+    // --keep-going, this test is about where it stands.
     let auto = s.path("auto");
-    let o = plan_file(&part, &["--orient", "auto", "-o", auto.to_str().unwrap()]);
+    let o = plan_file(
+        &part,
+        &[
+            "--orient",
+            "auto",
+            "--keep-going",
+            "-o",
+            auto.to_str().unwrap(),
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         !stderr(&o).contains("below the build plate"),
@@ -649,6 +669,7 @@ fn a_part_modelled_on_its_side_stands_on_the_face_chosen_or_picked() {
         &[
             "--base-face",
             &id.to_string(),
+            "--keep-going",
             "-o",
             chosen.to_str().unwrap(),
         ],
@@ -927,13 +948,24 @@ const FREEFORM: [&str; 7] = [
 ];
 
 /// Fixtures with an overhang no placement `--orient auto` tries removes: refused, naming it.
-const OVERHANGING: [(&str, &str); 2] = [
+const OVERHANGING: [(&str, &str); 4] = [
+    // Each blade's edge where it meets the hub's steep flank leans 60-70 degrees from the
+    // layers' build direction there (the hub's normal, nearly horizontal): four layers reach
+    // 0.3-0.7 mm past the 0.24 mm the limit allows, about 1 mm^2 each.
+    ("impeller", "feature 1 (freeform)"),
     // Its bridge spans the 38 mm between the feet: on any face, the feet and bridge are one
     // feature whose layers follow the plate's top.
     ("arch", "feature 1 (two5d)"),
     // The spherical void's ceiling, in whatever way the box stands.
     ("void_box", "feature 0 (two5d)"),
+    // As modelled a box floats 5 mm over the others; on any side, the cylinder (a solid of
+    // its own, sunk into the base) lies with 15 mm of its round underside in the air.
+    ("stacked_solids", "feature 3 (two5d)"),
 ];
+
+/// Fixtures refused on their machine for another cause than support, and that cause (issue 31,
+/// item 3: placement).
+const REFUSED_OTHERWISE: [(&str, &str); 1] = [("capsule", "outside the B limits")];
 
 /// Fixtures with no planar face to stand on (`--orient auto` refuses them).
 const ROUND: [&str; 2] = ["sphere", "torus"];
@@ -987,6 +1019,12 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
                 .any(|l| l.contains(feature) && l.contains("mm^2 unsupported"));
             if o.status.code() != Some(2) || !named || out.join("plan.json").exists() {
                 failures.push(format!("{name}: its overhang was not refused: {err}"));
+            }
+            continue;
+        }
+        if let Some((_, cause)) = REFUSED_OTHERWISE.iter().find(|(n, _)| n == name) {
+            if o.status.code() != Some(2) || !err.contains(cause) {
+                failures.push(format!("{name}: not refused for `{cause}` any more: {err}"));
             }
             continue;
         }

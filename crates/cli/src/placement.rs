@@ -4,9 +4,9 @@
 //! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
 //! outward is a candidate (the 8 with the largest planar area facing that way). The part is
 //! read turned so that the candidate points down and its features are extracted. Printability
-//! first: the candidate whose planar layers leave the least area unsupported within the
-//! overhang limit (`plan::support::planar_area`, issue 31: none, where any candidate has
-//! none) wins. Then a feature *needs a tool axis below the horizon* when its build direction
+//! first: a candidate whose planar layers leave no area unsupported within the overhang limit
+//! (`plan::support::planar_area`, issue 31) wins over any that leaves some (however little: a
+//! placement with less, but some, is no more printable, and may fail otherwise). Then a feature *needs a tool axis below the horizon* when its build direction
 //! (the normal of its reference plane, into the feature) points below the horizontal plane
 //! (z < −0.001): the candidate with the fewest such features wins; ties go to the larger
 //! planar area facing down, then to the candidate first in the file.
@@ -69,9 +69,9 @@ pub fn read_placed(
             "--orient auto: the part has no planar face to stand on",
         ));
     }
-    // (unsupported area, features needing an axis below the horizon, −area, index) for each
-    // candidate, with the part read turned onto it.
-    let mut best: Option<((f64, usize, f64, usize), &Candidate, StepPart)> = None;
+    // (some area unsupported, features needing an axis below the horizon, −area, index) for
+    // each candidate, with the part read turned onto it, and its unsupported area.
+    let mut best: Option<((bool, usize, f64, usize), f64, &Candidate, StepPart)> = None;
     for (k, c) in candidates.iter().enumerate() {
         let turned = brep::read_step_turned(path, [c.down.x, c.down.y, c.down.z])
             .map_err(|e| Failure::new(path, e))?;
@@ -87,22 +87,22 @@ pub fn read_placed(
         // A candidate whose support cannot be measured ranks after every one that can.
         let unsupported =
             plan::support::planar_area(&assembly, process, bead_width).unwrap_or(f64::INFINITY);
-        let key = (unsupported, below, -c.area, k);
+        let key = (unsupported > 0.0, below, -c.area, k);
         if best
             .as_ref()
-            .is_none_or(|(b, _, _)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
+            .is_none_or(|(b, _, _, _)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
         {
-            best = Some((key, c, turned));
+            best = Some((key, unsupported, c, turned));
         }
     }
-    let Some(((unsupported, below, _, _), c, turned)) = best else {
+    let Some(((_, below, _, _), unsupported, c, turned)) = best else {
         return Err(Failure::new(
             path,
             "--orient auto: the features of no candidate placement could be extracted",
         ));
     };
     let rule = format!(
-        "auto: of {} planar directions, the one leaving the least unsupported area ({unsupported:.1} mm^2), then the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
+        "auto: of {} planar directions, one leaving no area unsupported where one does (this one: {unsupported:.1} mm^2), then the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
         candidates.len(),
         c.area
     );
