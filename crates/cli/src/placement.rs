@@ -71,7 +71,7 @@ pub fn read_placed(
     }
     // (some area unsupported, features needing an axis below the horizon, −area, index) for
     // each candidate, with the part read turned onto it, and its unsupported area.
-    let mut best: Option<((bool, usize, f64, usize), f64, &Candidate, StepPart)> = None;
+    let mut best: Option<(Rank, f64, &Candidate, StepPart)> = None;
     for (k, c) in candidates.iter().enumerate() {
         let turned = brep::read_step_turned(path, [c.down.x, c.down.y, c.down.z])
             .map_err(|e| Failure::new(path, e))?;
@@ -111,6 +111,10 @@ pub fn read_placed(
     let d = [c.down.x, c.down.y, c.down.z];
     Ok((part, Some(entry(c.face_id, d, rule))))
 }
+
+/// How `--orient auto` ranks a candidate, least first: some planar area unsupported, features
+/// needing an axis below the horizon, −planar area down, index.
+type Rank = (bool, usize, f64, usize);
 
 /// Whether `down` already points down (−Z): the part stands as modelled.
 fn stands(down: V3) -> bool {
