@@ -28,9 +28,19 @@ impl Drop for Out {
 static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 fn plan(name: &str, extra: &[&str]) -> (Out, Value, String, String) {
-    let (dir, plan, csv, gcode, _) = plan_part(&fixture(&format!("{name}.step")), extra);
+    // Overhangs past the limit are refused (issue 31): these tests are about the geometry of
+    // what is laid, so the fixtures with real ones are planned anyway.
+    let mut extra = extra.to_vec();
+    if OVERHANGING.contains(&name) {
+        extra.push("--keep-going");
+    }
+    let (dir, plan, csv, gcode, _) = plan_part(&fixture(&format!("{name}.step")), &extra);
     (dir, plan, csv, gcode)
 }
+
+/// Fixtures with real overhangs (issue 31): the arch's 38 mm bridge, the void box's ceiling,
+/// the torus's underside, the impeller blades' edges on the hub's steep flank.
+const OVERHANGING: [&str; 4] = ["arch", "void_box", "torus", "impeller"];
 
 /// Plans `part` (any STEP file) with `extra` arguments into a directory of its own, which is
 /// removed when the returned `Out` drops: `plan.json`, `toolpath.csv`, the G-code (empty for
@@ -794,7 +804,8 @@ fn real_parts_put_down_each_features_volume() {
 fn several_solids_are_printed_lowest_first_and_their_overlap_and_gap_warned() {
     // stacked_solids: written highest first (floating box, resting box, sunk cylinder, base).
     let part = fixture("stacked_solids.step");
-    let (_dir, plan, csv, _, stderr) = plan_part(&part, &[]);
+    // The floating box is unsupported (issue 31): planned anyway, this test is about the order.
+    let (_dir, plan, csv, _, stderr) = plan_part(&part, &["--keep-going"]);
     // The toolpath runs feature by feature, each starting no lower than the one before.
     let rows = rows(&csv);
     let mut starts: Vec<(usize, f64)> = vec![];
@@ -957,8 +968,10 @@ fn every_corpus_plan_passes_its_self_check_or_exits_2_naming_why() {
                     .lines()
                     .filter(|l| !l.contains(": warning: "))
                     .collect();
-                // The self-check and the collision check list one line per feature.
+                // The self-check, the support check and the collision check list one line per
+                // feature.
                 let self_check = stderr.contains("fails its self-check")
+                    || stderr.contains("nothing holds up")
                     || stderr.contains("print head collides");
                 let named = errors.iter().any(|l| l.contains(": feature "));
                 if (self_check && !named) || errors.is_empty() {

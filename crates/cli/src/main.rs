@@ -152,13 +152,15 @@ pub struct PlanArgs {
     /// outward normal points down [default: as modelled, -Z down]
     #[arg(long, value_name = "ID", conflicts_with = "orient")]
     pub base_face: Option<u64>,
-    /// `auto`: stand the part on the planar face that leaves the fewest features growing below
-    /// the horizon (ties: the most planar area down); `modelled`: as the file has it
+    /// `auto`: stand the part on the planar face that leaves the least unsupported area, then
+    /// the fewest features growing below the horizon (ties: the most planar area down);
+    /// `modelled`: as the file has it
     #[arg(long, value_name = "auto|modelled", value_parser = ["auto", "modelled"])]
     pub orient: Option<String>,
     /// Write the plan even when its self-check fails (a feature with no layer, or extruded
-    /// volume more than 3 % from volume x fill): the failures become warnings and plan.json
-    /// says `"complete": false`
+    /// volume more than 3 % from volume x fill) or some layers are unsupported (reaching past
+    /// the layer below by more than layer height x tan(overhang_angle_deg)): the failures
+    /// become warnings and plan.json says `"complete": false`
     #[arg(long)]
     pub keep_going: bool,
     /// Write the plan even when the print head meets material built before a move, or the

@@ -126,6 +126,13 @@ impl Refusal<'_> {
                     " (--keep-going writes it anyway)",
                 )
             }
+            Gate::Unsupported(lines) => {
+                lines.iter().for_each(|l| say(l));
+                (
+                    format!("{} feature(s) have layers nothing holds up within the overhang limit (listed above)", lines.len()),
+                    " (--keep-going writes it anyway)",
+                )
+            }
             Gate::Collisions(lines) => {
                 lines.iter().for_each(|l| say(l));
                 (

@@ -134,6 +134,7 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
         thickness_min_mm: round(f.thickness.0, 1e6),
         thickness_mean_mm: round(f.thickness.1, 1e6),
         thickness_max_mm: round(f.thickness.2, 1e6),
+        unsupported_area_mm2: round(f.held.map_or(0.0, |h| h.support.area_mm2), 1e3),
         freeform: f.freeform.map(|ff| FreeformEntry {
             chart: ff.chart.as_str().to_string(),
             overhang_points: ff.overhang_points,

@@ -51,6 +51,10 @@ pub enum Gate {
     /// The self-check fails (and [`crate::Options::keep_going`] is off): a feature has no
     /// layer, or its extruded volume is off its volume × fill.
     SelfCheck(Vec<PlanProblem>),
+    /// Some layers are not held up within the overhang limit (and
+    /// [`crate::Options::keep_going`] is off): one line per feature
+    /// ([`crate::support::line`]).
+    Unsupported(Vec<String>),
     /// The head meets material or the table on some moves (and
     /// [`crate::Options::allow_collisions`] is off): one line per feature.
     Collisions(Vec<String>),
@@ -68,6 +72,7 @@ impl Gate {
     pub fn name(&self) -> &'static str {
         match self {
             Gate::SelfCheck(_) => "selfcheck",
+            Gate::Unsupported(_) => "unsupported",
             Gate::Collisions(_) => "collisions",
             Gate::Strict(_) => "strict",
             Gate::Unreachable(_) => "reach",
@@ -86,6 +91,7 @@ impl std::fmt::Display for Gate {
                     p.len()
                 )
             }
+            Gate::Unsupported(l) => write!(f, "{} feature(s) have unsupported layers", l.len()),
             Gate::Collisions(l) => write!(f, "the head collides in {} feature(s)", l.len()),
             Gate::Strict(n) => write!(f, "{n} warning(s) and strict"),
             Gate::Unreachable(n) => {

@@ -19,7 +19,7 @@ pub struct Passed {
     pub warnings: Vec<Warning>,
 }
 
-/// The gates before the post: the self-check, then the collisions left.
+/// The gates before the post: the self-check, then support, then the collisions left.
 pub fn before_post(
     features: &[LaidFeature],
     checked: &Checked,
@@ -39,6 +39,22 @@ pub fn before_post(
             problems
                 .into_iter()
                 .map(|p| Warning::part(WarningKind::SelfCheck(p))),
+        );
+    }
+    // Support: every layer held up (issue 31).
+    let unsupported: Vec<String> = features
+        .iter()
+        .filter_map(|f| crate::support::line(f.planned.id, f.held.as_ref()?))
+        .collect();
+    if !unsupported.is_empty() {
+        if !options.keep_going {
+            return Err(Gate::Unsupported(unsupported));
+        }
+        passed.complete = false;
+        passed.warnings.extend(
+            unsupported
+                .into_iter()
+                .map(|l| Warning::part(WarningKind::Unsupported(l))),
         );
     }
     let collided = crate::collisions::lines(&checked.collisions);
@@ -86,6 +102,16 @@ pub fn failures(gate: &Gate, plan: &Plan) -> Vec<FailureEntry> {
                     PlanProblem::NoLayers { id, .. } | PlanProblem::Volume { id, .. } => *id,
                 };
                 entry(Some(id), None, p.to_string())
+            })
+            .collect(),
+        Gate::Unsupported(lines) => lines
+            .iter()
+            .map(|l| {
+                let id = l
+                    .strip_prefix("feature ")
+                    .and_then(|r| r.split(' ').next())
+                    .and_then(|n| n.parse().ok());
+                entry(id, None, l.clone())
             })
             .collect(),
         Gate::Collisions(lines) => plan

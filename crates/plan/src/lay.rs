@@ -40,6 +40,9 @@ pub struct LaidFeature {
     pub freeform: Option<FreeformFigures>,
     /// The feature's warnings.
     pub warnings: Vec<Warning>,
+    /// What holds up its layers (issue 31): measured from the features alone for planar
+    /// layers, as laid for curved ones; `None` where nothing was measured.
+    pub held: Option<crate::support::Held>,
 }
 
 /// What the lay stage returns.
@@ -63,6 +66,8 @@ pub fn lay(
     tell: &dyn Fn(Progress),
 ) -> Result<Laid, PlanError> {
     let base = process.base();
+    // What holds up each planar layer, from the features alone (issue 31).
+    let mut held = crate::support::planar(&extracted.assembly, process, machine.bead().width)?;
     let window = rayon::current_num_threads().max(1);
     let mut plans = vec![];
     let mut cursor: Option<P3> = None;
@@ -90,6 +95,18 @@ pub fn lay(
             let mut plan = plan;
             let mut laid = laid.widen(&mut plan.points, machine);
             laid.warnings.extend(below.clone());
+            // Curved layers' support is measured as they are laid.
+            if let Some(ff) = &plan.freeform {
+                held.insert(
+                    id,
+                    crate::support::Held {
+                        support: ff.support,
+                        angle_deg: params.overhang_angle_deg,
+                        kind: extracted.feature(slot).kind,
+                    },
+                );
+            }
+            laid.held = held.get(&id).copied();
             warnings.extend(below);
             features.push(laid);
             plans.push((id, plan));
@@ -192,6 +209,7 @@ fn laid_feature(
         thickness: fig.thickness,
         freeform: plan.freeform,
         warnings,
+        held: None,
     };
     (laid, below)
 }

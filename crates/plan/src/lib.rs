@@ -32,6 +32,7 @@ pub mod report;
 pub mod settings;
 pub mod smooth;
 pub mod stage;
+pub mod support;
 mod tolerance;
 pub mod warning;
 
@@ -168,7 +169,7 @@ pub fn plan_file_into(
     sink: &mut dyn ProgramSink,
     csv: Option<&mut (dyn std::io::Write + Send)>,
 ) -> Result<Plan, PlanError> {
-    let placed = place::place(file, options.placement)?;
+    let placed = place::place(file, options.placement, process, machine.bead().width)?;
     process.validate_for_nozzle(machine.nozzle_diameter)?;
     let extracted = match placed.assembly {
         Some(assembly) => extract::arrange(assembly, process, machine)?,

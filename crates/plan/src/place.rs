@@ -5,11 +5,14 @@
 //!
 //! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
 //! outward is a candidate (the 8 with the largest planar area facing that way). The part is
-//! turned so that the candidate points down and its features are extracted; a feature *needs a
-//! tool axis below the horizon* when its build direction (the normal of its reference plane,
-//! into the feature) points below the horizontal plane (z < −0.001). The candidate with the
-//! fewest such features wins; ties go to the larger planar area facing down, then to the
-//! candidate first in the file.
+//! turned so that the candidate points down and its features are extracted. Printability
+//! first: a candidate whose planar layers leave no area unsupported within the overhang limit
+//! ([`crate::support::planar_area`], issue 31) wins over any that leaves some (however little:
+//! a placement with less, but some, is no more printable). Then a feature *needs a tool axis
+//! below the horizon* when its build direction (the normal of its reference plane, into the
+//! feature) points below the horizontal plane (z < −0.001): the candidate with the fewest such
+//! features wins; ties go to the larger planar area facing down, then to the candidate first
+//! in the file.
 
 use crate::report::PlacementEntry;
 use brep::math::V3;
@@ -78,8 +81,14 @@ pub struct Placed {
     pub entry: Option<PlacementEntry>,
 }
 
-/// Stands the part of `file` as `how` says.
-pub fn place(file: &StepFile, how: Placement) -> Result<Placed, PlaceError> {
+/// Stands the part of `file` as `how` says; `--orient auto` measures each candidate's support
+/// with `process`'s layers and beads `bead_width` wide.
+pub fn place(
+    file: &StepFile,
+    how: Placement,
+    process: &crate::Process,
+    bead_width: f64,
+) -> Result<Placed, PlaceError> {
     let part = file.part()?;
     match how {
         Placement::AsModelled => Ok(Placed {
@@ -88,7 +97,7 @@ pub fn place(file: &StepFile, how: Placement) -> Result<Placed, PlaceError> {
             entry: None,
         }),
         Placement::BaseFace(id) => base_face(file, part, id),
-        Placement::Auto => auto(file, part),
+        Placement::Auto => auto(file, part, process, bead_width),
     }
 }
 
@@ -113,14 +122,19 @@ fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceEr
 }
 
 /// The part on the face the rule of `--orient auto` picks (module docs).
-fn auto(file: &StepFile, part: StepPart) -> Result<Placed, PlaceError> {
+fn auto(
+    file: &StepFile,
+    part: StepPart,
+    process: &crate::Process,
+    bead_width: f64,
+) -> Result<Placed, PlaceError> {
     let candidates = candidates(&part.brep);
     if candidates.is_empty() {
         return Err(PlaceError::NoPlanarFace);
     }
-    // (features needing an axis below the horizon, −area, index) for each candidate, with the
-    // part turned onto it and its features.
-    let mut best: Option<(RankKey, &Candidate, StepPart, Assembly)> = None;
+    // (some area unsupported, features needing an axis below the horizon, −area, index) for
+    // each candidate, with its unsupported area, the part turned onto it and its features.
+    let mut best: Option<(RankKey, f64, &Candidate, StepPart, Assembly)> = None;
     for (k, c) in candidates.iter().enumerate() {
         let turned = file.turned([c.down.x, c.down.y, c.down.z])?;
         let Ok(assembly) = extract_all(&turned.brep, &ExtractOptions::default()) else {
@@ -132,17 +146,21 @@ fn auto(file: &StepFile, part: StepPart) -> Result<Placed, PlaceError> {
             .flat_map(|t| t.features.iter())
             .filter(|f| f.reference.normal.is_some_and(|n| n[2] < BELOW_HORIZON_Z))
             .count();
-        let key = (below, -c.area, k);
+        // A candidate whose support cannot be measured ranks after every one that can.
+        let unsupported =
+            crate::support::planar_area(&assembly, process, bead_width).unwrap_or(f64::INFINITY);
+        let key = (unsupported > 0.0, below, -c.area, k);
         if best
             .as_ref()
             .is_none_or(|(b, ..)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
         {
-            best = Some((key, c, turned, assembly));
+            best = Some((key, unsupported, c, turned, assembly));
         }
     }
-    let ((below, _, _), c, turned, assembly) = best.ok_or(PlaceError::NoCandidate)?;
+    let ((_, below, _, _), unsupported, c, turned, assembly) =
+        best.ok_or(PlaceError::NoCandidate)?;
     let rule = format!(
-        "auto: of {} planar directions, the one leaving the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
+        "auto: of {} planar directions, one leaving no area unsupported where one does (this one: {unsupported:.1} mm^2), then the fewest features with a build direction below the horizon ({below}), then the most planar area down ({:.1} mm^2)",
         candidates.len(),
         c.area
     );
@@ -155,9 +173,9 @@ fn auto(file: &StepFile, part: StepPart) -> Result<Placed, PlaceError> {
     })
 }
 
-/// A candidate's rank: features needing an axis below the horizon, −planar area down, its
-/// index (least first).
-type RankKey = (usize, f64, usize);
+/// A candidate's rank, least first: some planar area unsupported, features needing an axis
+/// below the horizon, −planar area down, its index.
+type RankKey = (bool, usize, f64, usize);
 
 /// Whether `down` already points down (−Z): the part stands as modelled.
 fn stands(down: V3) -> bool {

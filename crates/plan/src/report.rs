@@ -158,6 +158,10 @@ pub struct FeatureReport {
     pub thickness_mean_mm: f64,
     /// Thickest layer, mm.
     pub thickness_max_mm: f64,
+    /// Area of its layers that nothing holds up within the overhang limit
+    /// (`overhang_angle_deg`), summed over its layers, mm² rounded to 1e-3; 0 when supported
+    /// (issue 31, [`crate::support`]).
+    pub unsupported_area_mm2: f64,
     /// Curved features only.
     #[serde(flatten)]
     pub freeform: Option<FreeformEntry>,

@@ -60,6 +60,8 @@ pub enum WarningKind {
     SelfCheck(PlanProblem),
     /// The head collides and `allow_collisions` wrote the plan anyway: the feature's line.
     Collisions(String),
+    /// Layers nothing holds up and `keep_going` wrote the plan anyway: the feature's line.
+    Unsupported(String),
 }
 
 impl Warning {
@@ -87,7 +89,8 @@ impl std::fmt::Display for Warning {
             WarningKind::Planner(t)
             | WarningKind::Extraction(t)
             | WarningKind::Post(t)
-            | WarningKind::Collisions(t) => f.write_str(t),
+            | WarningKind::Collisions(t)
+            | WarningKind::Unsupported(t) => f.write_str(t),
             WarningKind::OffsetLayers { missed } => write!(
                 f,
                 "feature {id}: offset layers, not transition layers: these missed its volume by {:+.2} %",

@@ -63,6 +63,10 @@ pub struct FreeformFigures {
     pub overhang_points: usize,
     /// First and last layer (1-based) with such points.
     pub overhang_layers: Option<(usize, usize)>,
+    /// The bead laid more than `h·tan(overhang_angle_deg)` off the layer below (or off the
+    /// reference face, under the first layer), as area (mm²: length × width), layers whose
+    /// area is a sliver left out ([`crate::support::SLIVER_BEADS`]).
+    pub support: crate::support::FeatureSupport,
     /// The layers the feature got.
     pub layers: Layering,
 }

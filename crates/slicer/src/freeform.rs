@@ -42,9 +42,19 @@ use crate::lift::{lift, Lifted};
 use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::sst::{Sides, WALL_REACH};
+use crate::support::{reach, sliver_area};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
 use crate::toolpath::{Bead, MoveKind, PathPoint};
 use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
+
+/// The length of bead point `i` of `pts` lays: half of each segment it ends.
+fn bead_share(pts: &[Lifted], i: usize) -> f64 {
+    let seg = |a: usize, b: usize| match (pts.get(a), pts.get(b)) {
+        (Some(p), Some(q)) => (q.p - p.p).norm(),
+        _ => 0.0,
+    };
+    0.5 * (if i > 0 { seg(i - 1, i) } else { 0.0 } + seg(i, i + 1))
+}
 
 /// Splits chart paths where `keep` turns false, ending each piece on the boundary (found by
 /// bisection along the segment that crosses it).
@@ -110,21 +120,23 @@ use rayon::prelude::*;
 pub use crate::chart::{Chart, ChartKind};
 pub use crate::region_fill::{fill_flat_region, Boundary, FillPath};
 
-/// Whether chart point `q` lies in one of `regions` or within `reach` (chart units) of one.
-fn near_regions(regions: &[Region], q: Point2, reach: f64) -> bool {
+/// How far (chart units) chart point `q` lies outside `regions`: 0 inside one, the distance
+/// to the nearest boundary otherwise (infinite with no region).
+fn outside_regions(regions: &[Region], q: Point2) -> f64 {
     if regions.iter().any(|r| crate::geom2d::region_contains(r, q)) {
-        return true;
+        return 0.0;
     }
-    let r2 = reach * reach;
-    regions.iter().any(|r| {
-        std::iter::once(&r.outer).chain(r.holes.iter()).any(|ring| {
+    let mut d2 = f64::INFINITY;
+    for r in regions {
+        for ring in std::iter::once(&r.outer).chain(r.holes.iter()) {
             let n = ring.len();
-            (0..n).any(|i| {
+            for i in 0..n {
                 let x = segment_foot(q, ring[i], ring[(i + 1) % n]).1;
-                dist2(x, q) <= r2
-            })
-        })
-    })
+                d2 = d2.min(dist2(x, q));
+            }
+        }
+    }
+    d2.sqrt()
 }
 
 /// Plans one freeform feature on offsets of its reference surface; its first travel starts at
@@ -255,6 +267,7 @@ pub fn fill_freeform<'a>(
         concave_radius,
         overhang_points: 0,
         overhang_layers: None,
+        support: Default::default(),
         layers: Layering::Offset,
     };
     // The top faces, for transition layers and side-surface-tangent walls.
@@ -446,6 +459,11 @@ impl FreeformFill<'_> {
         let mut cursor = entry;
         let cursor = &mut cursor;
         let mut prev_regions: Vec<Region> = vec![];
+        // A band of transition layers over offset layers: each point of its first layer rests
+        // on the last offset layer laid there (the offset layers stop where the band takes
+        // over, point by point), so it is held by any of them, not by the last one alone.
+        let banded = blend.is_some() && offset_layers > 0;
+        let mut offset_regions: Vec<Region> = vec![];
         let mut layers = vec![];
         let mut points: Vec<PathPoint> = vec![];
         // Print points whose fixed axis points against the layer normal, and the worst angle.
@@ -462,6 +480,13 @@ impl FreeformFill<'_> {
                 Some((field, n)) => (field.height(q) - field.lower(q)) / n,
                 None => dl,
             };
+            if banded && layer < offset_layers {
+                offset_regions.extend(regions.iter().cloned());
+            }
+            let held_by = match banded && layer == offset_layers {
+                true => Some(&offset_regions),
+                false => None,
+            };
             let below = std::mem::replace(&mut prev_regions, regions);
             let start = cursor
                 .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -472,7 +497,7 @@ impl FreeformFill<'_> {
                 order_fill_paths(paths, start)
             };
             // Each path lifted onto the layer and its unsupported points counted, in parallel.
-            let lifted: Vec<(Vec<Lifted>, usize)> = paths
+            let lifted: Vec<(Vec<Lifted>, usize, f64)> = paths
                 .par_iter()
                 .map(|path| {
                     let mut pts = lift(&chart, path, z, params.tolerance);
@@ -480,22 +505,49 @@ impl FreeformFill<'_> {
                     if let Some(s) = &sides {
                         crate::sst::apply(&mut pts, s, |q| thick(q, dl), WALL_REACH * bead.width);
                     }
-                    // Support: the layer below (or, under the first layer, the reference face).
-                    let unheld = pts
-                        .iter()
-                        .filter(|x| {
-                            !if layer == 0 {
-                                chart.on_face(x.q)
+                    // Support: the layer below (or, under the first layer, the reference face):
+                    // points more than half a bead off it are counted (`overhang_points`),
+                    // and the bead of those more than h·tan(overhang limit) off it is
+                    // unsupported area (crate::support).
+                    let mut unheld = 0;
+                    let mut unsupported = 0.0;
+                    for (i, x) in pts.iter().enumerate() {
+                        let (off, limit) = if layer == 0 {
+                            let off = if chart.on_face(x.q) {
+                                0.0
                             } else {
-                                near_regions(&below, x.q, 0.5 * bead.width / chart.stretch(x.q, z))
+                                f64::INFINITY
+                            };
+                            (off, 0.0)
+                        } else {
+                            let s = chart.stretch(x.q, z);
+                            (
+                                outside_regions(&below, x.q) * s,
+                                reach(dl, params.overhang_angle_deg),
+                            )
+                        };
+                        if off > 0.5 * bead.width {
+                            unheld += 1;
+                        }
+                        let off = match held_by {
+                            Some(r) if off > limit => {
+                                outside_regions(r, x.q) * chart.stretch(x.q, z)
                             }
-                        })
-                        .count();
-                    (pts, unheld)
+                            _ => off,
+                        };
+                        if off > limit {
+                            unsupported += bead_share(&pts, i) * x.w;
+                        }
+                    }
+                    (pts, unheld, unsupported)
                 })
                 .collect();
+            let layer_unsupported: f64 = lifted.iter().map(|l| l.2).sum();
+            if layer_unsupported >= sliver_area(bead.width) {
+                ff.support.add(layer + 1, layer_unsupported);
+            }
             let mut layer_paths: Vec<LayerPath> = vec![];
-            for (pts, unheld) in lifted {
+            for (pts, unheld, _) in lifted {
                 if pts.len() < 2 {
                     continue;
                 }

@@ -17,6 +17,7 @@
 //!   (one region of a curved or thin planar layer filled with beads of varying width, shared
 //!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`;
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
+//! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
 //!   re-exported);
@@ -45,6 +46,7 @@ pub mod params;
 pub mod planar;
 mod region_fill;
 mod sst;
+pub mod support;
 mod tolerance;
 mod top_field;
 pub mod transition;

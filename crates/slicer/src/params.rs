@@ -12,6 +12,13 @@ use serde::{Deserialize, Serialize};
 /// (a 1 m part at 1 µm layers), and an empty list is returned instead of exhausting memory.
 pub const MAX_LAYERS: usize = 1_000_000;
 
+/// The default overhang limit, degrees from the build direction (issue 31): what FDM prints
+/// without support on common materials (45° is the usual rule, 50–60° the usual reach).
+pub const DEFAULT_OVERHANG_ANGLE_DEG: f64 = 50.0;
+
+/// `overhang_angle_deg` must stay under this: at 90° a layer may reach out without limit.
+pub const MAX_OVERHANG_ANGLE_DEG: f64 = 90.0;
+
 /// How a planar layer is filled (the paper's `path_mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -108,6 +115,10 @@ pub struct LayerParams {
     pub min_layer_height: f64,
     /// Thickest local thickness of a transition layer, mm. Default 0.3.
     pub max_layer_height: f64,
+    /// Overhang limit, degrees from the build direction: a layer's bead must lie within
+    /// `h·tan(overhang_angle_deg)` of the layer below it (h the layer's thickness), or on
+    /// material laid before, or on the plate ([`crate::support`]). Default 50.
+    pub overhang_angle_deg: f64,
 }
 
 impl Default for LayerParams {
@@ -128,6 +139,7 @@ impl Default for LayerParams {
             wall_orientation: WallOrientation::Normal,
             min_layer_height: 0.1,
             max_layer_height: 0.3,
+            overhang_angle_deg: DEFAULT_OVERHANG_ANGLE_DEG,
         }
     }
 }
@@ -259,6 +271,12 @@ impl LayerParams {
                 self.min_layer_height, self.max_layer_height
             ));
         }
+        let a = self.overhang_angle_deg;
+        if !(a.is_finite() && a > 0.0 && a < MAX_OVERHANG_ANGLE_DEG) {
+            return Err(format!(
+                "overhang_angle_deg must be more than 0 and less than {MAX_OVERHANG_ANGLE_DEG} degrees, got {a}"
+            ));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > 1e-9) {
@@ -318,6 +336,9 @@ impl LayerParams {
         if let Some(v) = p.max_layer_height {
             out.max_layer_height = v;
         }
+        if let Some(v) = p.overhang_angle_deg {
+            out.overhang_angle_deg = v;
+        }
         out
     }
 }
@@ -373,6 +394,9 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::max_layer_height`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_layer_height: Option<f64>,
+    /// Overrides [`LayerParams::overhang_angle_deg`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overhang_angle_deg: Option<f64>,
 }
 
 #[cfg(test)]

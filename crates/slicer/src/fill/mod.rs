@@ -336,3 +336,32 @@ pub fn bead_end_reach(width: f64, boundary: f64, room: f64) -> f64 {
         0.0
     }
 }
+
+/// The area (mm²) of each piece of `layer` lying outside `below` grown by `reach` (mm; round
+/// joins chorded within `tol`): what a layer holds that the one under it does not carry
+/// ([`crate::support`]). Pieces come as i_overlay's shapes, outer contour and holes; a piece's
+/// area is the outer's minus its holes'.
+pub(crate) fn pieces_outside(layer: &[Region], below: &[Region], reach: f64, tol: f64) -> Vec<f64> {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::core::overlay_rule::OverlayRule;
+    use i_overlay::float::single::SingleFloatOverlay;
+    let top: Shapes = layer.iter().flat_map(region_shapes).collect();
+    if top.is_empty() {
+        return vec![];
+    }
+    let base: Shapes = below.iter().flat_map(region_shapes).collect();
+    let pieces = if base.is_empty() {
+        top
+    } else {
+        let grown = if reach > 0.0 {
+            offset(&base, reach, &round_join(tol, reach), 1.1)
+        } else {
+            base
+        };
+        top.overlay(&grown, OverlayRule::Difference, FillRule::NonZero)
+    };
+    pieces
+        .iter()
+        .map(|shape| shape.iter().map(|c| 0.5 * area2(c)).sum::<f64>().abs())
+        .collect()
+}

@@ -1,0 +1,115 @@
+//! The support gate (issue 31): every bead rests on the bead below it, on material laid
+//! before it or on the plate, within the overhang limit (`overhang_angle_deg`). The measure is
+//! the slicer's ([`slicer::support`]): planar layers from the features alone, before any path
+//! is filled ([`planar`], also what `--orient auto` ranks placements by), curved layers as
+//! they are laid (`FreeformFigures::support`). A feature with unsupported area fails the plan
+//! like the self-check ([`crate::PlanError::Unsupported`], one [`line`] each).
+
+use crate::{PlanError, Process};
+use features::{Assembly, FeatureKind};
+use slicer::support::{feature_support, FeatureSupport};
+use std::collections::BTreeMap;
+
+/// What holds up one feature.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Held {
+    /// Its unsupported area, by layer.
+    pub support: FeatureSupport,
+    /// Its overhang limit, degrees from the build direction.
+    pub angle_deg: f64,
+    /// Its kind.
+    pub kind: FeatureKind,
+}
+
+/// The support of every two5d feature of `assembly` by file-wide id, with its parameters from
+/// `process` and beads `bead_width` wide: no path filled (freeform features are left out;
+/// their curved layers are measured as they are laid). A solid whose base feature lies above
+/// the plate (the lowest base plane, [`PLATE_SLACK`]) rests on the solids built before it.
+pub fn planar(
+    assembly: &Assembly,
+    process: &Process,
+    bead_width: f64,
+) -> Result<BTreeMap<usize, Held>, PlanError> {
+    let base = process.base();
+    let trees = &assembly.trees;
+    // How high each solid's base plane stands along the build direction (+Z).
+    let standing: Vec<Option<f64>> = trees
+        .iter()
+        .map(|t| {
+            let b = t.features.first()?;
+            let plane = slicer::planar::reference_plane(t, b)?;
+            Some(plane.origin.z)
+        })
+        .collect();
+    let plate = standing
+        .iter()
+        .flatten()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let mut out = BTreeMap::new();
+    let mut offset = 0;
+    for (ti, t) in trees.iter().enumerate() {
+        let lifted = standing[ti].is_some_and(|z| z > plate + PLATE_SLACK);
+        let earlier: Vec<_> = match lifted {
+            true => trees[..ti]
+                .iter()
+                .flat_map(|u| u.features.iter().map(move |g| (u, g)))
+                .collect(),
+            false => vec![],
+        };
+        for f in &t.features {
+            let id = offset + f.id;
+            let params = process.params_for(&base, id)?;
+            if let Some(support) = feature_support(t, f, &params, bead_width, &earlier)? {
+                let angle_deg = params.overhang_angle_deg;
+                let kind = f.kind;
+                out.insert(
+                    id,
+                    Held {
+                        support,
+                        angle_deg,
+                        kind,
+                    },
+                );
+            }
+        }
+        offset += t.features.len();
+    }
+    Ok(out)
+}
+
+/// How far (mm) above the lowest solid's base plane another solid's base may stand and still
+/// be on the plate: a micrometre (solids modelled on one plane share it to round-off).
+pub const PLATE_SLACK: f64 = 1e-3;
+
+/// The unsupported area of `assembly`'s planar layers, mm², summed over its features
+/// ([`planar`]): 0 when every layer is held up. What `--orient auto` ranks by first.
+pub fn planar_area(
+    assembly: &Assembly,
+    process: &Process,
+    bead_width: f64,
+) -> Result<f64, PlanError> {
+    Ok(planar(assembly, process, bead_width)?
+        .values()
+        .map(|h| h.support.area_mm2)
+        .sum())
+}
+
+/// The line a feature with unsupported area gets (`None` when it is held up): its id, kind,
+/// the layer with the most unsupported area and that area, the total and the limit.
+pub fn line(id: usize, held: &Held) -> Option<String> {
+    let s = &held.support;
+    let (layer, worst) = s.worst?;
+    Some(format!(
+        "feature {id} ({}): layer {layer}: {worst:.1} mm^2 unsupported ({:.1} mm^2 in {} layer(s); overhang limit {} degrees)",
+        held.kind.as_str(),
+        s.area_mm2,
+        s.layers,
+        held.angle_deg
+    ))
+}
+
+/// One [`line`] for each feature with unsupported area, by id.
+pub fn lines(held: &BTreeMap<usize, Held>) -> Vec<String> {
+    held.iter().filter_map(|(id, h)| line(*id, h)).collect()
+}

@@ -1,0 +1,302 @@
+//! Support (issue 31): every bead must rest on the bead below it, on material laid before it,
+//! or on the build plate, within an overhang limit (`overhang_angle_deg`, degrees from the
+//! build direction).
+//!
+//! - **A planar layer** is supported where it lies inside the layer below grown by
+//!   `h·tan(angle)` (h the layer's thickness): a wall may lean out by that much a layer. What
+//!   lies outside is unsupported ([`unsupported_area`]).
+//! - **The first layer of a feature** rests on what was built before it: its parent features,
+//!   whose material lies just below its reference plane (their sections half its first layer
+//!   below that plane), or the plate, for the base feature (its reference plane is the plate).
+//! - **Curved layers** (freeform features) are measured as they are laid (the layer below
+//!   along the tool axis, `crate::freeform`); [`feature_support`] gives `None` for them.
+//!
+//! Everything here is a function of the extracted features and their layer parameters: no
+//! path is filled, so a placement can be ranked by it ([`feature_support`] sections the
+//! feature's mesh at each layer's middle, as the planar planner does, and stops there).
+
+use crate::error::PlanError;
+use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::fill::{pieces_outside, regions_from_loops};
+use crate::geom2d::Region;
+use crate::params::LayerParams;
+use crate::planar::reference_plane;
+use brep::section::{section, Plane};
+use features::{Feature, FeatureKind, FeatureTree};
+use rayon::prelude::*;
+
+/// Pieces of a layer's unsupported region smaller than this many square bead widths are
+/// slivers, not overhangs, and are not counted (0.48 mm² for a 0.4 mm bead).
+///
+/// Why: a bead spans a gap of a few of its widths, held at both ends (a bridge), so a hole
+/// that small in the support costs nothing. And the sections are polygons of a mesh chorded
+/// within the slicing tolerance (a quarter of `tolerance`, 0.0125 mm): on a curved wall leaning
+/// inward the section one layer up may still poke past the grown section below where the
+/// plane crosses a facet's diagonal, by at most that chord error along at most a facet
+/// (hundredths of a mm by a few mm: well under a square bead). A real overhang is not lost
+/// to this: a wall leaning past the limit leaves a strip along the whole wall, one piece
+/// `h·(tan θ − tan α)` wide (0.11 mm for 60° at 0.2 mm layers), over the threshold once it runs
+/// 4.4 mm; a ceiling or a plate over a boss leaves pieces of its whole area. No distance is
+/// added to the reach, so the limit itself is not loosened.
+pub const SLIVER_BEADS: f64 = 3.0;
+
+/// What [`feature_support`] found of one feature.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FeatureSupport {
+    /// The feature's index in its tree.
+    pub feature: usize,
+    /// Unsupported area summed over its layers, mm² (the area of its overhangs seen along
+    /// its build direction); 0 when every layer is supported.
+    pub area_mm2: f64,
+    /// Layers with unsupported area.
+    pub layers: usize,
+    /// The layer (1-based) with the most unsupported area, and that area (mm²).
+    pub worst: Option<(usize, f64)>,
+}
+
+impl FeatureSupport {
+    /// Adds layer `layer`'s (1-based) unsupported area `area` (mm², 0 for none).
+    pub fn add(&mut self, layer: usize, area: f64) {
+        if area <= 0.0 {
+            return;
+        }
+        self.area_mm2 += area;
+        self.layers += 1;
+        if self.worst.is_none_or(|(_, a)| area > a) {
+            self.worst = Some((layer, area));
+        }
+    }
+}
+
+/// How far (mm) a layer `h` thick may reach out past the layer below at an overhang limit of
+/// `angle_deg` degrees from the build direction: `h·tan(angle)`.
+pub fn reach(h: f64, angle_deg: f64) -> f64 {
+    h * angle_deg.to_radians().tan()
+}
+
+/// The least area (mm²) of a piece of unsupported region that counts, for beads
+/// `bead_width` wide: [`SLIVER_BEADS`] square bead widths.
+pub fn sliver_area(bead_width: f64) -> f64 {
+    SLIVER_BEADS * bead_width * bead_width
+}
+
+/// The area (mm²) of `layer` outside `below` grown by `reach` mm, in pieces of `sliver` mm² or
+/// more (smaller pieces are slivers: [`SLIVER_BEADS`]). `tol` is the chord tolerance of the
+/// growth's round corners. Empty `below`: the whole layer is unsupported.
+pub fn unsupported_area(
+    layer: &[Region],
+    below: &[Region],
+    reach: f64,
+    sliver: f64,
+    tol: f64,
+) -> f64 {
+    pieces_outside(layer, below, reach.max(0.0), tol)
+        .into_iter()
+        .filter(|a| *a >= sliver)
+        .sum()
+}
+
+/// A planar section of `mesh` by `plane`, as regions in the plane's frame.
+fn section_regions(mesh: &brep::mesh::Mesh, plane: &Plane) -> Vec<Region> {
+    let loops: Vec<Vec<[f64; 2]>> = section(mesh, plane)
+        .iter()
+        .map(|l| l.iter().map(|p| plane.to_2d(p)).collect())
+        .collect();
+    regions_from_loops(&loops)
+}
+
+/// The support of a two5d feature's planar layers (as [`crate::planar`] lays them: parallel to
+/// its reference plane, each cut at its middle), for beads `bead_width` wide: each layer
+/// against the one below grown by [`reach`], the first against the sections of its parents
+/// half its thickness below its reference plane. A base feature (no parent) stands on the
+/// plate when `earlier` is empty (nothing to check), else on `earlier`: the features of the
+/// file's other solids built before it, for a solid whose base lies above the plate. `None`
+/// for a freeform feature, whose curved layers are measured as they are laid. Nothing is
+/// filled.
+pub fn feature_support(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead_width: f64,
+    earlier: &[(&FeatureTree, &Feature)],
+) -> Result<Option<FeatureSupport>, PlanError> {
+    if f.kind != FeatureKind::Two5d {
+        return Ok(None);
+    }
+    params
+        .validate()
+        .map_err(|msg| PlanError::Params { id: f.id, msg })?;
+    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+    let tol = slicing_tolerance(params);
+    let mesh = feature_mesh(tree, f, tol)?;
+    let top = mesh
+        .positions
+        .iter()
+        .map(|p| plane.height(p))
+        .fold(0.0f64, f64::max);
+    let heights = params.layer_heights(top);
+    let mut mids = Vec::with_capacity(heights.len());
+    let mut z = 0.0;
+    for &dl in &heights {
+        mids.push(z + 0.5 * dl);
+        z += dl;
+    }
+    let sections: Vec<Vec<Region>> = mids
+        .par_iter()
+        .map(|&mid| section_regions(&mesh, &plane.offset(mid)))
+        .collect();
+    // Under the first layer: the parents (or the earlier solids) just below the reference
+    // plane; the plate, with neither: nothing to check.
+    let under: Vec<(&FeatureTree, &Feature)> = match f.parents.is_empty() {
+        false => f
+            .parents
+            .iter()
+            .map(|&p| (tree, &tree.features[p]))
+            .collect(),
+        true => earlier.to_vec(),
+    };
+    let foundation = match (under.is_empty(), heights.first()) {
+        (false, Some(&h0)) => {
+            let cut = plane.offset(-0.5 * h0);
+            let mut regions = vec![];
+            for (t, g) in under {
+                regions.extend(section_regions(&feature_mesh(t, g, tol)?, &cut));
+            }
+            Some(regions)
+        }
+        _ => None,
+    };
+    let sliver = sliver_area(bead_width);
+    let angle = params.overhang_angle_deg;
+    let chord = params.tolerance;
+    let areas: Vec<f64> = (0..sections.len())
+        .into_par_iter()
+        .map(|k| {
+            let below = match k {
+                0 => match &foundation {
+                    Some(r) => r,
+                    None => return 0.0,
+                },
+                _ => &sections[k - 1],
+            };
+            unsupported_area(&sections[k], below, reach(heights[k], angle), sliver, chord)
+        })
+        .collect();
+    let mut out = FeatureSupport {
+        feature: f.id,
+        ..FeatureSupport::default()
+    };
+    for (k, a) in areas.into_iter().enumerate() {
+        out.add(k + 1, a);
+    }
+    Ok(Some(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const W: f64 = 0.4;
+    const TOL: f64 = 0.05;
+
+    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
+        Region {
+            outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
+            holes: vec![],
+        }
+    }
+
+    fn disc(r: f64) -> Region {
+        let n = 256;
+        Region {
+            outer: (0..n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / n as f64;
+                    [r * a.cos(), r * a.sin()]
+                })
+                .collect(),
+            holes: vec![],
+        }
+    }
+
+    /// The support of a stack of layers `h` thick whose sections are `layer(k)`, the first
+    /// on the plate.
+    fn stack(n: usize, h: f64, angle: f64, layer: impl Fn(usize) -> Vec<Region>) -> f64 {
+        let mut s = FeatureSupport::default();
+        for k in 1..n {
+            let a = unsupported_area(
+                &layer(k),
+                &layer(k - 1),
+                reach(h, angle),
+                sliver_area(W),
+                TOL,
+            );
+            s.add(k + 1, a);
+        }
+        s.area_mm2
+    }
+
+    #[test]
+    fn a_plate_over_a_boss_is_unsupported_by_its_area_outside_the_boss() {
+        // A 60 × 40 plate's first layer on a boss of radius 5 (the boss's section below).
+        let plate = [rect(-30.0, -20.0, 30.0, 20.0)];
+        let boss = [disc(5.0)];
+        let a = unsupported_area(&plate, &boss, reach(0.2, 50.0), sliver_area(W), TOL);
+        // The plate less the boss grown by 0.2·tan 50°.
+        let r = 5.0 + reach(0.2, 50.0);
+        let expect = 2400.0 - std::f64::consts::PI * r * r;
+        assert!((a - expect).abs() < 0.5, "{a} vs {expect}");
+        assert!(a > 2300.0);
+    }
+
+    #[test]
+    fn a_box_is_supported() {
+        let a = stack(50, 0.2, 50.0, |_| vec![rect(0.0, 0.0, 20.0, 30.0)]);
+        assert_eq!(a, 0.0);
+    }
+
+    /// A 20 mm wide block whose +x wall leans out at `lean` degrees from the build direction,
+    /// 5 mm tall in 0.2 mm layers, checked at a 50° limit.
+    fn leaning(lean: f64) -> f64 {
+        let h = 0.2;
+        let t = lean.to_radians().tan();
+        stack(25, h, 50.0, |k| {
+            let x = 10.0 + (k as f64 + 0.5) * h * t;
+            vec![rect(0.0, 0.0, x, 20.0)]
+        })
+    }
+
+    #[test]
+    fn a_45_degree_chamfer_is_supported_at_50_and_a_60_degree_one_is_not() {
+        assert_eq!(leaning(45.0), 0.0);
+        assert_eq!(leaning(0.0), 0.0);
+        let a = leaning(60.0);
+        // Each of the 24 layers above the first reaches 0.2·(tan 60° − tan 50°) past the
+        // grown one below, along the 20 mm wall.
+        let per_layer = 0.2 * (60f64.to_radians().tan() - 50f64.to_radians().tan()) * 20.0;
+        assert!((a - 24.0 * per_layer).abs() < 0.01 * a, "{a}");
+    }
+
+    #[test]
+    fn a_shrinking_layer_and_a_sliver_count_nothing() {
+        let below = [rect(0.0, 0.0, 20.0, 20.0)];
+        // Inside the layer below.
+        let inner = [rect(5.0, 5.0, 15.0, 15.0)];
+        assert_eq!(
+            unsupported_area(&inner, &below, 0.0, sliver_area(W), TOL),
+            0.0
+        );
+        // A sliver: 0.3 × 1 mm out past the reach.
+        let nub = [
+            rect(0.0, 0.0, 20.0, 20.0),
+            rect(20.0, 5.0, 20.3 + reach(0.2, 50.0), 6.0),
+        ];
+        assert_eq!(
+            unsupported_area(&nub, &below, reach(0.2, 50.0), sliver_area(W), TOL),
+            0.0
+        );
+        // Nothing below: all of it.
+        let a = unsupported_area(&below, &[], reach(0.2, 50.0), sliver_area(W), TOL);
+        assert!((a - 400.0).abs() < 1e-9);
+    }
+}
