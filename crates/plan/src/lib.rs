@@ -14,6 +14,7 @@ pub mod collisions;
 pub mod estimate;
 pub mod process;
 pub mod report;
+pub mod resolution;
 
 pub use process::{Process, ProcessError};
 pub use report::{FeatureEntry, FeatureReport, PlanReport, SettingsEntry};
@@ -303,8 +304,19 @@ pub fn plan_into(
                 fill: params.filling_ratio,
                 layers: fig.layers,
                 extruded,
+                tolerance: VOLUME_TOLERANCE,
             });
             let mut fw = fig.warnings.clone();
+            // Below the nozzle's resolution (issue 31, item 4): named, and judged within
+            // what the widening below adds.
+            let below = resolution::below_resolution(
+                t,
+                f,
+                &params,
+                &plan.points,
+                min_bead,
+                machine.nozzle_diameter,
+            )?;
             // Printability: beads narrower than the nozzle lays well (thin walls, blade tips)
             // are widened to min_bead_width, their filament with them.
             let narrow = widen_narrow_beads(&mut plan.points, min_bead);
@@ -318,6 +330,10 @@ pub fn plan_into(
                     narrow.thinnest,
                     100.0 * widened / extruded.max(1e-12)
                 ));
+            }
+            if let (Some(b), Some(p)) = (&below, planned.last_mut()) {
+                p.tolerance = resolution::tolerance(widened, f.volume * params.filling_ratio);
+                fw.push(resolution::warning(id, b, min_bead));
             }
             // Below the build plate (the base feature's reference plane): any point of the
             // feature, planned or not (a planar layer starts at its reference plane, so what
@@ -343,6 +359,11 @@ pub fn plan_into(
                 travel_length_mm: round(fig.travel_length, 1e3),
                 extruded_volume_mm3: round(extruded, 1e3),
                 widened_volume_mm3: round(widened, 1e3),
+                below_resolution: below.map(|b| resolution::BelowResolution {
+                    narrowest_mm: round(b.narrowest_mm, 1e3),
+                    nozzle_needed_mm: round(b.nozzle_needed_mm, 1e3),
+                    narrow_share: round(b.narrow_share, 1e4),
+                }),
                 thickness_min_mm: round(fig.thickness.0, 1e6),
                 thickness_mean_mm: round(fig.thickness.1, 1e6),
                 thickness_max_mm: round(fig.thickness.2, 1e6),

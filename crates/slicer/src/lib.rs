@@ -44,6 +44,7 @@ pub mod orient;
 pub mod params;
 pub mod planar;
 mod region_fill;
+pub mod resolution;
 mod sst;
 mod tolerance;
 mod top_field;
