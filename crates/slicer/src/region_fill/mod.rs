@@ -278,7 +278,7 @@ pub(crate) fn fill_region(
                 &mut out[last_ring_from..],
                 lm.area_above(&db, c - 0.5 * width),
                 width,
-                MAX_CORE_WIDENING,
+                conserve::MAX_LAST_RING_SCALE,
                 |a, b| surface_length(chart, z, a, b),
             );
             return out;
