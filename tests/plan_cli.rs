@@ -1226,8 +1226,8 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
         "plate_boss_boss.step",
         &["--base-face", "521", "-o", out.to_str().unwrap()],
     );
-    assert_refused(&o, &["overhang limit", "nothing written"]);
-    assert!(!out.exists());
+    assert_refused(&o, &["overhang limit", "no program written"]);
+    assert!(!out.join("program.gcode").exists());
     let err = stderr(&o);
     let line = err
         .lines()

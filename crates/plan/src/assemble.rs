@@ -131,6 +131,13 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
         travel_length_mm: round(f.travel_length, 1e3),
         extruded_volume_mm3: round(f.extruded, 1e3),
         widened_volume_mm3: round(f.widened, 1e3),
+        below_resolution: f
+            .below_resolution
+            .map(|b| crate::resolution::BelowResolution {
+                narrowest_mm: round(b.narrowest_mm, 1e3),
+                nozzle_needed_mm: round(b.nozzle_needed_mm, 1e3),
+                narrow_share: round(b.narrow_share, 1e4),
+            }),
         thickness_min_mm: round(f.thickness.0, 1e6),
         thickness_mean_mm: round(f.thickness.1, 1e6),
         thickness_max_mm: round(f.thickness.2, 1e6),

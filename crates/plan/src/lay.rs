@@ -40,6 +40,9 @@ pub struct LaidFeature {
     pub freeform: Option<FreeformFigures>,
     /// The feature's warnings.
     pub warnings: Vec<Warning>,
+    /// Below the nozzle's resolution (issue 31, item 4): how narrow, and what nozzle would lay
+    /// it; `None` when the beads lay it.
+    pub below_resolution: Option<crate::resolution::BelowResolution>,
     /// What holds up its layers (issue 31): measured from the features alone for planar
     /// layers, as laid for curved ones; `None` where nothing was measured.
     pub held: Option<crate::support::Held>,
@@ -93,7 +96,31 @@ pub fn lay(
             cursor = plan.exit().map(P3::from).or(cursor);
             let (laid, below) = laid_feature(extracted, slot, &params, &plan, fallback, machine);
             let mut plan = plan;
+            // Below the nozzle's resolution (issue 31, item 4): named, and judged within what
+            // the widening adds.
+            let t = &extracted.assembly.trees[slot.tree];
+            let below_resolution = crate::resolution::below_resolution(
+                t,
+                extracted.feature(slot),
+                &params,
+                &plan.points,
+                machine.min_bead_width(),
+                machine.nozzle_diameter,
+            )?;
             let mut laid = laid.widen(&mut plan.points, machine);
+            if let Some(b) = &below_resolution {
+                let expected = laid.planned.volume * laid.planned.fill;
+                laid.planned.tolerance = crate::resolution::tolerance(laid.widened, expected);
+                laid.warnings.push(Warning::feature(
+                    id,
+                    WarningKind::Planner(crate::resolution::warning(
+                        id,
+                        b,
+                        machine.min_bead_width(),
+                    )),
+                ));
+            }
+            laid.below_resolution = below_resolution;
             laid.warnings.extend(below.clone());
             // Curved layers' support is measured as they are laid.
             if let Some(ff) = &plan.freeform {
@@ -199,6 +226,7 @@ fn laid_feature(
             fill: params.filling_ratio,
             layers: fig.layers,
             extruded,
+            tolerance: VOLUME_TOLERANCE,
         },
         layers: fig.layers,
         points: fig.points,
@@ -209,6 +237,7 @@ fn laid_feature(
         thickness: fig.thickness,
         freeform: plan.freeform,
         warnings,
+        below_resolution: None,
         held: None,
     };
     (laid, below)

@@ -29,6 +29,7 @@ pub mod post;
 pub mod process;
 pub mod reach;
 pub mod report;
+pub mod resolution;
 pub mod settings;
 pub mod smooth;
 pub mod stage;

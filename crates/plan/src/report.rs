@@ -152,6 +152,10 @@ pub struct FeatureReport {
     /// Bead volume added over that by widening beads narrower than the machine's
     /// `min_bead_width` to it, mm³ (the program lays both).
     pub widened_volume_mm3: f64,
+    /// Set when the feature is below the nozzle's resolution (a share of it narrower than
+    /// `min_bead_width`): its narrowest width and the nozzle it would need
+    /// ([`crate::resolution`]); `null` otherwise.
+    pub below_resolution: Option<crate::resolution::BelowResolution>,
     /// Thinnest layer, mm.
     pub thickness_min_mm: f64,
     /// Mean layer, mm.

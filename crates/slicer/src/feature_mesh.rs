@@ -24,8 +24,46 @@ pub(crate) fn feature_mesh(
     for v in &f.voids {
         faces.extend(v.iter().copied());
     }
-    mesh_faces(&tree.brep, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| PlanError::Mesh {
-        id: f.id,
-        msg: e.to_string(),
-    })
+    let mesh_at = |tol: f64| {
+        mesh_faces(&tree.brep, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| {
+            PlanError::Mesh {
+                id: f.id,
+                msg: e.to_string(),
+            }
+        })
+    };
+    let mesh = mesh_at(tol)?;
+    // A small feature's sections lose to their chords what its volume keeps (issue 31, item
+    // 4): meshed again finer for its thickness.
+    let fine = THICKNESS_CHORD_SHARE * thickness(f.volume, &mesh);
+    if fine.is_finite() && fine < tol {
+        return mesh_at(fine.max(MICROMETRE));
+    }
+    Ok(mesh)
+}
+
+/// The chord tolerance of a feature's mesh as a share of its thickness ([`thickness`]): a
+/// round section of radius r meshed at chord tolerance s keeps, as an inscribed polygon, about
+/// `1 − (4/3)·s/r` of its area (each chord of length c cuts off a segment of area
+/// `(2/3)·c·s`, and the chords add up to `2πr`). A pin's thickness `2V/A` is about its radius
+/// (`r·h/(r + h)` with its ends), so this share keeps a pin's sections within 0.3 % of their
+/// area: a 1.39 mm pin was 2.4 % short at the slicing tolerance of 0.0125 mm.
+const THICKNESS_CHORD_SHARE: f64 = 0.002;
+
+/// A feature's thickness, mm: twice its volume over its surface area (a wall's thickness, a
+/// long pin's radius); infinite where the mesh has no area.
+fn thickness(volume: f64, mesh: &brep::mesh::Mesh) -> f64 {
+    let area: f64 = mesh
+        .triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            0.5 * (b - a).cross(&(c - a)).norm()
+        })
+        .sum();
+    if area > 0.0 && volume.is_finite() && volume > 0.0 {
+        2.0 * volume / area
+    } else {
+        f64::INFINITY
+    }
 }

@@ -45,6 +45,7 @@ pub mod orient;
 pub mod params;
 pub mod planar;
 mod region_fill;
+pub mod resolution;
 mod sst;
 pub mod support;
 mod tolerance;

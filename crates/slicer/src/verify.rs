@@ -17,7 +17,8 @@ pub enum PlanProblem {
         /// The feature's volume, mm³.
         volume: f64,
     },
-    /// The extruded volume is off by more than [`VOLUME_TOLERANCE`].
+    /// The extruded volume is off by more than the feature's tolerance ([`VOLUME_TOLERANCE`]
+    /// unless it is below the nozzle's resolution).
     #[error(
         "feature {id} ({kind}): {extruded:.3} mm^3 extruded for {expected:.3} mm^3 expected (volume {volume:.3} mm^3 x fill {fill}), {percent:+.2} %"
     )]
@@ -55,10 +56,14 @@ pub struct PlannedFeature {
     pub layers: usize,
     /// Bead volume put down (Eq. 1 filament length × filament area), mm³.
     pub extruded: f64,
+    /// How far `extruded` may stray from `volume × fill`, as a fraction: [`VOLUME_TOLERANCE`],
+    /// or more for a feature below the nozzle's resolution (the plan crate's `resolution`
+    /// module derives it from the beads widened there).
+    pub tolerance: f64,
 }
 
-/// Checks one feature's plan: at least one layer, and extruded volume within
-/// [`VOLUME_TOLERANCE`] of `volume × fill`.
+/// Checks one feature's plan: at least one layer, and extruded volume within its
+/// `tolerance` (at least [`VOLUME_TOLERANCE`]) of `volume × fill`.
 pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
     if f.layers == 0 || f.extruded <= 0.0 {
         return Some(PlanProblem::NoLayers {
@@ -69,7 +74,7 @@ pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
     }
     let expected = f.volume * f.fill;
     let rel = (f.extruded - expected) / expected.max(1e-12);
-    (rel.abs() > VOLUME_TOLERANCE).then(|| PlanProblem::Volume {
+    (rel.abs() > f.tolerance.max(VOLUME_TOLERANCE)).then(|| PlanProblem::Volume {
         id: f.id,
         kind: f.kind.clone(),
         volume: f.volume,
@@ -97,6 +102,7 @@ mod tests {
             fill,
             layers,
             extruded,
+            tolerance: VOLUME_TOLERANCE,
         }
     }
 
@@ -115,6 +121,26 @@ mod tests {
         assert!(check_planned(&f(10, 102.9, 1.0)).is_none());
         assert!(check_planned(&f(10, 97.1, 1.0)).is_none());
         assert!(check_planned(&f(10, 103.1, 1.0)).is_some());
+    }
+
+    #[test]
+    fn a_feature_below_resolution_is_judged_by_its_own_tolerance() {
+        let wide = PlannedFeature {
+            tolerance: 0.3,
+            ..f(10, 75.0, 1.0)
+        };
+        assert!(check_planned(&wide).is_none());
+        assert!(check_planned(&PlannedFeature {
+            extruded: 65.0,
+            ..wide.clone()
+        })
+        .is_some());
+        // Never tighter than the plan's.
+        let tight = PlannedFeature {
+            tolerance: 0.0,
+            ..f(10, 98.0, 1.0)
+        };
+        assert!(check_planned(&tight).is_none());
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! boundary ([`border`]).
 
 mod border;
+mod conserve;
 mod gap;
 mod spurs;
 #[cfg(test)]
@@ -203,7 +204,10 @@ pub(crate) fn fill_region(
         ridge(&lm, &db, &wanted, spacing)
     };
     let mut last_ring = None;
+    // Where the last ring's paths (and the gap fill before it) begin ([`conserve::conserve_core`]).
+    let mut last_ring_from = 0;
     for (j, &c) in levels.iter().enumerate() {
+        last_ring_from = out.len();
         let edge = c - 0.5 * width;
         if j > 0 {
             // Where this ring does not reach (the region's half width is under `c` there),
@@ -270,6 +274,13 @@ pub(crate) fn fill_region(
                 below: f64::INFINITY,
             };
             out.extend(core_fill(gap));
+            conserve::conserve_core(
+                &mut out[last_ring_from..],
+                lm.area_above(&db, c - 0.5 * width),
+                width,
+                conserve::MAX_LAST_RING_SCALE,
+                |a, b| surface_length(chart, z, a, b),
+            );
             return out;
         }
         // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or

@@ -1,0 +1,165 @@
+//! Features below the nozzle's resolution (issue 31, item 4): a contact 0.3 mm wide, a pin
+//! thinner than a bead. Their fill lays beads as wide as they are, narrower than the
+//! machine's `min_bead_width`; the plan widens those beads to it (`widen_narrow_beads`), so
+//! what is printed there is as much as the nozzle allows, not the feature. Such a feature is
+//! named (a warning and `below_resolution` in `plan.json`, with its narrowest width and the
+//! nozzle it would need) and judged by the self-check with a tolerance derived from the
+//! widening ([`tolerance`]), not failed at [`VOLUME_TOLERANCE`].
+
+use features::{Feature, FeatureTree};
+use serde::Serialize;
+use slicer::params::LayerParams;
+use slicer::toolpath::{MoveKind, PathPoint};
+use slicer::verify::VOLUME_TOLERANCE;
+
+/// A feature's beads narrower than `min_bead_width` must carry at least this share of its
+/// planned material before its sections are measured ([`below_resolution`]): most features
+/// have some (the spurs into sharp corners, the gap fill between a wall's rings), and a
+/// feature without any is not below resolution.
+pub const NARROW_BEAD_SHARE: f64 = 0.01;
+
+/// A feature is below resolution when its sections' regions narrower than `min_bead_width`
+/// hold at least this share of it (not a sliver at its top or bottom).
+pub const BELOW_RESOLUTION_SHARE: f64 = 0.01;
+
+/// A feature below the nozzle's resolution (`below_resolution` in `plan.json`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BelowResolution {
+    /// The narrowest full width of a region of its layers' sections, mm.
+    pub narrowest_mm: f64,
+    /// The nozzle whose narrowest bead, at this machine's ratio of `min_bead_width` to
+    /// `nozzle_diameter`, is that width, mm.
+    pub nozzle_needed_mm: f64,
+    /// The share of the feature in regions narrower than `min_bead_width`.
+    pub narrow_share: f64,
+}
+
+/// Whether feature `f`, planned with `params` as `points` (before its narrow beads are
+/// widened), is below the resolution of a nozzle `nozzle` mm across that lays beads
+/// `min_bead` mm wide at the narrowest: its beads narrower than that carry at least
+/// [`NARROW_BEAD_SHARE`] of its material, and its sections' regions narrower than that hold at
+/// least [`BELOW_RESOLUTION_SHARE`] of it ([`slicer::resolution::narrow_sections`]; two5d
+/// features only).
+pub fn below_resolution(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    points: &[PathPoint],
+    min_bead: f64,
+    nozzle: f64,
+) -> Result<Option<BelowResolution>, slicer::planar::PlanError> {
+    let (mut total, mut narrow) = (0.0, 0.0);
+    for q in points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print && q.width > 0.0 && q.e > 0.0)
+    {
+        total += q.e;
+        if q.width < min_bead {
+            narrow += q.e;
+        }
+    }
+    if total <= 0.0 || narrow < NARROW_BEAD_SHARE * total || min_bead.is_nan() || min_bead <= 0.0 {
+        return Ok(None);
+    }
+    let Some(n) = slicer::resolution::narrow_sections(tree, f, params, min_bead)? else {
+        return Ok(None);
+    };
+    Ok(
+        (n.share >= BELOW_RESOLUTION_SHARE).then(|| BelowResolution {
+            narrowest_mm: n.narrowest,
+            nozzle_needed_mm: nozzle * n.narrowest / min_bead,
+            narrow_share: n.share,
+        }),
+    )
+}
+
+/// The self-check's tolerance for a feature below resolution whose narrow beads were widened
+/// by `widened` mm³ for `expected` mm³ (its volume × fill): [`VOLUME_TOLERANCE`] plus
+/// `widened / expected`.
+///
+/// Derivation: where the feature is narrower than `min_bead_width` its fill lays beads as wide
+/// as it is, down to a fifth of a bead, and leaves out what is narrower still (or the margin
+/// a bead's middle keeps inside a sliver), so what is planned there may miss the feature by up
+/// to all of it; the program lays those beads `min_bead_width` wide, `widened` mm³ more. The
+/// material of those stretches is the planned narrow beads' plus what their widening adds,
+/// and the widening is the most the nozzle's resolution puts beside the feature's own: the
+/// planned volume is held to the plan's tolerance plus that share of the feature. Features
+/// whose narrow beads carry no material (`widened` = 0) keep [`VOLUME_TOLERANCE`].
+pub fn tolerance(widened: f64, expected: f64) -> f64 {
+    if expected > 0.0 && widened.is_finite() && widened > 0.0 {
+        VOLUME_TOLERANCE + widened / expected
+    } else {
+        VOLUME_TOLERANCE
+    }
+}
+
+/// The warning line of a feature below resolution.
+pub fn warning(id: usize, b: &BelowResolution, min_bead: f64) -> String {
+    format!(
+        "feature {id}: below the nozzle's resolution: {:.1} % of it narrower than min_bead_width {min_bead} mm, down to {:.3} mm; a nozzle of {:.2} mm would lay it (judged by the self-check within what the widening adds)",
+        100.0 * b.narrow_share,
+        b.narrowest_mm,
+        b.nozzle_needed_mm
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bead(width: f64, e: f64) -> PathPoint {
+        PathPoint {
+            feature: 1,
+            layer: 0,
+            kind: MoveKind::Print,
+            p: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            e,
+            thickness: 0.2,
+            width,
+            role: slicer::toolpath::Role::GapFill,
+        }
+    }
+
+    #[test]
+    fn a_feature_with_few_narrow_beads_is_not_measured() {
+        // A wall of full beads with 0.5 % of its material in narrow spur tips: its sections
+        // are not measured (the tree is never read).
+        let mut points: Vec<_> = (0..199).map(|_| bead(0.45, 0.1)).collect();
+        points.push(bead(0.13, 0.1));
+        let part = brep::read_step(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/families/thin_wall_2.step"
+        ))
+        .expect("reads");
+        let assembly = features::extract_all(&part.brep, &Default::default()).expect("features");
+        let t = &assembly.trees[0];
+        let params = LayerParams::default();
+        let none = below_resolution(t, &t.features[0], &params, &points, 0.24, 0.4);
+        assert!(matches!(none, Ok(None)));
+        // The same plate's contact (0.297 mm wide) is below the resolution of a nozzle whose
+        // narrowest bead is 0.4 mm (not of the delta5's, 0.24 mm), and nothing else is.
+        let narrow: Vec<_> = (0..20).map(|_| bead(0.15, 0.01)).collect();
+        let contact = t
+            .features
+            .iter()
+            .filter_map(|f| {
+                below_resolution(t, f, &params, &narrow, 0.4, 0.6)
+                    .ok()
+                    .flatten()
+            })
+            .collect::<Vec<_>>();
+        assert_eq!(contact.len(), 1, "{contact:?}");
+        let b = contact[0];
+        assert!((b.narrowest_mm - 0.2967).abs() < 0.01, "{b:?}");
+        assert!((b.nozzle_needed_mm - 0.6 * b.narrowest_mm / 0.4).abs() < 1e-12);
+        assert!(b.narrow_share > 0.9, "{b:?}");
+    }
+
+    #[test]
+    fn the_tolerance_grows_with_the_widening() {
+        assert_eq!(tolerance(0.0, 10.0), VOLUME_TOLERANCE);
+        assert!((tolerance(2.0, 10.0) - (VOLUME_TOLERANCE + 0.2)).abs() < 1e-12);
+        assert_eq!(tolerance(1.0, 0.0), VOLUME_TOLERANCE);
+    }
+}
