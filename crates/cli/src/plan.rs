@@ -213,8 +213,20 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         o if o.is_dir() => dir.display().to_string(),
         o => o.display().to_string(),
     };
+    // The pedestal, if the part stands on one (issue 31).
+    let pedestal = plan
+        .features()
+        .iter()
+        .find_map(|f| {
+            let h = f.pedestal_height_mm?;
+            Some(format!(
+                " on a pedestal of {h} mm ({} layers, feature {}),",
+                f.layers, f.feature.id
+            ))
+        })
+        .unwrap_or_default();
     emit(&format!(
-        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {} warning(s) -> {to}\n",
+        "{}: {} feature(s),{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {} warning(s) -> {to}\n",
         path.display(),
         plan.features().len(),
         plan.toolpath.points.len(),

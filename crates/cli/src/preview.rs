@@ -73,7 +73,16 @@ pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
                 ),
             ),
             ("warnings".into(), plan.warnings().len().to_string()),
-        ],
+        ]
+        .into_iter()
+        .chain(f.iter().find_map(|x| {
+            let h = x.pedestal_height_mm?;
+            Some((
+                "pedestal".into(),
+                format!("{h} mm, {} layers (feature {})", x.layers, x.feature.id),
+            ))
+        }))
+        .collect(),
     })
 }
 

@@ -12,6 +12,7 @@
 
 pub mod collisions;
 pub mod estimate;
+pub mod pedestal;
 pub mod process;
 pub mod report;
 
@@ -57,6 +58,10 @@ pub enum PlanError {
     /// [`Options::allow_collisions`] is off): one line per feature.
     #[error("the head collides in {} feature(s)", .0.len())]
     Collisions(Vec<String>),
+    /// The pedestal cannot lift the part clear of the table, or the one asked for cannot be
+    /// made.
+    #[error(transparent)]
+    Pedestal(#[from] pedestal::PedestalError),
     /// The part needs more bead than one plan holds ([`MAX_BEAD_KM`]), estimated before any
     /// layer is made: nothing planned.
     #[error("the part's features hold {volume_m3:.3} m^3: at these layer heights and bead spacings that is at least {bead_km:.0} km of bead, more than the {MAX_BEAD_KM} km one plan holds (is the file's length unit right?); nothing planned")]
@@ -359,6 +364,7 @@ pub fn plan_into(
                 orientation: None,
                 post: None,
                 collision: Default::default(),
+                pedestal_height_mm: None,
             });
             plans.push((id, plan));
             tell(Progress::FeatureDone);
@@ -401,7 +407,27 @@ pub fn plan_into(
     }
     // The head against what is built before each move and the table (issue 18).
     tell(Progress::Stage(STAGES[1]));
-    let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &reports, limits);
+    // The check, on the pedestal the process asks for (issue 31): the least that keeps the
+    // head off the table, printed first as feature `offset` (the next free id).
+    let ctx = pedestal::Context {
+        trees,
+        params: &process.params_for(&base, 0)?,
+        setting: base.pedestal,
+        bead,
+        machine,
+        id: offset,
+        allow_collisions: options.allow_collisions,
+    };
+    let avoid = |p: &mut ToolPath, axes: &[slicer::vec3::V3]| {
+        collisions::avoid(p, axes, machine, &reports, limits)
+    };
+    let checked = pedestal::stand(&ctx, toolpath, planned_axes, avoid)?;
+    let (toolpath, avoided) = (checked.path, checked.avoided);
+    warnings.extend(checked.warnings);
+    if let Some(p) = &checked.pedestal {
+        reports.insert(0, p.report(filament_area));
+        planned.insert(0, p.planned(filament_area, ctx.params.filling_ratio));
+    }
     let collided = collisions::entries(&avoided);
     let points = collisions::points(&toolpath);
     for r in &mut reports {
@@ -419,6 +445,7 @@ pub fn plan_into(
         format!("filament used [mm] = {:.2}", est.filament_mm),
         format!("filament used [g] = {:.2}", est.filament_g),
     ];
+    notes.extend(checked.pedestal.as_ref().map(pedestal::Stood::line));
     notes.extend(settings.lines());
     tell(Progress::Stage(STAGES[2]));
     let job = Job {

@@ -66,6 +66,52 @@ pub enum WallOrientation {
     Sst,
 }
 
+/// Whether the part stands on a printed pedestal (issue 31, the process key `pedestal`): a
+/// prism under its build-plate face that lifts it off the table where the head would meet the
+/// table. Written `"auto"`, `"off"` or a height in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pedestal {
+    /// The least whole number of layers that leaves no move of the head hitting the table,
+    /// none when nothing hits it (the default).
+    Auto,
+    /// Never a pedestal.
+    Off,
+    /// A pedestal of this height (mm; rounded up to whole layers), 0 for none.
+    Height(f64),
+}
+
+impl Serialize for Pedestal {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Pedestal::Auto => s.serialize_str("auto"),
+            Pedestal::Off => s.serialize_str("off"),
+            Pedestal::Height(h) => s.serialize_f64(*h),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Pedestal {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        /// A number or a word, as the file gives it.
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Given {
+            Height(f64),
+            Word(String),
+        }
+        match Given::deserialize(d)? {
+            Given::Height(h) => Ok(Pedestal::Height(h)),
+            Given::Word(w) => match w.as_str() {
+                "auto" => Ok(Pedestal::Auto),
+                "off" => Ok(Pedestal::Off),
+                _ => Err(serde::de::Error::custom(format!(
+                    "pedestal must be \"auto\", \"off\" or a height in mm, got \"{w}\""
+                ))),
+            },
+        }
+    }
+}
+
 /// Layer and path parameters of one feature.
 ///
 /// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
@@ -108,6 +154,11 @@ pub struct LayerParams {
     pub min_layer_height: f64,
     /// Thickest local thickness of a transition layer, mm. Default 0.3.
     pub max_layer_height: f64,
+    /// The part's pedestal ([`Pedestal`]); the part's, so set in `[defaults]` only. Default
+    /// `auto`.
+    pub pedestal: Pedestal,
+    /// How far the pedestal's outline lies inside the build-plate face's, mm (≥ 0). Default 0.
+    pub pedestal_inset: f64,
 }
 
 impl Default for LayerParams {
@@ -128,6 +179,8 @@ impl Default for LayerParams {
             wall_orientation: WallOrientation::Normal,
             min_layer_height: 0.1,
             max_layer_height: 0.3,
+            pedestal: Pedestal::Auto,
+            pedestal_inset: 0.0,
         }
     }
 }
@@ -259,6 +312,17 @@ impl LayerParams {
                 self.min_layer_height, self.max_layer_height
             ));
         }
+        if let Pedestal::Height(h) = self.pedestal {
+            if !(h.is_finite() && h >= 0.0) {
+                return Err(format!(
+                    "pedestal must be \"auto\", \"off\" or a height of 0 mm or more, got {h}"
+                ));
+            }
+        }
+        let inset = self.pedestal_inset;
+        if !(inset.is_finite() && inset >= 0.0) {
+            return Err(format!("pedestal_inset must be 0 mm or more, got {inset}"));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > 1e-9) {
@@ -318,6 +382,12 @@ impl LayerParams {
         if let Some(v) = p.max_layer_height {
             out.max_layer_height = v;
         }
+        if let Some(v) = p.pedestal {
+            out.pedestal = v;
+        }
+        if let Some(v) = p.pedestal_inset {
+            out.pedestal_inset = v;
+        }
         out
     }
 }
@@ -373,6 +443,12 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::max_layer_height`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_layer_height: Option<f64>,
+    /// Overrides [`LayerParams::pedestal`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pedestal: Option<Pedestal>,
+    /// Overrides [`LayerParams::pedestal_inset`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pedestal_inset: Option<f64>,
 }
 
 #[cfg(test)]
