@@ -302,7 +302,13 @@ impl Stood {
             thickness_max_mm: round(fig.thickness.2, 1e6),
             freeform: None,
             warnings: vec![],
-            orientation: None,
+            // Every axis the plate's normal: nothing turns, before or after smoothing.
+            orientation: Some(slicer::orient::OrientationFigures {
+                step_max_deg_before: 0.0,
+                step_max_deg_after: 0.0,
+                rate_max_deg_per_mm_before: 0.0,
+                rate_max_deg_per_mm_after: 0.0,
+            }),
             post: None,
             collision: Default::default(),
             pedestal_height_mm: Some(round(self.height, 1e6)),
