@@ -159,6 +159,54 @@ fn check(file: &str, features: u64) -> Vec<String> {
     why
 }
 
+/// A machine whose tallest pedestal is one layer short refuses the plan, naming a height that
+/// does clear the table (planned on it: no colliding move).
+fn refused_naming_the_height(file: &str) -> Vec<String> {
+    let part = families_dir().join(file);
+    let stem = file.trim_end_matches(".step");
+    let dir = Out(std::env::temp_dir().join(format!(
+        "features-pedestal-max-{}-{stem}",
+        std::process::id()
+    )));
+    let out = plan(&part, &dir.0, &[]);
+    let Some(p) = read_json(&dir.0.join("plan.json")).filter(|_| out.status.success()) else {
+        return vec!["no plan".into()];
+    };
+    let ped = p["features"][0].clone();
+    let (h, n) = (
+        ped["pedestal_height_mm"].as_f64().unwrap_or(0.0),
+        ped["layers"].as_u64().unwrap_or(0),
+    );
+    if n < 2 {
+        return vec![format!("a pedestal of {n} layers: none one layer shorter to refuse")];
+    }
+    let max = format!("machine.max_pedestal_height={}", h - h / n as f64);
+    let out = plan(&part, &dir.0, &["--set", &max]);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    let named = err
+        .split("a pedestal of ")
+        .nth(1)
+        .and_then(|t| t.split(" mm would").next())
+        .and_then(|t| t.parse::<f64>().ok());
+    let Some(named) = named.filter(|_| out.status.code() == Some(2)) else {
+        return vec![format!("{max}: exit {}, {err}", out.status)];
+    };
+    let mut why = vec![];
+    if named < h {
+        why.push(format!("{max} names {named} mm, under the least {h} mm"));
+    }
+    let set = format!("pedestal={named}");
+    let out = plan(&part, &dir.0, &["--set", &set]);
+    if !out.status.success() {
+        why.push(format!(
+            "{set} (named by {max}): exit {}: {}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    why
+}
+
 #[test]
 fn ledge_parts_stand_on_the_least_pedestal_that_clears_the_table() {
     let parts = ledge_parts();
@@ -183,4 +231,12 @@ fn ledge_parts_stand_on_the_least_pedestal_that_clears_the_table() {
             .collect()
     });
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_pedestal_taller_than_the_machine_allows_is_refused_naming_one_that_clears() {
+    let parts = ledge_parts();
+    let (file, _) = &parts[0];
+    let why = refused_naming_the_height(file);
+    assert!(why.is_empty(), "{file}: {}", why.join("\n"));
 }
