@@ -178,15 +178,17 @@ fn refused_naming_the_height(file: &str) -> Vec<String> {
         ped["layers"].as_u64().unwrap_or(0),
     );
     if n < 2 {
-        return vec![format!("a pedestal of {n} layers: none one layer shorter to refuse")];
+        return vec![format!(
+            "a pedestal of {n} layers: none one layer shorter to refuse"
+        )];
     }
     let max = format!("machine.max_pedestal_height={}", h - h / n as f64);
     let out = plan(&part, &dir.0, &["--set", &max]);
     let err = String::from_utf8_lossy(&out.stderr).to_string();
     let named = err
-        .split("a pedestal of ")
+        .split("; a pedestal of ")
         .nth(1)
-        .and_then(|t| t.split(" mm would").next())
+        .and_then(|t| t.split(" mm clears").next())
         .and_then(|t| t.parse::<f64>().ok());
     let Some(named) = named.filter(|_| out.status.code() == Some(2)) else {
         return vec![format!("{max}: exit {}, {err}", out.status)];

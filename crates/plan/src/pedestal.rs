@@ -39,6 +39,9 @@ pub const KIND: &str = "pedestal";
 /// pedestal: the table lies across +Z.
 const FACES_UP: f64 = 1.0 - 1e-6;
 
+/// Pedestals taller than the machine's tallest checked for the height a refusal names.
+const NAMED_TRIES: usize = 4;
+
 /// Heights (mm) within this of each other are one: a pedestal height a whole number of layers
 /// to within rounding.
 const HEIGHT_SLACK: f64 = 1e-9;
@@ -47,14 +50,25 @@ const HEIGHT_SLACK: f64 = 1e-9;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PedestalError {
     /// Even the machine's tallest pedestal leaves moves hitting the table.
-    #[error("the head meets the table on {moves} move(s) even on a pedestal of the machine's max_pedestal_height {max} mm; a pedestal of {needed} mm would lift the head's body clear of the table along those moves' tool axes (raise machine.max_pedestal_height to it)")]
+    #[error("the head meets the table on {moves} move(s) even on a pedestal of the machine's max_pedestal_height {max} mm; a pedestal of {needed} mm clears it (raise machine.max_pedestal_height to it)")]
     TooLow {
         /// The machine's `max_pedestal_height`, mm.
         max: f64,
         /// Moves still hitting the table on it.
         moves: usize,
-        /// The height (mm, whole layers) that lifts them clear.
+        /// A height (mm, whole layers) checked to lift them clear.
         needed: f64,
+    },
+    /// Even the machine's tallest pedestal leaves moves hitting the table, and so do the
+    /// taller ones tried.
+    #[error("the head meets the table on {moves} move(s) even on a pedestal of the machine's max_pedestal_height {max} mm, and still on pedestals up to {tried} mm (the tilts that clear the head give out): plan with --set pedestal=off --allow-collisions to see the moves in collisions.csv")]
+    NoneClears {
+        /// The machine's `max_pedestal_height`, mm.
+        max: f64,
+        /// Moves still hitting the table on it.
+        moves: usize,
+        /// The tallest pedestal tried, mm.
+        tried: f64,
     },
     /// `pedestal = <mm>` taller than the machine allows.
     #[error("pedestal = {given} mm is taller than the machine's max_pedestal_height {max} mm")]
@@ -484,14 +498,36 @@ pub fn stand(
             warnings: vec![],
         });
     }
-    // Not even the tallest: the height that would do, from how deep the head still reaches.
+    // Not even the tallest: the height that would do, from how deep the head still reaches,
+    // checked (the tilts found change with the height: a move cleared at one height may hit
+    // at the next), and raised again from where it still hits, a few times.
     let stood = build(&o, max);
     let (p, a) = check(&stood);
-    let needed = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer) as f64 * layer;
-    let e = PedestalError::TooLow {
-        max: max_height,
-        moves: table_hits(&a),
-        needed: round(needed, 1e3),
+    let moves = table_hits(&a);
+    let mut n = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
+    let mut cleared = false;
+    for _ in 0..NAMED_TRIES {
+        let s = build(&o, n);
+        let (q, b) = check(&s);
+        if table_hits(&b) == 0 {
+            cleared = true;
+            break;
+        }
+        n = layer_count(s.height + lift_needed(&b, &q, ctx.machine), layer).max(n + 1);
+    }
+    let height = round(n as f64 * layer, 1e3);
+    let e = if cleared {
+        PedestalError::TooLow {
+            max: max_height,
+            moves,
+            needed: height,
+        }
+    } else {
+        PedestalError::NoneClears {
+            max: max_height,
+            moves,
+            tried: height,
+        }
     };
     if !ctx.allow_collisions {
         return Err(e);
