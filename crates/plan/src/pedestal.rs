@@ -134,7 +134,7 @@ pub fn outline(
     }
     let regions = slicer::fill::shrink_regions(&regions, inset, params.tolerance);
     let area: f64 = regions.iter().map(region_area).sum();
-    if regions.is_empty() || !(area > 0.0) {
+    if regions.is_empty() || area.is_nan() || area <= 0.0 {
         return Err(NoPedestal::Empty(inset));
     }
     Ok(Outline {
