@@ -634,6 +634,24 @@ mod tests {
         assert_eq!(d["filling_ratio"].as_float(), Some(1.0));
         assert_eq!(d["perimeters"].as_integer(), Some(2));
         assert_eq!(d["raster_angle_deg"].as_float(), Some(45.0));
+        assert_eq!(d["pedestal"].as_str(), Some("auto"));
+        assert_eq!(d["pedestal_inset"].as_float(), Some(0.0));
+        // The tallest pedestal: the built-in 5-axis and robot profiles say it, a profile
+        // without it gets the default, and it fits under the bed's height.
+        for kind in [MachineKind::Delta5, MachineKind::Kuka] {
+            let m = MachineProfile::builtin(kind);
+            assert_eq!(m.max_pedestal_height, Some(DEFAULT_MAX_PEDESTAL_HEIGHT));
+            let over = MachineProfile {
+                max_pedestal_height: Some(m.bed_size[2] + 1.0),
+                ..m.clone()
+            };
+            assert!(over.validate().is_err());
+            let none = MachineProfile {
+                max_pedestal_height: None,
+                ..m
+            };
+            assert_eq!(none.max_pedestal_height(), DEFAULT_MAX_PEDESTAL_HEIGHT);
+        }
         // The example override is commented out, and valid once uncommented.
         assert!(!v.contains_key("features"));
         let uncommented: String = PROCESS_TOML

@@ -552,6 +552,30 @@ mod tests {
     }
 
     #[test]
+    fn the_pedestal_is_a_word_or_a_height() {
+        let read = |v: &str| toml::from_str::<LayerParamsPatch>(&format!("pedestal = {v}"));
+        assert_eq!(read("\"auto\"").unwrap().pedestal, Some(Pedestal::Auto));
+        assert_eq!(read("\"off\"").unwrap().pedestal, Some(Pedestal::Off));
+        assert_eq!(read("2.4").unwrap().pedestal, Some(Pedestal::Height(2.4)));
+        assert_eq!(read("3").unwrap().pedestal, Some(Pedestal::Height(3.0)));
+        assert!(read("\"tall\"").is_err());
+        let bad = LayerParams {
+            pedestal: Pedestal::Height(-1.0),
+            ..LayerParams::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("pedestal"));
+        let bad = LayerParams {
+            pedestal_inset: -0.5,
+            ..LayerParams::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("pedestal_inset"));
+        // Written back as read.
+        let p = LayerParams::default().patched(&read("2.4").unwrap());
+        let text = toml::to_string(&p).unwrap();
+        assert!(text.contains("pedestal = 2.4"), "{text}");
+    }
+
+    #[test]
     fn validate_names_the_key() {
         let bad = |f: fn(&mut LayerParams), key: &str| {
             let mut p = LayerParams::default();
