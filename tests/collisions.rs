@@ -63,6 +63,9 @@ fn plan(name: &str, machine: &str) -> Planned {
             "--allow-collisions",
             "--allow-unreachable",
             "--keep-going",
+            // The head against the table as the part is modelled: no pedestal under it.
+            "--set",
+            "pedestal=off",
             "-o",
         ])
         .arg(&dir)

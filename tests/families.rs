@@ -421,6 +421,12 @@ fn check_part(file: &str, run: usize) -> Vec<String> {
     if meshes.is_empty() {
         return [why, vec!["the part does not mesh".into()]].concat();
     }
+    // The pedestal the part may stand on (issue 31) lies under the part, not in it.
+    let pedestals: Vec<u64> = features
+        .iter()
+        .filter(|f| f["kind"] == "pedestal")
+        .filter_map(|f| f["id"].as_u64())
+        .collect();
     // Print points outside by more than half a bead width, per feature: count, worst, where.
     let mut outside: std::collections::BTreeMap<usize, (usize, f64, P)> = Default::default();
     let mut prints = 0usize;
@@ -436,6 +442,9 @@ fn check_part(file: &str, run: usize) -> Vec<String> {
         }
         let num = |k: usize| c[k].parse::<f64>().unwrap_or(f64::NAN);
         let feature: usize = c[0].parse().unwrap_or(usize::MAX);
+        if pedestals.contains(&(feature as u64)) {
+            continue;
+        }
         let t = num(10);
         // The middle of the bead: half its thickness back along the tool axis.
         let q = [

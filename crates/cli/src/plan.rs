@@ -322,8 +322,20 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
     };
     // Where it went: the folder, or the program file `-o` named.
     let to = outputs.shown();
+    // The pedestal, if the part stands on one (issue 31).
+    let pedestal = plan
+        .features()
+        .iter()
+        .find_map(|f| {
+            let h = f.pedestal_height_mm?;
+            Some(format!(
+                " on a pedestal of {h} mm ({} layers, feature {}),",
+                f.layers, f.feature.id
+            ))
+        })
+        .unwrap_or_default();
     format!(
-        "{}: {} feature(s), {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
+        "{}: {} feature(s),{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
         args.part.display(),
         plan.features().len(),
         plan.toolpath.points.len(),

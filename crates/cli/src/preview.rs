@@ -185,7 +185,16 @@ fn plan_preview<'a>(plan: &'a plan::Plan, title: &str) -> Preview<'a> {
                 ),
             ),
             ("warnings".into(), plan.warnings().len().to_string()),
-        ],
+        ]
+        .into_iter()
+        .chain(f.iter().find_map(|x| {
+            let h = x.pedestal_height_mm?;
+            Some((
+                "pedestal".into(),
+                format!("{h} mm, {} layers (feature {})", x.layers, x.feature.id),
+            ))
+        }))
+        .collect(),
         ..Preview::default()
     }
 }

@@ -71,8 +71,15 @@ impl Table {
         lowest(shape, a[2].min(b[2]), axis) >= self.surface() - tol + 1e-5
     }
 
-    /// The table surface's height, mm.
-    fn surface(&self) -> f64 {
+    /// How far (mm) the head with its tip at `tip` and unit tool axis `axis` reaches below the
+    /// table's surface (the plane's; 0 when it does not): the lift along +Z that brings its
+    /// lowest point up onto the surface.
+    pub fn depth_below(&self, shape: &HeadShape, tip: V3, axis: V3) -> f64 {
+        (self.surface() - lowest(shape, tip[2], axis)).max(0.0)
+    }
+
+    /// The table's surface's height, mm.
+    pub fn surface(&self) -> f64 {
         match *self {
             Table::Plane { z } | Table::Disc { z, .. } => z,
         }

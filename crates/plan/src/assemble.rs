@@ -59,9 +59,18 @@ impl Stages {
             checked,
         } = self;
         let program = posted.map(|p| p.program);
-        let reports = features
+        let filament_area = machine.bead().filament_area();
+        // The pedestal first (printed first), then the part's features in build order.
+        let reports = checked
+            .pedestal
+            .as_ref()
+            .map(|p| pedestal_report(p.report(filament_area), &checked, program))
             .into_iter()
-            .map(|f| feature_report(f, &checked, program))
+            .chain(
+                features
+                    .into_iter()
+                    .map(|f| feature_report(f, &checked, program)),
+            )
             .collect();
         // The part's warnings: the lay stage's, extraction's, the post's, then what the
         // gates let pass.
@@ -73,6 +82,7 @@ impl Stages {
                 .into_iter()
                 .map(|w| Warning::part(WarningKind::Extraction(w))),
         );
+        all.extend(checked.part_warnings.iter().cloned());
         if let Some(p) = program {
             all.extend(
                 p.warnings
@@ -109,6 +119,27 @@ impl Stages {
             assembly: extracted.assembly,
             collisions: checked.avoided,
         }
+    }
+}
+
+/// The pedestal's report, with what the head check and the post found of it.
+fn pedestal_report(
+    mut r: FeatureReport,
+    checked: &Checked,
+    program: Option<&Program>,
+) -> FeatureReport {
+    let id = r.feature.id;
+    r.points = checked.points.get(&id).copied().unwrap_or(0);
+    r.collision = checked.collisions.get(&id).cloned().unwrap_or_default();
+    r.post = program.and_then(|p| p.figures.get(&id)).map(post_entry);
+    r
+}
+
+/// What the post measured of one feature, as reported.
+fn post_entry(k: &PostFigures) -> PostEntry {
+    match k {
+        PostFigures::Delta5(k) => PostEntry::delta5(k),
+        PostFigures::Kuka(k) => PostEntry::kuka(k),
     }
 }
 
@@ -158,10 +189,8 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
             rate_max_deg_per_mm_before: round(o.rate_max_deg_per_mm_before, 1e6),
             rate_max_deg_per_mm_after: round(o.rate_max_deg_per_mm_after, 1e6),
         }),
-        post: program.and_then(|p| p.figures.get(&id)).map(|k| match k {
-            PostFigures::Delta5(k) => PostEntry::delta5(k),
-            PostFigures::Kuka(k) => PostEntry::kuka(k),
-        }),
+        post: program.and_then(|p| p.figures.get(&id)).map(post_entry),
         collision: checked.collisions.get(&id).cloned().unwrap_or_default(),
+        pedestal_height_mm: None,
     }
 }

@@ -22,6 +22,10 @@ pub enum PlanError {
     /// The post could not write the program.
     #[error(transparent)]
     Post(#[from] robot_post::PostError),
+    /// The pedestal cannot lift the part clear of the table, or the one asked for cannot be
+    /// made.
+    #[error(transparent)]
+    Pedestal(#[from] crate::pedestal::PedestalError),
     /// `toolpath.csv` could not be written ([`crate::plan_into`]'s `csv`).
     #[error("cannot write toolpath.csv: {0}")]
     Csv(#[source] std::io::Error),

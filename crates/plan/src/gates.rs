@@ -25,7 +25,13 @@ pub fn before_post(
     checked: &Checked,
     options: &Options,
 ) -> Result<Passed, Gate> {
-    let planned: Vec<_> = features.iter().map(|f| f.planned.clone()).collect();
+    // The pedestal's first (printed first), then the part's features.
+    let planned: Vec<_> = checked
+        .pedestal_planned
+        .iter()
+        .cloned()
+        .chain(features.iter().map(|f| f.planned.clone()))
+        .collect();
     let problems = check_plan(&planned);
     let mut passed = Passed {
         complete: problems.is_empty(),

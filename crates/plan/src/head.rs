@@ -1,11 +1,16 @@
 //! The head-check stage (issue 18): the machine's print head swept along every move against
 //! what was built before it and the table, colliding moves tilted and travels lifted
-//! ([`crate::collisions::avoid`]), and what is left counted per feature.
+//! ([`crate::collisions::avoid`]), on the printed pedestal that keeps it off the table where
+//! one is needed ([`crate::pedestal::stand`], issue 31), and what is left counted per feature.
 
 use crate::collisions::{self, Avoided};
+use crate::extract::Extracted;
 use crate::lay::LaidFeature;
+use crate::pedestal::{self, Stood};
 use crate::report::CollisionEntry;
 use crate::smooth::Smoothed;
+use crate::warning::{Warning, WarningKind};
+use crate::{Options, PlanError, Process};
 use robot_post::machine::MachineProfile;
 use slicer::orient::OrientationFigures;
 use slicer::toolpath::ToolPath;
@@ -14,7 +19,8 @@ use std::collections::BTreeMap;
 /// What the head-check stage returns.
 #[derive(Debug)]
 pub struct Checked {
-    /// The tool path after avoidance (tilted axes, lifted travels, siblings interleaved).
+    /// The tool path after avoidance (tilted axes, lifted travels, siblings interleaved), the
+    /// pedestal's points first when there is one.
     pub toolpath: ToolPath,
     /// The colliding moves left and the moves tilt cleared.
     pub avoided: Avoided,
@@ -22,34 +28,72 @@ pub struct Checked {
     pub collisions: BTreeMap<usize, CollisionEntry>,
     /// Per feature id, its points in the tool path (lifted travels add some).
     pub points: BTreeMap<usize, usize>,
+    /// The pedestal the part stands on, if any.
+    pub pedestal: Option<Stood>,
+    /// What the self-check asks of the pedestal (its prism's volume × the base feature's
+    /// fill).
+    pub pedestal_planned: Option<slicer::verify::PlannedFeature>,
     /// Smoothing's figures, carried on.
     pub orientation: BTreeMap<usize, OrientationFigures>,
     /// Smoothing's warnings, carried on.
-    pub warnings: Vec<crate::Warning>,
+    pub warnings: Vec<Warning>,
+    /// The pedestal's warnings of the part (none where one was wanted).
+    pub part_warnings: Vec<Warning>,
 }
 
 /// Checks the head along `smoothed`'s tool path on `machine`, avoiding what it can; sibling
-/// features (the same parents, from `features`) may be interleaved layer by layer.
+/// features (the same parents, from `features`) may be interleaved layer by layer; the part
+/// stands on the pedestal the process asks for (`auto`: the least that keeps the head off the
+/// table, printed first as the next free feature id).
 pub fn head_check(
     smoothed: Smoothed,
+    extracted: &Extracted,
+    process: &Process,
     machine: &MachineProfile,
     features: &[LaidFeature],
-) -> Checked {
+    options: &Options,
+) -> Result<Checked, PlanError> {
     let Smoothed {
-        mut toolpath,
+        toolpath,
         planned_axes,
         limits,
         orientation,
         warnings,
     } = smoothed;
     let entries: Vec<_> = features.iter().map(|f| f.entry.clone()).collect();
-    let avoided = collisions::avoid(&mut toolpath, &planned_axes, machine, &entries, limits);
-    Checked {
-        collisions: collisions::entries(&avoided),
-        points: collisions::points(&toolpath),
-        toolpath,
-        avoided,
+    let base = process.base();
+    let params = process.params_for(&base, 0)?;
+    let trees = &extracted.assembly.trees;
+    let ctx = pedestal::Context {
+        trees,
+        params: &params,
+        setting: base.pedestal,
+        bead: machine.bead(),
+        machine,
+        id: trees.iter().map(|t| t.features.len()).sum(),
+        allow_collisions: options.allow_collisions,
+    };
+    let avoid = |p: &mut ToolPath, axes: &[slicer::vec3::V3]| {
+        collisions::avoid(p, axes, machine, &entries, limits)
+    };
+    let stood = pedestal::stand(&ctx, toolpath, planned_axes, avoid)?;
+    let pedestal_planned = stood
+        .pedestal
+        .as_ref()
+        .map(|p| p.planned(machine.bead().filament_area(), params.filling_ratio));
+    Ok(Checked {
+        pedestal_planned,
+        collisions: collisions::entries(&stood.avoided),
+        points: collisions::points(&stood.path),
+        toolpath: stood.path,
+        avoided: stood.avoided,
+        pedestal: stood.pedestal,
         orientation,
         warnings,
-    }
+        part_warnings: stood
+            .warnings
+            .into_iter()
+            .map(|w| Warning::part(WarningKind::Planner(w)))
+            .collect(),
+    })
 }

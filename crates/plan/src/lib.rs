@@ -24,6 +24,7 @@ pub mod extract;
 pub mod gates;
 pub mod head;
 pub mod lay;
+pub mod pedestal;
 pub mod place;
 pub mod post;
 pub mod process;
@@ -209,7 +210,14 @@ fn run(
     tell(Progress::Stage(Stage::Smooth));
     let smoothed = smooth::smooth(laid.toolpath, process, machine);
     tell(Progress::Stage(Stage::HeadCheck));
-    let checked = head::head_check(smoothed, machine, &laid.features);
+    let checked = head::head_check(
+        smoothed,
+        &extracted,
+        process,
+        machine,
+        &laid.features,
+        options,
+    )?;
     let stages = assemble::Stages {
         extracted,
         placement,
@@ -227,7 +235,7 @@ fn run(
     let machine = moved.as_ref().map_or(machine, |m| &m.machine);
     let settings = settings::entry(process, machine, &process.base());
     let est = estimate::estimate(&stages.checked.toolpath, machine);
-    let notes = post::notes(&est, &settings);
+    let notes = post::notes(&est, &stages.checked, &settings);
     let program = match post::post(
         &stages.checked.toolpath,
         machine,
@@ -266,7 +274,7 @@ fn refuse(
 ) -> PlanError {
     let settings = settings::entry(process, machine, &process.base());
     let est = estimate::estimate(&stages.checked.toolpath, machine);
-    let notes = post::notes(&est, &settings);
+    let notes = post::notes(&est, &stages.checked, &settings);
     let gate = match post::post(
         &stages.checked.toolpath,
         machine,

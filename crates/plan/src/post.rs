@@ -3,14 +3,16 @@
 //! caller's sink, with `toolpath.csv` beside it on another thread.
 
 use crate::estimate::{self, Estimate};
+use crate::head::Checked;
 use crate::report::SettingsEntry;
 use crate::{Options, PlanError};
 use robot_post::machine::MachineProfile;
 use robot_post::{Job, Program, ProgramSink};
 use slicer::toolpath::ToolPath;
 
-/// The header notes of a program: the estimate, then every setting.
-pub fn notes(est: &Estimate, settings: &SettingsEntry) -> Vec<String> {
+/// The header notes of a program: the estimate, the pedestal (when the part stands on one),
+/// then every setting.
+pub fn notes(est: &Estimate, checked: &Checked, settings: &SettingsEntry) -> Vec<String> {
     let mut notes = vec![
         format!(
             "estimated printing time (normal mode) = {}",
@@ -19,6 +21,7 @@ pub fn notes(est: &Estimate, settings: &SettingsEntry) -> Vec<String> {
         format!("filament used [mm] = {:.2}", est.filament_mm),
         format!("filament used [g] = {:.2}", est.filament_g),
     ];
+    notes.extend(checked.pedestal.as_ref().map(crate::pedestal::Stood::line));
     notes.extend(settings.lines());
     notes
 }

@@ -78,6 +78,18 @@ impl Process {
                     process.at("features", id, "")
                 )));
             }
+            let patch = &process.features[id];
+            for (key, set) in [
+                ("pedestal", patch.pedestal.is_some()),
+                ("pedestal_inset", patch.pedestal_inset.is_some()),
+            ] {
+                if set {
+                    return Err(ProcessError(format!(
+                        "process file{}: [features.{id}] {key}: the pedestal is the part's, not a feature's: set it in [defaults]",
+                        process.at("features", id, key)
+                    )));
+                }
+            }
         }
         Ok(process)
     }

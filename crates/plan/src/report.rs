@@ -31,7 +31,7 @@ pub struct ReferenceEntry {
 pub struct FeatureEntry {
     /// File-wide id.
     pub id: usize,
-    /// `two5d` or `freeform`.
+    /// `two5d`, `freeform`, or `pedestal` (the prism under the part, [`crate::pedestal`]).
     pub kind: String,
     /// What it looks like (`stretch`, `brep_freeform`, ...).
     pub subtype: String,
@@ -180,6 +180,9 @@ pub struct FeatureReport {
     /// Moves of the head into material or the table left after avoidance.
     #[serde(flatten)]
     pub collision: CollisionEntry,
+    /// The pedestal's height, mm (the `pedestal` feature only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pedestal_height_mm: Option<f64>,
 }
 
 /// A feature's colliding moves (issue 18): the moves, print or travel, whose swept head meets

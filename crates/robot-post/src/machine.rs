@@ -106,6 +106,11 @@ pub struct MachineProfile {
     /// without the table gets too.
     #[serde(default)]
     pub head: collide::Head,
+    /// Tallest pedestal (mm) a plan may print under the part to lift it off the table where
+    /// the head meets it (issue 31, the process key `pedestal`). Optional:
+    /// [`DEFAULT_MAX_PEDESTAL_HEIGHT`] when left out ([`MachineProfile::max_pedestal_height`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_pedestal_height: Option<f64>,
     /// The bed's kinematics (`[delta5]` table); required when `kind = "delta5"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delta5: Option<crate::delta5::geometry::Delta5Geometry>,
@@ -117,6 +122,9 @@ pub struct MachineProfile {
 /// The jerk (mm/s) of a profile that gives an acceleration but no `max_jerk`: Marlin's
 /// classic default for X and Y.
 pub const DEFAULT_JERK: f64 = 10.0;
+
+/// The tallest pedestal (mm) of a profile that does not say (`max_pedestal_height`).
+pub const DEFAULT_MAX_PEDESTAL_HEIGHT: f64 = 40.0;
 
 /// The narrowest bead a nozzle lays well, as a share of its diameter, when a profile does
 /// not say (`min_bead_width`).
@@ -220,6 +228,17 @@ impl MachineProfile {
                     format!(
                         "must be positive and at most bead_width {}, got {w}",
                         self.bead_width
+                    ),
+                ));
+            }
+        }
+        if let Some(h) = self.max_pedestal_height {
+            if !(h.is_finite() && (0.0..=self.bed_size[2]).contains(&h)) {
+                return Err(bad(
+                    "max_pedestal_height",
+                    format!(
+                        "must be 0 mm or more and at most the bed's height {}, got {h}",
+                        self.bed_size[2]
                     ),
                 ));
             }
@@ -362,6 +381,13 @@ impl MachineProfile {
     /// Eq. 1). For planners; the posts only write the `e` the planner computed.
     pub fn filament_length(&self, w: f64, dl: f64, len: f64) -> f64 {
         self.bead().filament_length(w, dl, len)
+    }
+
+    /// The tallest pedestal a plan may print under the part (mm): `max_pedestal_height`, or
+    /// [`DEFAULT_MAX_PEDESTAL_HEIGHT`].
+    pub fn max_pedestal_height(&self) -> f64 {
+        self.max_pedestal_height
+            .unwrap_or(DEFAULT_MAX_PEDESTAL_HEIGHT)
     }
 
     /// The narrowest bead the nozzle lays well: `min_bead_width`, or 0.6 × the nozzle.
@@ -608,6 +634,24 @@ mod tests {
         assert_eq!(d["filling_ratio"].as_float(), Some(1.0));
         assert_eq!(d["perimeters"].as_integer(), Some(2));
         assert_eq!(d["raster_angle_deg"].as_float(), Some(45.0));
+        assert_eq!(d["pedestal"].as_str(), Some("auto"));
+        assert_eq!(d["pedestal_inset"].as_float(), Some(0.0));
+        // The tallest pedestal: the built-in 5-axis and robot profiles say it, a profile
+        // without it gets the default, and it fits under the bed's height.
+        for kind in [MachineKind::Delta5, MachineKind::Kuka] {
+            let m = MachineProfile::builtin(kind);
+            assert_eq!(m.max_pedestal_height, Some(DEFAULT_MAX_PEDESTAL_HEIGHT));
+            let over = MachineProfile {
+                max_pedestal_height: Some(m.bed_size[2] + 1.0),
+                ..m.clone()
+            };
+            assert!(over.validate().is_err());
+            let none = MachineProfile {
+                max_pedestal_height: None,
+                ..m
+            };
+            assert_eq!(none.max_pedestal_height(), DEFAULT_MAX_PEDESTAL_HEIGHT);
+        }
         // The example override is commented out, and valid once uncommented.
         assert!(!v.contains_key("features"));
         let uncommented: String = PROCESS_TOML

@@ -40,6 +40,11 @@ pub(crate) fn area2(pts: &[Point2]) -> f64 {
     s
 }
 
+/// Area of a region (its outer boundary's less its holes'), mm².
+pub fn region_area(r: &Region) -> f64 {
+    0.5 * (area2(&r.outer).abs() - r.holes.iter().map(|h| area2(h).abs()).sum::<f64>())
+}
+
 pub(crate) fn perimeter(pts: &[Point2]) -> f64 {
     let n = pts.len();
     (0..n).map(|i| dist(pts[i], pts[(i + 1) % n])).sum()

@@ -73,6 +73,52 @@ pub enum WallOrientation {
     Sst,
 }
 
+/// Whether the part stands on a printed pedestal (issue 31, the process key `pedestal`): a
+/// prism under its build-plate face that lifts it off the table where the head would meet the
+/// table. Written `"auto"`, `"off"` or a height in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pedestal {
+    /// The least whole number of layers that leaves no move of the head hitting the table,
+    /// none when nothing hits it (the default).
+    Auto,
+    /// Never a pedestal.
+    Off,
+    /// A pedestal of this height (mm; rounded up to whole layers), 0 for none.
+    Height(f64),
+}
+
+impl Serialize for Pedestal {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Pedestal::Auto => s.serialize_str("auto"),
+            Pedestal::Off => s.serialize_str("off"),
+            Pedestal::Height(h) => s.serialize_f64(*h),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Pedestal {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        /// A number or a word, as the file gives it.
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Given {
+            Height(f64),
+            Word(String),
+        }
+        match Given::deserialize(d)? {
+            Given::Height(h) => Ok(Pedestal::Height(h)),
+            Given::Word(w) => match w.as_str() {
+                "auto" => Ok(Pedestal::Auto),
+                "off" => Ok(Pedestal::Off),
+                _ => Err(serde::de::Error::custom(format!(
+                    "pedestal must be \"auto\", \"off\" or a height in mm, got \"{w}\""
+                ))),
+            },
+        }
+    }
+}
+
 /// Layer and path parameters of one feature.
 ///
 /// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
@@ -119,6 +165,11 @@ pub struct LayerParams {
     /// `h·tan(overhang_angle_deg)` of the layer below it (h the layer's thickness), or on
     /// material laid before, or on the plate ([`crate::support`]). Default 50.
     pub overhang_angle_deg: f64,
+    /// The part's pedestal ([`Pedestal`]); the part's, so set in `[defaults]` only. Default
+    /// `auto`.
+    pub pedestal: Pedestal,
+    /// How far the pedestal's outline lies inside the build-plate face's, mm (≥ 0). Default 0.
+    pub pedestal_inset: f64,
 }
 
 impl Default for LayerParams {
@@ -140,6 +191,8 @@ impl Default for LayerParams {
             min_layer_height: 0.1,
             max_layer_height: 0.3,
             overhang_angle_deg: DEFAULT_OVERHANG_ANGLE_DEG,
+            pedestal: Pedestal::Auto,
+            pedestal_inset: 0.0,
         }
     }
 }
@@ -277,6 +330,17 @@ impl LayerParams {
                 "overhang_angle_deg must be more than 0 and less than {MAX_OVERHANG_ANGLE_DEG} degrees, got {a}"
             ));
         }
+        if let Pedestal::Height(h) = self.pedestal {
+            if !(h.is_finite() && h >= 0.0) {
+                return Err(format!(
+                    "pedestal must be \"auto\", \"off\" or a height of 0 mm or more, got {h}"
+                ));
+            }
+        }
+        let inset = self.pedestal_inset;
+        if !(inset.is_finite() && inset >= 0.0) {
+            return Err(format!("pedestal_inset must be 0 mm or more, got {inset}"));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > 1e-9) {
@@ -339,6 +403,12 @@ impl LayerParams {
         if let Some(v) = p.overhang_angle_deg {
             out.overhang_angle_deg = v;
         }
+        if let Some(v) = p.pedestal {
+            out.pedestal = v;
+        }
+        if let Some(v) = p.pedestal_inset {
+            out.pedestal_inset = v;
+        }
         out
     }
 }
@@ -397,6 +467,12 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::overhang_angle_deg`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub overhang_angle_deg: Option<f64>,
+    /// Overrides [`LayerParams::pedestal`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pedestal: Option<Pedestal>,
+    /// Overrides [`LayerParams::pedestal_inset`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pedestal_inset: Option<f64>,
 }
 
 #[cfg(test)]
@@ -497,6 +573,30 @@ mod tests {
             ..LayerParams::default()
         };
         assert!(p.layer_heights(1000.0).is_empty());
+    }
+
+    #[test]
+    fn the_pedestal_is_a_word_or_a_height() {
+        let read = |v: &str| toml::from_str::<LayerParamsPatch>(&format!("pedestal = {v}"));
+        assert_eq!(read("\"auto\"").unwrap().pedestal, Some(Pedestal::Auto));
+        assert_eq!(read("\"off\"").unwrap().pedestal, Some(Pedestal::Off));
+        assert_eq!(read("2.4").unwrap().pedestal, Some(Pedestal::Height(2.4)));
+        assert_eq!(read("3").unwrap().pedestal, Some(Pedestal::Height(3.0)));
+        assert!(read("\"tall\"").is_err());
+        let bad = LayerParams {
+            pedestal: Pedestal::Height(-1.0),
+            ..LayerParams::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("pedestal"));
+        let bad = LayerParams {
+            pedestal_inset: -0.5,
+            ..LayerParams::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("pedestal_inset"));
+        // Written back as read.
+        let p = LayerParams::default().patched(&read("2.4").unwrap());
+        let text = toml::to_string(&p).unwrap();
+        assert!(text.contains("pedestal = 2.4"), "{text}");
     }
 
     #[test]

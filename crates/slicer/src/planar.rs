@@ -221,6 +221,62 @@ pub fn fill_two5d(
     })
 }
 
+/// The outline of a tree's build-plate face: the section of its base feature `f` (a two5d
+/// feature) in the middle of its first layer, what that layer fills, as regions in the 2-D
+/// frame of `f`'s reference plane, with that plane. Empty regions when the section is empty.
+pub fn plate_regions(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+) -> Result<(Plane, Vec<Region>), PlanError> {
+    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+    let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
+    let top = mesh
+        .positions
+        .iter()
+        .map(|p| plane.height(p))
+        .fold(0.0f64, f64::max);
+    let Some(&first) = params.layer_heights(top).first() else {
+        return Ok((plane, vec![]));
+    };
+    let cut = plane.offset(0.5 * first);
+    let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
+        .iter()
+        .map(|l| l.iter().map(|p| plane.to_2d(p)).collect())
+        .collect();
+    Ok((plane, regions_from_loops(&loops)))
+}
+
+/// A prism's layers filled like a two5d feature's (feature `id`): `layers` layers `height` mm
+/// thick on `plane`, each the section `regions` (in `plane`'s 2-D frame), filled by `params`
+/// with solid skins at the bottom and the top; [`Two5dFill::lay`] lays them.
+pub fn fill_prism(
+    id: usize,
+    plane: Plane,
+    regions: &[Region],
+    layers: usize,
+    height: f64,
+    params: &LayerParams,
+    bead: Bead,
+) -> Two5dFill {
+    let spacing = params.spacing(bead.width);
+    let tops = (0..layers)
+        .map(|k| {
+            let z = k as f64 * height;
+            (z + 0.5 * height, z + height, height)
+        })
+        .collect();
+    let filled = fill_sections(vec![regions.to_vec(); layers], params, bead.width, spacing);
+    Two5dFill {
+        id,
+        plane,
+        bead,
+        tops,
+        filled,
+        fig: FeatureFigures::default(),
+    }
+}
+
 /// Each layer's paths from its section's regions, filled in parallel. A layer whose section is
 /// the same polygon as an earlier layer's ([`SectionKey`]) of the same parity where the fill
 /// alternates ([`alternates`]: the zig-zag's angle turns every other layer, and nothing else of

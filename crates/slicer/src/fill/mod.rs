@@ -102,6 +102,19 @@ fn shapes_area(s: &Shapes) -> f64 {
     s.iter().flatten().map(|c| 0.5 * area2(c)).sum()
 }
 
+/// `regions` shrunk by `d` mm (≥ 0) inward, corners rounded within `tol` mm: what is left of
+/// each, as regions (a region thinner than `2·d` is gone). `d = 0` gives the regions as they are.
+pub fn shrink_regions(regions: &[Region], d: f64, tol: f64) -> Vec<Region> {
+    if d <= 0.0 {
+        return regions.to_vec();
+    }
+    let shapes: Shapes = regions.iter().flat_map(region_shapes).collect();
+    erode(&shapes, d, &round_join(tol, d))
+        .into_iter()
+        .filter_map(shape_region)
+        .collect()
+}
+
 /// What one fill call needs to know.
 #[derive(Debug, Clone)]
 struct Ctx {
