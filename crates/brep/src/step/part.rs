@@ -1,6 +1,7 @@
 //! Reading a STEP file into a B-rep: the parser and the translator in turn.
 
 use super::error::ReadError;
+use crate::tolerance::PARALLEL;
 use crate::topology::Brep;
 use std::path::Path;
 
@@ -55,7 +56,7 @@ pub fn turn_down(n: [f64; 3]) -> [[f64; 3]; 3] {
     let (kx, ky) = (-n[1], n[0]);
     let s = (kx * kx + ky * ky).sqrt();
     let c = -n[2];
-    if s < 1e-12 {
+    if s < PARALLEL {
         return if c > 0.0 {
             [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         } else {
