@@ -103,7 +103,9 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
     out
 }
 use brep::math::{P3, V3};
+use brep::mesh::Mesh;
 use brep::section::{section, Plane};
+use brep::surface::Surface;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
@@ -188,7 +190,7 @@ pub fn fill_freeform<'a>(
         .ok_or_else(|| err("it has no reference face".into()))?;
     let surf = b.face_surface(rf);
     // N into the feature: the host face's outward normal (the parent's outside).
-    let mut sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
+    let sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
     let tol = slicing_tolerance(params);
     let mesh = feature_mesh(tree, f, tol)?;
     if mesh.positions.is_empty() {
@@ -204,43 +206,12 @@ pub fn fill_freeform<'a>(
     // valley by levels that are translates of its reference along one direction, which cannot
     // fold (issue 17, item 5: crate::chart::translate_chart); transition layers then morph
     // them into its top.
-    let translate = match fold_check(surf, sign, &mesh, tol, params, id) {
-        Ok(()) => None,
-        Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
-        Err(e) => Some(translate_chart(surf, sign, &mesh, tol).ok_or(e)?),
-    };
-    let mut chart = match translate {
-        Some(c) => c,
-        None => choose_chart(surf, sign, id, &mesh)?,
-    };
-    let mut mapped = mapped_mesh(&chart, &mesh, id)?;
-    // The feature lies on the side N points to: check, and turn N round if the face said
-    // otherwise (a translate chart has checked it).
-    let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
-    if mean_d < 0.0 && translate.is_none() {
-        sign = -sign;
-        chart = choose_chart(surf, sign, id, &mesh)?;
-        mapped = mapped_mesh(&chart, &mesh, id)?;
-    }
+    let (chart, mapped, translated) = feature_chart(surf, sign, &mesh, tol, params, id)?;
     let top = mapped.positions.iter().map(|p| p.z).fold(0.0f64, f64::max);
     let mut heights = params.layer_heights(top);
     // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature
     // (none for translates).
-    let stride = (mapped.positions.len() / 300).max(1);
-    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
-    let mut lambda = 0.0f64;
-    if translate.is_none() {
-        for p in mapped.positions.iter().step_by(stride) {
-            if let Some(l) = chart.min_curvature([p.x, p.y], step) {
-                lambda = lambda.min(l);
-            }
-        }
-    }
-    let concave_radius = if lambda < -FLAT_CURVATURE {
-        -1.0 / lambda
-    } else {
-        f64::INFINITY
-    };
+    let concave_radius = concave_radius(&chart, &mapped, params, !translated);
     let spacing = params.spacing(bead.width);
     let mut fig = FeatureFigures {
         below_plate: below,
@@ -265,44 +236,14 @@ pub fn fill_freeform<'a>(
         vec![]
     };
     // Offset or transition layers (issue 17): see crate::transition.
-    let blend = match params.layer_strategy {
-        LayerStrategy::Offset => None,
-        strategy => {
-            let forced = strategy == LayerStrategy::Transition;
-            match build_top_field(&chart, b, &raw, &tops, &mapped, id)? {
-                None if forced => {
-                    return Err(err(
-                        "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
-                    ))
-                }
-                None => None,
-                Some(field) => match levels(field.range, params) {
-                    Levels::Offset => None,
-                    Levels::Transition(n) => Some((field, n, 0)),
-                    Levels::Infeasible(lo, hi) => {
-                        let (a, _, b) = field.range;
-                        // Offset layers first, a band of transition layers for the rest.
-                        match band(field, params, bead.width) {
-                            Some(banded) => Some(banded),
-                            None => {
-                                let why = format!(
-                                    "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}, and no band of transition layers over offset layers keeps those bounds either",
-                                    params.max_layer_height, params.min_layer_height
-                                );
-                                if forced {
-                                    return Err(err(why));
-                                }
-                                fig.warnings.push(format!(
-                                    "feature {id}: offset layers, not transition layers: {why}"
-                                ));
-                                None
-                            }
-                        }
-                    }
-                },
-            }
-        }
-    };
+    let blend = choose_blend(
+        (&chart, b, &raw),
+        (&tops, &mapped),
+        params,
+        bead.width,
+        id,
+        &mut fig.warnings,
+    )?;
     // Offset layers first (all of them without transition layers), then the transition layers.
     let offset_layers = match &blend {
         Some((field, n, k)) => {
@@ -319,7 +260,6 @@ pub fn fill_freeform<'a>(
     };
     let ff = ff;
     let sides = sst.then(|| Sides::new(&raw, &f.heal_faces, &tops, 1.0));
-    let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
     check_folds(id, &heights, concave_radius)?;
@@ -328,16 +268,7 @@ pub fn fill_freeform<'a>(
         .map(|a| V3::new(a[0], a[1], a[2]).normalize());
     // Each layer's regions and fill depend on that layer alone: computed in parallel, then
     // ordered, lifted and joined by travel one layer after the other.
-    let mut tops = Vec::with_capacity(heights.len());
-    for &dl in &heights[..offset_layers] {
-        tops.push((z + 0.5 * dl, z + dl));
-        z += dl;
-    }
-    if let Some((_, n, _)) = &blend {
-        for k in 0..*n {
-            tops.push(((k as f64 + 0.5) / *n as f64, (k + 1) as f64 / *n as f64));
-        }
-    }
+    let tops = layer_tops(&heights[..offset_layers], blend.as_ref().map(|b| b.1));
     // Transition layers are sliced at morph levels: each vertex's place between where they
     // start and the top over it.
     let blended = blend.as_ref().map(|(field, _, _)| {
@@ -359,37 +290,8 @@ pub fn fill_freeform<'a>(
                 Some((_, _, field)) => (&chart, &mapped, Some((*field, z))),
                 None => (&chart, &mapped, None),
             };
-            let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
-                .iter()
-                .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
-                .collect();
-            let regions = regions_from_loops(&loops);
-            let spacing = params
-                .spacing_for_layer(bead.width, layer)
-                .max(MICROMETRE)
-                .min(spacing.max(MICROMETRE) * 1e3);
-            let mut paths = vec![];
-            let layers = heights.len();
-            for r in &regions {
-                paths.extend(fill_region(
-                    chart,
-                    r,
-                    z,
-                    params,
-                    layer,
-                    bead.width,
-                    spacing,
-                    SLIVER_INSET * bead.width,
-                ));
-                paths.extend(corner_spurs(chart, r, z, bead.width));
-            }
-            if let Some((field, z)) = clip {
-                paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
-            }
-            (
-                regions,
-                crate::region_fill::solid_on_skins(paths, layer, layers),
-            )
+            let at = (layer, heights.len(), mid, z);
+            fill_layer(chart, mapped, clip, &up, at, params, bead.width, spacing)
         })
         .collect();
     drop(blended);
@@ -408,6 +310,175 @@ pub fn fill_freeform<'a>(
         fig,
         ff,
     })
+}
+
+/// The feature's chart and its mesh mapped into it, and whether the chart is a translate:
+/// offsets of the reference where they do not fold (or offset layers are asked for), else
+/// translates of it; N turned round where the feature lies on the other side.
+fn feature_chart<'a>(
+    surf: &'a Surface,
+    mut sign: f64,
+    mesh: &Mesh,
+    tol: f64,
+    params: &LayerParams,
+    id: usize,
+) -> Result<(Chart<'a>, Mesh, bool), PlanError> {
+    let translate = match fold_check(surf, sign, mesh, tol, params, id) {
+        Ok(()) => None,
+        Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
+        Err(e) => Some(translate_chart(surf, sign, mesh, tol).ok_or(e)?),
+    };
+    let mut chart = match translate {
+        Some(c) => c,
+        None => choose_chart(surf, sign, id, mesh)?,
+    };
+    let mut mapped = mapped_mesh(&chart, mesh, id)?;
+    // The feature lies on the side N points to: check, and turn N round if the face said
+    // otherwise (a translate chart has checked it).
+    let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
+    if mean_d < 0.0 && translate.is_none() {
+        sign = -sign;
+        chart = choose_chart(surf, sign, id, mesh)?;
+        mapped = mapped_mesh(&chart, mesh, id)?;
+    }
+    Ok((chart, mapped, translate.is_some()))
+}
+
+/// Each layer's middle and top level: the offset layers' (thicknesses `offsets`) from 0, then
+/// the `transition` layers' morph levels in (0, 1].
+fn layer_tops(offsets: &[f64], transition: Option<usize>) -> Vec<(f64, f64)> {
+    let mut tops = Vec::with_capacity(offsets.len() + transition.unwrap_or(0));
+    let mut z = 0.0;
+    for &dl in offsets {
+        tops.push((z + 0.5 * dl, z + dl));
+        z += dl;
+    }
+    if let Some(n) = transition {
+        for k in 0..n {
+            tops.push(((k as f64 + 0.5) / n as f64, (k + 1) as f64 / n as f64));
+        }
+    }
+    tops
+}
+
+/// Offset deterioration (paper, Fig. 9): the smallest concave radius of the reference under
+/// the feature, sampled at its mapped mesh's points; infinite for translates (`offsets` false)
+/// or a reference that is nowhere concave.
+fn concave_radius(chart: &Chart, mapped: &Mesh, params: &LayerParams, offsets: bool) -> f64 {
+    let stride = (mapped.positions.len() / 300).max(1);
+    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
+    let mut lambda = 0.0f64;
+    if offsets {
+        for p in mapped.positions.iter().step_by(stride) {
+            if let Some(l) = chart.min_curvature([p.x, p.y], step) {
+                lambda = lambda.min(l);
+            }
+        }
+    }
+    if lambda < -FLAT_CURVATURE {
+        -1.0 / lambda
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Offset or transition layers (issue 17, see crate::transition): the top's distance field,
+/// the number of transition layers and the number of offset layers under them; `None` for
+/// offset layers only (asked for, no top, or transition layers that would break the layer
+/// height bounds, with a warning).
+fn choose_blend(
+    (chart, b, raw): (&Chart, &brep::Brep, &Mesh),
+    (tops, mapped): (&[brep::topology::FaceId], &Mesh),
+    params: &LayerParams,
+    bead_width: f64,
+    id: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Option<(TopField, usize, usize)>, PlanError> {
+    let err = |msg: String| PlanError::Freeform { id, msg };
+    Ok(match params.layer_strategy {
+        LayerStrategy::Offset => None,
+        strategy => {
+            let forced = strategy == LayerStrategy::Transition;
+            match build_top_field(chart, b, raw, tops, mapped, id)? {
+                None if forced => {
+                    return Err(err(
+                        "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
+                    ))
+                }
+                None => None,
+                Some(field) => match levels(field.range, params) {
+                    Levels::Offset => None,
+                    Levels::Transition(n) => Some((field, n, 0)),
+                    Levels::Infeasible(lo, hi) => {
+                        let (a, _, b) = field.range;
+                        // Offset layers first, a band of transition layers for the rest.
+                        match band(field, params, bead_width) {
+                            Some(banded) => Some(banded),
+                            None => {
+                                let why = format!(
+                                    "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}, and no band of transition layers over offset layers keeps those bounds either",
+                                    params.max_layer_height, params.min_layer_height
+                                );
+                                if forced {
+                                    return Err(err(why));
+                                }
+                                warnings.push(format!(
+                                    "feature {id}: offset layers, not transition layers: {why}"
+                                ));
+                                None
+                            }
+                        }
+                    }
+                },
+            }
+        }
+    })
+}
+
+/// One layer's regions (the section of the mapped mesh at `mid`) and fill paths at offset `z`
+/// (`at`: the layer, the number of layers, `mid` and `z`), clipped to where the transition band
+/// `clip` stays above, skins made solid.
+#[allow(clippy::too_many_arguments)]
+fn fill_layer(
+    chart: &Chart,
+    mapped: &Mesh,
+    clip: Option<(&TopField, f64)>,
+    up: &Plane,
+    (layer, layers, mid, z): (usize, usize, f64, f64),
+    params: &LayerParams,
+    bead_width: f64,
+    spacing: f64,
+) -> (Vec<Region>, Vec<FillPath>) {
+    let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
+        .iter()
+        .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let regions = regions_from_loops(&loops);
+    let spacing = params
+        .spacing_for_layer(bead_width, layer)
+        .max(MICROMETRE)
+        .min(spacing.max(MICROMETRE) * 1e3);
+    let mut paths = vec![];
+    for r in &regions {
+        paths.extend(fill_region(
+            chart,
+            r,
+            z,
+            params,
+            layer,
+            bead_width,
+            spacing,
+            SLIVER_INSET * bead_width,
+        ));
+        paths.extend(corner_spurs(chart, r, z, bead_width));
+    }
+    if let Some((field, z)) = clip {
+        paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
+    }
+    (
+        regions,
+        crate::region_fill::solid_on_skins(paths, layer, layers),
+    )
 }
 
 impl FreeformFill<'_> {
