@@ -43,7 +43,7 @@ use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::sst::{Sides, WALL_REACH};
 use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
-use crate::toolpath::{Bead, MoveKind, PathPoint};
+use crate::toolpath::{Bead, MoveKind, PathPoint, Role};
 use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
 
 /// Splits chart paths where `keep` turns false, ending each piece on the boundary (found by
@@ -543,51 +543,24 @@ impl FreeformFill<'_> {
                 order_fill_paths(paths, start)
             };
             // Each path lifted onto the layer and its unsupported points counted, in parallel.
-            let lifted: Vec<(Vec<Lifted>, usize)> = paths
-                .par_iter()
-                .map(|path| {
-                    let mut pts = lift(&chart, path, z, params.tolerance);
-                    // Wall beads: the side-surface-tangent axis (Eq. 3).
-                    if let Some(s) = &sides {
-                        crate::sst::apply(&mut pts, s, |q| thick(q, dl), WALL_REACH * bead.width);
-                    }
-                    // Support: the layer below (or, under the first layer, the reference face).
-                    let unheld = pts
-                        .iter()
-                        .filter(|x| {
-                            !if layer == 0 {
-                                chart.on_face(x.q)
-                            } else {
-                                near_regions(&below, x.q, 0.5 * bead.width / chart.stretch(x.q, z))
-                            }
-                        })
-                        .count();
-                    (pts, unheld)
-                })
-                .collect();
+            let support = (layer, below.as_slice());
+            let lifted = lift_paths(
+                &chart,
+                &paths,
+                z,
+                params,
+                (&sides, bead.width),
+                |q| thick(q, dl),
+                support,
+            );
             let mut layer_paths: Vec<LayerPath> = vec![];
             for (pts, unheld) in lifted {
                 if pts.len() < 2 {
                     continue;
                 }
                 // A fixed axis pointing against the layer's growth lays beads from below.
-                if let Some(a) = fixed {
-                    for x in &pts[1..] {
-                        let c = a.dot(&x.n).clamp(-1.0, 1.0);
-                        if c < 0.0 {
-                            against.0 += 1;
-                            against.1 = against.1.max(c.acos().to_degrees());
-                        }
-                    }
-                }
-                if unheld > 0 {
-                    ff.overhang_points += unheld;
-                    let l = layer + 1;
-                    ff.overhang_layers = Some(match ff.overhang_layers {
-                        Some((a, b)) => (a.min(l), b.max(l)),
-                        None => (l, l),
-                    });
-                }
+                count_against(fixed, &pts, &mut against);
+                note_overhang(&mut ff, unheld, layer);
                 let start = points.len();
                 let axis = |n: V3| {
                     let a = fixed.unwrap_or(n);
@@ -602,78 +575,30 @@ impl FreeformFill<'_> {
                     None => dl,
                 };
                 let lift_to = z + step;
-                let mut travel: Vec<(P3, V3)> = vec![];
-                if let Some(c) = *cursor {
-                    if let Some((qc, dc)) = chart.inverse(&c) {
-                        let hz = lift_to.max(dc + step);
-                        let span = dist2(first.q, qc).sqrt();
-                        let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
-                        for i in 0..=n {
-                            let t = i as f64 / n as f64;
-                            let q = [
-                                qc[0] + (first.q[0] - qc[0]) * t,
-                                qc[1] + (first.q[1] - qc[1]) * t,
-                            ];
-                            if let Some(x) = chart.at(q, hz) {
-                                travel.push(x);
-                            }
-                        }
-                    }
-                }
+                let mut travel = travel_over(&chart, *cursor, first.q, lift_to, step);
                 travel.push((first.p, first.n));
-                for (p, n) in travel {
-                    if let Some(c) = *cursor {
-                        fig.travel_length += (p - c).norm();
-                    }
-                    points.push(PathPoint {
-                        feature: id,
-                        layer,
-                        kind: MoveKind::Travel,
-                        p: [p.x, p.y, p.z],
-                        axis: axis(n),
-                        e: 0.0,
-                        thickness: thick(first.q, dl),
-                        width: bead.width,
-                        role: pts[0].role,
-                    });
-                    *cursor = Some(p);
-                }
+                let head = (thick(first.q, dl), bead.width, pts[0].role);
+                push_travel(
+                    &mut points,
+                    travel,
+                    (id, layer, head),
+                    &axis,
+                    cursor,
+                    &mut fig,
+                );
                 let print_start = points.len();
-                for w in pts.windows(2) {
-                    let l = (w[1].p - w[0].p).norm();
-                    let width = 0.5 * (w[0].w + w[1].w);
-                    // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
-                    let mut t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
-                    let mut run = l;
-                    if levels.is_some() || base_chart.along.is_some() {
-                        // A transition layer (or a translate of the reference) leans on the
-                        // direction its levels grow along (N, or a translate chart's `a`): the
-                        // bead is as thick as the layers lie apart across it, t_N·(n_L·N), and
-                        // as long as the segment runs along it (not up its steps over the
-                        // offset layers' staircase, which the layer under it climbs too).
-                        let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
-                        if let Some(g) = base_chart.growth(w[1].q) {
-                            t *= nl.dot(&g).abs();
-                        }
-                        let d = w[1].p - w[0].p;
-                        run = (d - nl * d.dot(&nl)).norm();
-                    }
-                    let e = bead.filament_length(width, t, run);
-                    spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
-                    fig.print_length += l;
-                    fig.filament += e;
-                    points.push(PathPoint {
-                        feature: id,
-                        layer,
-                        kind: MoveKind::Print,
-                        p: [w[1].p.x, w[1].p.y, w[1].p.z],
-                        axis: axis(w[1].n),
-                        e,
-                        thickness: t,
-                        width,
-                        role: w[1].role,
-                    });
-                }
+                let leans = levels.is_some() || base_chart.along.is_some();
+                let seg_thick = |w: &[Lifted]| 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
+                let chart = leans.then_some(&base_chart);
+                let at = (id, layer, bead);
+                push_prints(
+                    &mut points,
+                    &pts,
+                    at,
+                    (seg_thick, chart, &axis),
+                    &mut fig,
+                    &mut spread,
+                );
                 *cursor = pts.last().map(|x| x.p);
                 layer_paths.push(LayerPath {
                     travel: start..print_start,
@@ -697,18 +622,7 @@ impl FreeformFill<'_> {
         if blend.is_some() && spread.3 > 0 {
             fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
         }
-        if against.0 > 0 {
-            fig.warnings.push(format!(
-                "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",
-                against.1, against.0
-            ));
-        }
-        if let Some((a, b)) = ff.overhang_layers {
-            fig.warnings.push(format!(
-                "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
-                ff.overhang_points
-            ));
-        }
+        lay_warnings(&mut fig, id, against, &ff);
         FeaturePlan {
             feature: id,
             points,
@@ -716,5 +630,198 @@ impl FreeformFill<'_> {
             figures: fig,
             freeform: Some(ff),
         }
+    }
+}
+
+/// Each path lifted onto the layer at `z` (wall beads given the side-surface-tangent axis
+/// where `sides` are), and its points unsupported: off the reference face under the first
+/// layer, else off the regions `below`; in parallel.
+fn lift_paths(
+    chart: &Chart,
+    paths: &[FillPath],
+    z: f64,
+    params: &LayerParams,
+    (sides, bead_width): (&Option<Sides>, f64),
+    thick: impl Fn(Point2) -> f64 + Sync,
+    (layer, below): (usize, &[Region]),
+) -> Vec<(Vec<Lifted>, usize)> {
+    paths
+        .par_iter()
+        .map(|path| {
+            let mut pts = lift(chart, path, z, params.tolerance);
+            // Wall beads: the side-surface-tangent axis (Eq. 3).
+            if let Some(s) = sides {
+                crate::sst::apply(&mut pts, s, &thick, WALL_REACH * bead_width);
+            }
+            // Support: the layer below (or, under the first layer, the reference face).
+            let unheld = pts
+                .iter()
+                .filter(|x| {
+                    !if layer == 0 {
+                        chart.on_face(x.q)
+                    } else {
+                        near_regions(below, x.q, 0.5 * bead_width / chart.stretch(x.q, z))
+                    }
+                })
+                .count();
+            (pts, unheld)
+        })
+        .collect()
+}
+
+/// Travel from `cursor` to over `q`: up one layer (`step`, at least to `lift_to`) and along
+/// the layer above, clear of this layer's beads on a curved surface.
+fn travel_over(
+    chart: &Chart,
+    cursor: Option<P3>,
+    q: Point2,
+    lift_to: f64,
+    step: f64,
+) -> Vec<(P3, V3)> {
+    let mut travel: Vec<(P3, V3)> = vec![];
+    if let Some(c) = cursor {
+        if let Some((qc, dc)) = chart.inverse(&c) {
+            let hz = lift_to.max(dc + step);
+            let span = dist2(q, qc).sqrt();
+            let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
+            for i in 0..=n {
+                let t = i as f64 / n as f64;
+                let q = [qc[0] + (q[0] - qc[0]) * t, qc[1] + (q[1] - qc[1]) * t];
+                if let Some(x) = chart.at(q, hz) {
+                    travel.push(x);
+                }
+            }
+        }
+    }
+    travel
+}
+
+/// A segment `w` of a transition layer (or of a translate of the reference), which leans on the
+/// direction its levels grow along (N, or a translate chart's `a`): the bead is as thick as
+/// the layers lie apart across it, t_N·(n_L·N), and as long as the segment runs along it (not
+/// up its steps over the offset layers' staircase, which the layer under it climbs too). The
+/// thickness `t` so scaled, and that length.
+fn leaning(chart: &Chart, w: &[Lifted], mut t: f64) -> (f64, f64) {
+    let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
+    if let Some(g) = chart.growth(w[1].q) {
+        t *= nl.dot(&g).abs();
+    }
+    let d = w[1].p - w[0].p;
+    let run = (d - nl * d.dot(&nl)).norm();
+    (t, run)
+}
+
+/// The warnings of a laid feature: a fixed axis pointing against the layers' growth (`against`:
+/// print points and the worst angle), and print points overhanging the layer below.
+fn lay_warnings(fig: &mut FeatureFigures, id: usize, against: (usize, f64), ff: &FreeformFigures) {
+    if against.0 > 0 {
+        fig.warnings.push(format!(
+            "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",
+            against.1, against.0
+        ));
+    }
+    if let Some((a, b)) = ff.overhang_layers {
+        fig.warnings.push(format!(
+            "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
+            ff.overhang_points
+        ));
+    }
+}
+
+/// Counts the print points of `pts` whose fixed axis points against the layer's growth (lays
+/// beads from below), and the worst angle, into `against`.
+fn count_against(fixed: Option<V3>, pts: &[Lifted], against: &mut (usize, f64)) {
+    if let Some(a) = fixed {
+        for x in &pts[1..] {
+            let c = a.dot(&x.n).clamp(-1.0, 1.0);
+            if c < 0.0 {
+                against.0 += 1;
+                against.1 = against.1.max(c.acos().to_degrees());
+            }
+        }
+    }
+}
+
+/// Counts `unheld` overhanging print points of layer `layer` into the figures.
+fn note_overhang(ff: &mut FreeformFigures, unheld: usize, layer: usize) {
+    if unheld > 0 {
+        ff.overhang_points += unheld;
+        let l = layer + 1;
+        ff.overhang_layers = Some(match ff.overhang_layers {
+            Some((a, b)) => (a.min(l), b.max(l)),
+            None => (l, l),
+        });
+    }
+}
+
+/// The print points of the lifted path `pts` (feature, layer, bead: `at`), each segment's
+/// filament by Eq. 1 with its thickness (`thick`; scaled by [`leaning`] on `leaning_on`'s
+/// levels) and the axis `axis` makes of its normal; lengths, filament and thickness spread
+/// added to the figures.
+fn push_prints(
+    points: &mut Vec<PathPoint>,
+    pts: &[Lifted],
+    (id, layer, bead): (usize, usize, Bead),
+    (thick, leaning_on, axis): (
+        impl Fn(&[Lifted]) -> f64,
+        Option<&Chart>,
+        &dyn Fn(V3) -> [f64; 3],
+    ),
+    fig: &mut FeatureFigures,
+    spread: &mut (f64, f64, f64, usize),
+) {
+    for w in pts.windows(2) {
+        let l = (w[1].p - w[0].p).norm();
+        let width = 0.5 * (w[0].w + w[1].w);
+        // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
+        let t = thick(w);
+        let (t, run) = match leaning_on {
+            Some(chart) => leaning(chart, w, t),
+            None => (t, l),
+        };
+        let e = bead.filament_length(width, t, run);
+        *spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
+        fig.print_length += l;
+        fig.filament += e;
+        points.push(PathPoint {
+            feature: id,
+            layer,
+            kind: MoveKind::Print,
+            p: [w[1].p.x, w[1].p.y, w[1].p.z],
+            axis: axis(w[1].n),
+            e,
+            thickness: t,
+            width,
+            role: w[1].role,
+        });
+    }
+}
+
+/// The travel points `travel` (feature, layer, and the bead's thickness, width and role:
+/// `at`), each from the cursor, which follows them; their length added to the figures.
+fn push_travel(
+    points: &mut Vec<PathPoint>,
+    travel: Vec<(P3, V3)>,
+    (id, layer, (thickness, width, role)): (usize, usize, (f64, f64, Role)),
+    axis: &dyn Fn(V3) -> [f64; 3],
+    cursor: &mut Option<P3>,
+    fig: &mut FeatureFigures,
+) {
+    for (p, n) in travel {
+        if let Some(c) = *cursor {
+            fig.travel_length += (p - c).norm();
+        }
+        points.push(PathPoint {
+            feature: id,
+            layer,
+            kind: MoveKind::Travel,
+            p: [p.x, p.y, p.z],
+            axis: axis(n),
+            e: 0.0,
+            thickness,
+            width,
+            role,
+        });
+        *cursor = Some(p);
     }
 }
