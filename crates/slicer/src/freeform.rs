@@ -42,7 +42,7 @@ use crate::lift::{lift, Lifted};
 use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::sst::{Sides, WALL_REACH};
-use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
+use crate::tolerance::{FLAT_CURVATURE, HEIGHT_SLACK, MICROMETRE, SHORT_VECTOR};
 use crate::toolpath::{Bead, MoveKind, PathPoint, Role};
 use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
 
@@ -473,7 +473,7 @@ fn fill_layer(
         paths.extend(corner_spurs(chart, r, z, bead_width));
     }
     if let Some((field, z)) = clip {
-        paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
+        paths = clip_paths(paths, |q| field.lower(q) >= z - HEIGHT_SLACK);
     }
     (
         regions,
@@ -702,7 +702,9 @@ fn travel_over(
 /// up its steps over the offset layers' staircase, which the layer under it climbs too). The
 /// thickness `t` so scaled, and that length.
 fn leaning(chart: &Chart, w: &[Lifted], mut t: f64) -> (f64, f64) {
-    let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
+    let nl = (w[0].ln + w[1].ln)
+        .try_normalize(SHORT_VECTOR)
+        .unwrap_or(w[1].ln);
     if let Some(g) = chart.growth(w[1].q) {
         t *= nl.dot(&g).abs();
     }

@@ -6,7 +6,9 @@ use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
 use crate::geom2d::{area2, dist, perimeter, Point2};
-use crate::tolerance::ROUND_OFF;
+use crate::tolerance::{
+    AREA_SLACK, COUNT_SLACK, DEGENERATE_LENGTH, NONZERO, PARALLEL_RAY, ROUND_OFF,
+};
 use crate::toolpath::Role;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -23,7 +25,7 @@ fn ray_to_boundary(base: &Shapes, p: Point2, d: Point2) -> Option<f64> {
             let (a, b) = (c[i], c[(i + 1) % n]);
             let e = [b[0] - a[0], b[1] - a[1]];
             let den = cross(d, e);
-            if den.abs() <= 1e-15 * (1.0 + e[0].abs() + e[1].abs()) {
+            if den.abs() <= PARALLEL_RAY * (1.0 + e[0].abs() + e[1].abs()) {
                 continue;
             }
             let ap = [a[0] - p[0], a[1] - p[1]];
@@ -105,7 +107,7 @@ pub(super) fn rings(
         } else {
             opening(&cur, OPEN_SHARE * ctx.spacing, ctx)
         };
-        let opened = !clean && shapes_area(&ring) < shapes_area(&cur) - 1e-9;
+        let opened = !clean && shapes_area(&ring) < shapes_area(&cur) - AREA_SLACK;
         if lost || opened {
             let edge = match &before {
                 Some(b) => erode(b, half, &ctx.join),
@@ -235,7 +237,7 @@ fn principal_angle(shape: &Shape) -> f64 {
             sxy += (x0 * y1 + 2.0 * x0 * y0 + 2.0 * x1 * y1 + x1 * y0) * cr / 24.0;
         }
     }
-    if a.abs() < 1e-300 {
+    if a.abs() < NONZERO {
         return 0.0;
     }
     let (cx, cy) = (sx / a, sy / a);
@@ -308,7 +310,7 @@ pub(super) fn scan_fill(
     }
     // Lines centred on the area's extent; the outermost pulled a hair inside so a line on a
     // boundary edge still cuts the area.
-    let n = (h / spacing + 1e-9).floor() as usize + 1;
+    let n = (h / spacing + COUNT_SLACK).floor() as usize + 1;
     let y0 = ymin + 0.5 * (h - (n - 1) as f64 * spacing);
     let ys: Vec<f64> = (0..n)
         .map(|j| (y0 + j as f64 * spacing).clamp(ymin + eps, ymax - eps))
@@ -489,7 +491,7 @@ fn segments(
         hs.sort_by(|a, b| a.0.total_cmp(&b.0));
         for pair in hs.chunks_exact(2) {
             let (a, b) = (pair[0], pair[1]);
-            if b.0 - a.0 <= 1e-9 || b.0.is_nan() || a.0.is_nan() {
+            if b.0 - a.0 <= DEGENERATE_LENGTH || b.0.is_nan() || a.0.is_nan() {
                 continue;
             }
             let sid = segs.len();

@@ -14,6 +14,7 @@ use crate::chart::Chart;
 use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
 use crate::geom2d::{Point2, Region};
 use crate::params::{LayerParams, PathMode};
+use crate::tolerance::{ROUND_OFF, SHORT_VECTOR};
 use crate::toolpath::Role;
 use border::Border;
 use brep::math::{P3, V3};
@@ -489,7 +490,7 @@ fn seed_field(
             Some((a - b) / (2.0 * e))
         };
         match (step(dir), step(nrm)) {
-            (Some(t), Some(n)) if t.norm() > 1e-12 => {
+            (Some(t), Some(n)) if t.norm() > SHORT_VECTOR => {
                 let t = t / t.norm();
                 (n - t * n.dot(&t)).norm()
             }
@@ -641,7 +642,7 @@ fn conserved(
         })
         .sum();
     let held = lm.area_above(db, edge);
-    if covered > 0.0 && (covered - held).abs() > 1e-9 * held {
+    if covered > 0.0 && (covered - held).abs() > ROUND_OFF * held {
         let k = (held / covered).min(MAX_CORE_WIDENING);
         for p in &mut paths {
             for w in &mut p.widths {
