@@ -3,10 +3,7 @@
 
 use crate::curve::Curve;
 use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
-use crate::tolerance::{
-    ANGLE_ZERO, CLOSED_PROFILE, NONZERO, NORMAL_ZERO, PARALLEL, POINT_COINCIDENCE, PROJECTION_STEP,
-    SINGULAR_DET_RELATIVE, SURFACE_COINCIDENCE,
-};
+use crate::tolerance::*;
 use std::f64::consts::{FRAC_PI_2, TAU};
 use truck_geometry::prelude as tg;
 
