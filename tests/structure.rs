@@ -1,6 +1,8 @@
 //! The layout rules of the workspace (issue 15), checked on the sources: no file of library code
 //! over 1,000 lines, no two modules of one crate importing each other, the posts not depending
-//! on the slicer, and Eq. 1 written once.
+//! on the slicer, and Eq. 1 written once; functions a reader can hold (issue 32): no library
+//! function over 150 lines, and no bare float literal below 1e-6 outside a crate's tolerance
+//! module.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -291,4 +293,310 @@ fn every_link_of_the_readme_and_docs_reaches_a_file_and_heading() {
         }
     }
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+/// Crates whose library code is checked by the function-length and tolerance rules: the
+/// libraries, the viewer and the command (its binary is library code for this purpose).
+const CODE_CRATES: [&str; 9] = [
+    "brep",
+    "features",
+    "toolpath",
+    "collide",
+    "slicer",
+    "robot-post",
+    "plan",
+    "preview",
+    "cli",
+];
+
+/// Functions the rules leave alone, by crate, file (under `src/`) and name: none (issue 32's
+/// `plan_into` and `cli::plan::run` are stages now).
+const EXEMPT_FUNCTIONS: [(&str, &str, &str); 0] = [];
+
+/// Files the tolerance rule leaves alone, by crate and file (under `src/`): none.
+const EXEMPT_FILES: [(&str, &str); 0] = [];
+
+/// A library source file: its crate, its path under `src/` and its lines (1-based numbers)
+/// with test code left out: files named `tests.rs` or under a `tests/` folder, and every item
+/// marked `#[cfg(test)]` (a `mod tests { … }` block, a helper).
+struct Source {
+    krate: &'static str,
+    rel: String,
+    lines: Vec<(usize, String)>,
+}
+
+fn library_sources() -> Vec<Source> {
+    let mut out = vec![];
+    for krate in CODE_CRATES {
+        let src = root().join("crates").join(krate).join("src");
+        let mut files = vec![];
+        rust_files(&src, &mut files);
+        files.sort();
+        assert!(!files.is_empty(), "{krate} has no sources");
+        for f in files {
+            let rel = f
+                .strip_prefix(&src)
+                .expect("under src")
+                .to_string_lossy()
+                .replace('\\', "/");
+            if rel == "tests.rs"
+                || rel.ends_with("/tests.rs")
+                || rel.split('/').any(|c| c == "tests")
+            {
+                continue;
+            }
+            let text = std::fs::read_to_string(&f).expect("reads");
+            let all: Vec<&str> = text.lines().collect();
+            let mut lines = vec![];
+            let mut i = 0;
+            while i < all.len() {
+                if all[i].trim() == "#[cfg(test)]" && i + 1 < all.len() {
+                    // Skip the item: a declaration ending in `;` or a block closed at its indent.
+                    let item = all[i + 1];
+                    let indent = item.len() - item.trim_start().len();
+                    let mut k = i + 1;
+                    if !item.trim_end().ends_with(';') {
+                        while k < all.len() && !is_close(all[k], indent) {
+                            k += 1;
+                        }
+                    }
+                    i = k + 1;
+                    continue;
+                }
+                lines.push((i + 1, all[i].to_string()));
+                i += 1;
+            }
+            out.push(Source { krate, rel, lines });
+        }
+    }
+    out
+}
+
+/// Whether `line` is a closing brace at `indent`.
+fn is_close(line: &str, indent: usize) -> bool {
+    let t = line.trim_end();
+    t.len() == indent + 1 && t.ends_with('}') && t[..indent].trim().is_empty()
+}
+
+/// The name of the function a line declares (`pub(crate) const fn name(`), if it does.
+fn declared_fn(line: &str) -> Option<&str> {
+    let mut rest = line.trim_start();
+    loop {
+        if let Some(r) = rest.strip_prefix("pub(") {
+            rest = r.split_once(')')?.1.trim_start();
+        } else if let Some(r) = ["pub ", "const ", "async ", "unsafe ", "extern \"C\" "]
+            .iter()
+            .find_map(|k| rest.strip_prefix(k))
+        {
+            rest = r.trim_start();
+        } else {
+            break;
+        }
+    }
+    let rest = rest.strip_prefix("fn ")?;
+    let name: &str = &rest[..rest
+        .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .unwrap_or(rest.len())];
+    (!name.is_empty()).then_some(name)
+}
+
+/// Every function of the library code: crate, file, name, first line and length in lines
+/// (from the `fn` line to its closing brace).
+fn functions() -> Vec<(&'static str, String, String, usize, usize)> {
+    let mut out = vec![];
+    for s in library_sources() {
+        let lines = &s.lines;
+        for (i, (n, line)) in lines.iter().enumerate() {
+            let Some(name) = declared_fn(line) else {
+                continue;
+            };
+            let indent = line.len() - line.trim_start().len();
+            // The signature ends at the line ending in `{` (a body) or `;` (a declaration).
+            // (`}`: a body on one line).
+            let Some(open) = (i..lines.len()).find(|&j| {
+                let t = lines[j].1.trim_end();
+                t.ends_with('{') || t.ends_with(';') || t.ends_with('}')
+            }) else {
+                continue;
+            };
+            if !lines[open].1.trim_end().ends_with('{') {
+                continue;
+            }
+            let close = (open + 1..lines.len())
+                .find(|&k| is_close(&lines[k].1, indent))
+                .unwrap_or(lines.len() - 1);
+            out.push((
+                s.krate,
+                s.rel.clone(),
+                name.to_string(),
+                *n,
+                lines[close].0 - n + 1,
+            ));
+        }
+    }
+    out
+}
+
+#[test]
+fn no_library_function_is_over_150_lines() {
+    let functions = functions();
+    assert!(
+        functions.len() > 500,
+        "the scan finds functions ({})",
+        functions.len()
+    );
+    let long: Vec<String> = functions
+        .iter()
+        .filter(|(k, rel, name, _, _)| {
+            !EXEMPT_FUNCTIONS.contains(&(*k, rel.as_str(), name.as_str()))
+        })
+        .filter(|f| f.4 > 150)
+        .map(|(k, rel, name, n, len)| format!("{k}/src/{rel}:{n} {name} ({len} lines)"))
+        .collect();
+    assert!(long.is_empty(), "split along the steps: {long:?}");
+}
+
+/// The code of a line: string and character literals blanked, the comment cut off. `in_string`
+/// carries a string literal over line ends.
+fn code_of(line: &str, in_string: &mut bool) -> String {
+    let chars: Vec<char> = line.chars().collect();
+    let mut out = String::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if *in_string {
+            match c {
+                '\\' => i += 1,
+                '"' => *in_string = false,
+                _ => {}
+            }
+            out.push(' ');
+        } else if c == '\'' && chars.get(i + 1) == Some(&'\\') {
+            // An escaped character literal `'\\n'`, `'\\''`.
+            i += 3;
+            out.push(' ');
+        } else if c == '\'' && chars.get(i + 2) == Some(&'\'') {
+            // A character literal `'x'`.
+            i += 2;
+            out.push(' ');
+        } else if c == '/' && chars.get(i + 1) == Some(&'/') {
+            break;
+        } else if c == '"' {
+            *in_string = true;
+            out.push(' ');
+        } else {
+            out.push(c);
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The float literals of a line of code (blanked of strings and comments) whose value is
+/// positive and below 1e-6: `1e-9`, `1.0e-12`, `5E-7_f64`, `0.0000001`.
+fn small_literals(code: &str) -> Vec<String> {
+    let b = code.as_bytes();
+    let mut out = vec![];
+    let mut i = 0;
+    while i < b.len() {
+        let starts = b[i].is_ascii_digit()
+            && (i == 0
+                || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_' || b[i - 1] == b'.'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let mut j = i;
+        while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'_') {
+            j += 1;
+        }
+        if j + 1 < b.len() && b[j] == b'.' && b[j + 1].is_ascii_digit() {
+            j += 1;
+            while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'_') {
+                j += 1;
+            }
+        }
+        if j + 1 < b.len()
+            && (b[j] == b'e' || b[j] == b'E')
+            && (b[j + 1] == b'-' || b[j + 1].is_ascii_digit())
+        {
+            j += 1;
+            if b[j] == b'-' {
+                j += 1;
+            }
+            while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'_') {
+                j += 1;
+            }
+        }
+        // A type suffix's `_` (`5E-7_f64`) is not part of the number.
+        let text = code[i..j].trim_end_matches('_');
+        if let Ok(v) = text.replace('_', "").parse::<f64>() {
+            if v > 0.0 && v < 1e-6 {
+                out.push(text.to_string());
+            }
+        }
+        i = j.max(i + 1);
+    }
+    out
+}
+
+#[test]
+fn the_scan_finds_small_literals() {
+    let mut s = false;
+    assert_eq!(
+        small_literals(&code_of("x < 1e-9 && y > 1.0e-12", &mut s)),
+        ["1e-9", "1.0e-12"]
+    );
+    assert_eq!(
+        small_literals(&code_of("a * 5E-7_f64 + 0.0000001", &mut s)),
+        ["5E-7", "0.0000001"]
+    );
+    assert!(small_literals(&code_of("x < 1e-6 || y > 2.5e-3 || v1e-9", &mut s)).is_empty());
+    assert!(small_literals(&code_of("// 1e-9 in a comment", &mut s)).is_empty());
+    assert!(small_literals(&code_of("f(\"1.E-07\", '\"') // 1e-9", &mut s)).is_empty());
+    assert!(!s, "the string closed");
+}
+
+#[test]
+fn every_crate_names_its_small_tolerances() {
+    // The crates that compare floats hold their tolerances in one module, `tolerance.rs`.
+    let sources = library_sources();
+    let tolerance_module = |krate: &str| {
+        sources.iter().any(|s| {
+            s.krate == krate && (s.rel == "tolerance.rs" || s.rel.ends_with("/tolerance.rs"))
+        })
+    };
+    for krate in LIBRARIES {
+        assert!(tolerance_module(krate), "{krate} has no tolerance module");
+    }
+    let functions = functions();
+    let exempt = |krate: &str, rel: &str, n: usize| {
+        EXEMPT_FILES.contains(&(krate, rel))
+            || functions.iter().any(|(k, r, name, first, len)| {
+                *k == krate
+                    && r == rel
+                    && EXEMPT_FUNCTIONS.contains(&(krate, rel, name.as_str()))
+                    && (*first..first + len).contains(&n)
+            })
+    };
+    let mut bare = vec![];
+    let mut count = 0;
+    for s in &sources {
+        let in_module = s.rel == "tolerance.rs" || s.rel.ends_with("/tolerance.rs");
+        let mut in_string = false;
+        for (n, line) in &s.lines {
+            let found = small_literals(&code_of(line, &mut in_string));
+            count += found.len();
+            if in_module || found.is_empty() || exempt(s.krate, &s.rel, *n) {
+                continue;
+            }
+            bare.push(format!("{}/src/{}:{n} {}", s.krate, s.rel, found.join(" ")));
+        }
+    }
+    assert!(count > 10, "the scan finds the named tolerances ({count})");
+    assert!(
+        bare.is_empty(),
+        "name these in the crate's tolerance module ({}): {bare:?}",
+        bare.len()
+    );
 }

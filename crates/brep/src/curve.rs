@@ -1,7 +1,7 @@
 //! Exact 3-D curves: the geometry of edges and of swept-surface profiles.
 
 use crate::math::{nearest_periodic, Frame, P3, V3};
-use crate::tolerance::{NONZERO, POINT_COINCIDENCE};
+use crate::tolerance::{CURVE_NEWTON_STEP, NONZERO, POINT_COINCIDENCE};
 use std::f64::consts::TAU;
 use truck_geometry::prelude as tg;
 
@@ -378,7 +378,7 @@ impl Curve {
             if let Some((a, b)) = clamp {
                 nt = nt.clamp(a, b);
             }
-            if (nt - t).abs() < 1e-14 * (1.0 + t.abs()) {
+            if (nt - t).abs() < CURVE_NEWTON_STEP * (1.0 + t.abs()) {
                 t = nt;
                 break;
             }

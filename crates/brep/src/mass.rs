@@ -4,7 +4,7 @@
 
 use crate::math::{Aabb, P3, V3};
 use crate::mesh::Mesh;
-use crate::tolerance::NONZERO;
+use crate::tolerance::{LENGTH_FLOOR, NONZERO, STRAIGHT_BOW};
 use crate::topology::Brep;
 
 /// Integrals over a set of faces.
@@ -163,7 +163,7 @@ fn plane_slivers(
                 let (cx, cy) = (b.x - a.x, b.y - a.y);
                 let len = cx.hypot(cy);
                 let bow = ((mid.x - a.x) * cy - (mid.y - a.y) * cx).abs() / len.max(NONZERO);
-                if bow <= 1e-9 * (1.0 + len) {
+                if bow <= STRAIGHT_BOW * (1.0 + len) {
                     continue;
                 }
                 let mut curve = 0.0;
@@ -249,7 +249,7 @@ pub fn exact_bbox(brep: &Brep, mesh: &Mesh) -> Aabb {
         }
         for t in &ft.triangles {
             let ps = t.map(|i| mesh.positions[ft.vertex[i as usize] as usize]);
-            if ps.iter().any(|p| near(p, &bbox, tol.max(1e-9))) {
+            if ps.iter().any(|p| near(p, &bbox, tol.max(LENGTH_FLOOR))) {
                 cands.push((fi, t.map(|i| ft.uv[i as usize])));
             }
         }

@@ -3,7 +3,7 @@
 
 use crate::curve::Curve;
 use crate::math::{nearest_periodic, wrap, Frame, P3, V3};
-use crate::tolerance::{ANGLE_ZERO, NONZERO, PARALLEL, POINT_COINCIDENCE, SURFACE_COINCIDENCE};
+use crate::tolerance::*;
 use std::f64::consts::{FRAC_PI_2, TAU};
 use truck_geometry::prelude as tg;
 
@@ -450,7 +450,7 @@ impl Surface {
                 for (a, b) in [(0.0, 1e-5), (0.0, -1e-5), (1e-5, 0.0), (-1e-5, 0.0)] {
                     let (su, sv) = self.derivs(u + a * du, v + b * dv);
                     let n = su.cross(&sv);
-                    if n.norm() > 1e-14 * (1.0 + su.norm() * sv.norm()) && n.norm() > 0.0 {
+                    if n.norm() > NORMAL_ZERO * (1.0 + su.norm() * sv.norm()) && n.norm() > 0.0 {
                         return Some(n / n.norm());
                     }
                 }
@@ -501,7 +501,7 @@ impl Surface {
             Surface::Extrusion { profile, .. } => {
                 if let Some(p) = profile.period() {
                     Some(p)
-                } else if profile.is_closed(1e-7) {
+                } else if profile.is_closed(CLOSED_PROFILE) {
                     let (a, b) = profile.range();
                     Some(b - a)
                 } else {
@@ -779,7 +779,7 @@ impl Surface {
             let b1 = -su.dot(&d);
             let b2 = -sv.dot(&d);
             let det = a11 * a22 - a12 * a12;
-            let (du, dv) = if det.abs() > 1e-18 * (a11 * a22).max(NONZERO) {
+            let (du, dv) = if det.abs() > SINGULAR_DET_RELATIVE * (a11 * a22).max(NONZERO) {
                 ((b1 * a22 - b2 * a12) / det, (a11 * b2 - a12 * b1) / det)
             } else if a11 > a22 && a11 > 0.0 {
                 (b1 / a11, 0.0)
@@ -799,7 +799,7 @@ impl Surface {
                 let nv = clamp_v(v + f * dv);
                 let nd = (self.eval(nu, nv) - p).norm();
                 if nd <= dist {
-                    let small = (nu - u).abs() + (nv - v).abs() < 1e-13;
+                    let small = (nu - u).abs() + (nv - v).abs() < PROJECTION_STEP;
                     u = nu;
                     v = nv;
                     dist = nd;

@@ -27,3 +27,59 @@ pub const PARALLEL: f64 = 1e-12;
 
 /// An angle (or its tangent) below this is zero: a cone whose semi-angle is zero is a cylinder.
 pub const ANGLE_ZERO: f64 = 1e-12;
+
+/// A Newton step on a curve's parameter below this fraction of `1 + |t|` has converged.
+pub const CURVE_NEWTON_STEP: f64 = 1e-14;
+
+/// A step of a point's projection onto a surface, `|Δu| + |Δv|` in parameters, below this has
+/// converged.
+pub const PROJECTION_STEP: f64 = 1e-13;
+
+/// A segment of a planar curve bows off its chord by less than this fraction of `1 + length`:
+/// it is straight and has no sliver worth an integral.
+pub const STRAIGHT_BOW: f64 = 1e-9;
+
+/// A floor, mm, for a tolerance or a model size that may be zero (an empty box's diagonal, a
+/// degenerate face's size) before a tolerance is taken as a fraction of it.
+pub const LENGTH_FLOOR: f64 = 1e-9;
+
+/// A floor for a face's parameter span before a finite-difference step is taken as a
+/// thousandth of it.
+pub const PARAMETER_SPAN_FLOOR: f64 = 1e-9;
+
+/// A surface curves in a direction where its second derivative exceeds this fraction of
+/// `1 + |first derivative|`.
+pub const CURVATURE_RELATIVE: f64 = 1e-9;
+
+/// A first derivative (length per unit parameter) at or below this is zero.
+pub const DERIVATIVE_ZERO: f64 = 1e-12;
+
+/// A signed area in a face's parameter domain above this is positive (the loop turns counter
+/// to the face's sense).
+pub const PARAMETER_AREA: f64 = 1e-12;
+
+/// The triangulator (spade) refuses coordinate magnitudes below 2^-142; a scaled parameter
+/// below this is zero.
+pub const TRIANGULATOR_ZERO: f64 = 1e-30;
+
+/// A placement is the identity where every entry of its rotation matrix is within this of the
+/// identity's.
+pub const ROTATION_IDENTITY: f64 = 1e-12;
+
+/// Two placements' rotation matrices are equal where every entry differs by less than this.
+pub const ROTATION_EQUAL: f64 = 1e-9;
+
+/// A placement's shift, mm, shorter than this is no shift.
+pub const SHIFT_ZERO: f64 = 1e-9;
+
+/// A surface's normal is defined where `|S_u × S_v|` exceeds this fraction of
+/// `1 + |S_u||S_v|`.
+pub const NORMAL_ZERO: f64 = 1e-14;
+
+/// A profile curve whose two ends are within this, mm, is closed (an extrusion of it is
+/// periodic).
+pub const CLOSED_PROFILE: f64 = 1e-7;
+
+/// The 2 × 2 normal equations of a surface projection are singular where the determinant is
+/// below this fraction of the product of their diagonal.
+pub const SINGULAR_DET_RELATIVE: f64 = 1e-18;

@@ -408,7 +408,7 @@ impl Sweep {
             let key = child_cell(cell, slot);
             if level == 1 {
                 let (centre, half) = d.leaves[c as usize].centres_box(key);
-                self.may_hold(centre, half.map(|x| x + 1e-9))
+                self.may_hold(centre, half.map(|x| x + crate::tolerance::CELL_PAD))
             } else {
                 self.visit(d, c, level - 1, key)
             }

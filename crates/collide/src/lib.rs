@@ -24,6 +24,7 @@ mod order;
 mod scene;
 mod table;
 mod tilt;
+mod tolerance;
 
 pub use check::{check_and_route, tilt, tilt_and_route, Routed, Travels};
 pub use deposit::{Deposit, GRAIN_SPACING};

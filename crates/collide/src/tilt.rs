@@ -40,6 +40,7 @@
 //!    its tilt only when every move that collides after it collided before it and fewer do.
 
 use crate::scene::{move_hit, Collision, Obstacle, Scene};
+use crate::tolerance::{ANGLE_SLACK, TURN_ZERO, WINDOW_FLOOR};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use toolpath::vec3::{add, cross, dot, norm, scale, sub, unit, V3};
@@ -64,9 +65,6 @@ pub const KEY_SPACING_MM: f64 = 1.0;
 /// Passes of key search, blend and check per continuous path.
 const PASSES: usize = 4;
 
-/// Angle (radians) an axis may exceed a limit by, for rounding.
-const SLACK: f64 = 1e-9;
-
 /// What a tilt may do.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TiltLimits {
@@ -85,7 +83,7 @@ impl TiltLimits {
     /// The largest change of the turn field per mm of path, radians: two cone half-angles (the
     /// most a turn inside the cone can be) over one window.
     pub fn slope(&self) -> f64 {
-        2.0 * self.cone_half_deg.to_radians() / self.window_mm.max(1e-9)
+        2.0 * self.cone_half_deg.to_radians() / self.window_mm.max(WINDOW_FLOOR)
     }
 }
 
@@ -104,7 +102,7 @@ pub struct Tilted {
 /// `v` turned by the rotation vector `w` (Rodrigues).
 fn rotate(v: V3, w: V3) -> V3 {
     let t = norm(w);
-    if t < 1e-15 {
+    if t < TURN_ZERO {
         return v;
     }
     let k = scale(w, 1.0 / t);
@@ -141,8 +139,8 @@ impl Allowed {
     }
 
     fn holds(&self, a: V3) -> bool {
-        angle(a, self.planned) <= self.half + SLACK
-            && (self.from_z.is_infinite() || angle(a, [0.0, 0.0, 1.0]) <= self.from_z + SLACK)
+        angle(a, self.planned) <= self.half + ANGLE_SLACK
+            && (self.from_z.is_infinite() || angle(a, [0.0, 0.0, 1.0]) <= self.from_z + ANGLE_SLACK)
     }
 
     /// The allowed axis nearest +Z: the most a tilt can lift the head off the table.
@@ -194,197 +192,28 @@ pub(crate) fn tilt_run(
     // takes a turn of its own, bound neither to the bead's keys nor to each other (they all lie
     // at arc length 0, where the slope would demand one turn for all).
     let mut lead_keys: BTreeMap<usize, V3> = BTreeMap::new();
-    let none: BTreeMap<usize, V3> = BTreeMap::new();
     let mut tried = vec![false; run.len()];
     // Points before a key given the least turn that clears the head there (see below).
     let mut lifted = vec![false; run.len()];
     let mut axes = given.clone();
     let mut now: Vec<Option<Collision>> = before.to_vec();
+    let cx = Run {
+        scene,
+        run,
+        given: &given,
+        allowed: &allowed,
+        s: &s,
+        limits,
+        lead,
+    };
     for _ in 0..PASSES {
-        let mut added = false;
-        // Where the last search along the bead found no turn: the moves just after it mostly
-        // meet the same obstacle, so the search waits [`RETRY_MM`] of path; those it passed
-        // over are tried in the next pass.
-        let mut failed: Option<f64> = None;
-        let mut waited = false;
-        // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
-        // for the blend, and are searched in the next pass if it leaves them colliding.
-        let mut found: Option<f64> = None;
-        for k in 0..run.len() {
-            let Some(c) = now[k] else { continue };
-            // Print moves; and travels into the lead or the bead start where the head
-            // collides at the point itself (no lift clears that).
-            let point = k <= lead && scene.at(run[k].p, axes[k]).is_some();
-            if k <= lead && !point {
-                continue;
-            }
-            if k < lead {
-                if lead_keys.contains_key(&k) || tried[k] {
-                    continue;
-                }
-                tried[k] = true;
-                let at = Candidate {
-                    k,
-                    lead,
-                    hits: c.hits,
-                };
-                if let Some(w) = search(scene, run, &given, &allowed, &none, &s, at, limits) {
-                    lead_keys.insert(k, w);
-                    added = true;
-                }
-                continue;
-            }
-            // A key on the bead that still collides (its move starts from a blended axis):
-            // the point before it takes the same turn.
-            let (k, w, ahead) = match keys.get(&k) {
-                Some(&w)
-                    if k > lead
-                        && !keys.contains_key(&(k - 1))
-                        && allowed[k - 1].holds(rotate(given[k - 1], w))
-                        && near(&keys, &s, k - 1, w, limits) =>
-                {
-                    (k - 1, Some(w), true)
-                }
-                // Or a turn of its own, if none was searched there yet, or none that clears
-                // the head at the point alone.
-                Some(_)
-                    if k > lead
-                        && !keys.contains_key(&(k - 1))
-                        && !(tried[k - 1] && lifted[k - 1]) =>
-                {
-                    (k - 1, None, true)
-                }
-                // Or, where the head meets something at the key's point itself, the least turn
-                // that clears it there.
-                Some(_) if !lifted[k] && scene.at(run[k].p, axes[k]).is_some() => (k, None, true),
-                Some(_) => continue,
-                None if tried[k] => continue,
-                None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => {
-                    waited = true;
-                    continue;
-                }
-                None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
-                None => (k, None, false),
-            };
-            let searched = std::mem::replace(&mut tried[k], true);
-            let w = w.or_else(|| {
-                if searched {
-                    return None;
-                }
-                let at = Candidate {
-                    k,
-                    lead,
-                    hits: c.hits,
-                };
-                search(scene, run, &given, &allowed, &keys, &s, at, limits)
-            });
-            // Against the table, a move no one turn clears (its start needs a larger turn than
-            // its end allows, or the other way about): its start gets a key of its own first,
-            // the least turn towards the allowed axis nearest +Z that clears the head there,
-            // and the move is searched again from it.
-            let w = match w {
-                None if !searched
-                    && c.hits == Obstacle::Table
-                    && k > lead
-                    && !keys.contains_key(&(k - 1)) =>
-                {
-                    let start = lift(scene, run[k - 1].p, given[k - 1], &allowed[k - 1], |w| {
-                        near(&keys, &s, k - 1, w, limits)
-                    });
-                    start
-                        .and_then(|w0| {
-                            keys.insert(k - 1, w0);
-                            let at = Candidate {
-                                k,
-                                lead,
-                                hits: c.hits,
-                            };
-                            let w = search(scene, run, &given, &allowed, &keys, &s, at, limits);
-                            if w.is_none() {
-                                keys.remove(&(k - 1));
-                            }
-                            w
-                        })
-                        .or_else(|| {
-                            // Else both ends turned all the way to their highest allowed axes.
-                            let w0 = towards(given[k - 1], allowed[k - 1].highest());
-                            let w1 = towards(given[k], allowed[k].highest());
-                            let (a0, a1) = (rotate(given[k - 1], w0), rotate(given[k], w1));
-                            let clear = near(&keys, &s, k - 1, w0, limits)
-                                && (k - 1 > lead || scene.at(run[k - 1].p, a0).is_none())
-                                && scene.sweep(run[k - 1].p, a0, run[k].p, a1).is_none();
-                            if !clear {
-                                return None;
-                            }
-                            keys.insert(k - 1, w0);
-                            if near(&keys, &s, k, w1, limits) {
-                                Some(w1)
-                            } else {
-                                keys.remove(&(k - 1));
-                                None
-                            }
-                        })
-                }
-                // Or, where the key at its start holds the turn back (the slope between them),
-                // one turn for both: that key moved to it.
-                None if !searched && c.hits == Obstacle::Table && k > lead => {
-                    let old = keys.remove(&(k - 1));
-                    let at = Candidate {
-                        k,
-                        lead,
-                        hits: c.hits,
-                    };
-                    let w =
-                        search(scene, run, &given, &allowed, &keys, &s, at, limits).filter(|&w| {
-                            allowed[k - 1].holds(rotate(given[k - 1], w))
-                                && near(&keys, &s, k - 1, w, limits)
-                        });
-                    match (w, old) {
-                        (Some(w), _) => {
-                            keys.insert(k - 1, w);
-                        }
-                        (None, Some(old)) => {
-                            keys.insert(k - 1, old);
-                        }
-                        (None, None) => {}
-                    }
-                    w
-                }
-                w => w,
-            };
-            // The point before a key whose move still collides, when no turn clears the move
-            // into it: turned so the head clears it there at least, which the move from it
-            // needs.
-            let w = match w {
-                None if ahead && !std::mem::replace(&mut lifted[k], true) => {
-                    lift(scene, run[k].p, given[k], &allowed[k], |w| {
-                        near(&keys, &s, k, w, limits)
-                    })
-                    .or_else(|| {
-                        // Where the key just before it holds the turn back (the slope between
-                        // them), that key moved to the same turn.
-                        let j = k.checked_sub(1).filter(|&j| j >= lead)?;
-                        let old = keys.remove(&j)?;
-                        let w = lift(scene, run[k].p, given[k], &allowed[k], |w| {
-                            near(&keys, &s, k, w, limits)
-                                && allowed[j].holds(rotate(given[j], w))
-                                && near(&keys, &s, j, w, limits)
-                        });
-                        keys.insert(j, w.unwrap_or(old));
-                        w
-                    })
-                }
-                w => w,
-            };
-            match w {
-                Some(w) => {
-                    keys.insert(k, w);
-                    found = Some(s[k]);
-                    added = true;
-                }
-                None => failed = Some(s[k]),
-            }
-        }
+        let (added, waited) = find_keys(
+            &cx,
+            &now,
+            &axes,
+            (&mut keys, &mut lead_keys),
+            (&mut tried, &mut lifted),
+        );
         if !added {
             if waited {
                 continue;
@@ -425,6 +254,261 @@ pub(crate) fn tilt_run(
     (fewer && !new).then_some((axes, now))
 }
 
+/// One pass of key search along a run: for each move still colliding (`now`) at the axes
+/// `axes`, a key (a turn) that clears it, searched where none was yet; the travel points of the
+/// lead take keys of their own. Whether a key was added, and whether the search waited over
+/// moves after one it found no turn for.
+fn find_keys(
+    cx: &Run,
+    now: &[Option<Collision>],
+    axes: &[V3],
+    (keys, lead_keys): (&mut BTreeMap<usize, V3>, &mut BTreeMap<usize, V3>),
+    (tried, lifted): (&mut [bool], &mut [bool]),
+) -> (bool, bool) {
+    let Run {
+        scene,
+        run,
+        given,
+        allowed,
+        s,
+        limits,
+        lead,
+    } = *cx;
+    let none: BTreeMap<usize, V3> = BTreeMap::new();
+    let mut added = false;
+    // Where the last search along the bead found no turn: the moves just after it mostly
+    // meet the same obstacle, so the search waits [`RETRY_MM`] of path; those it passed
+    // over are tried in the next pass.
+    let mut failed: Option<f64> = None;
+    let mut waited = false;
+    // The last key found in this pass: moves closer after it than [`KEY_SPACING_MM`] wait
+    // for the blend, and are searched in the next pass if it leaves them colliding.
+    let mut found: Option<f64> = None;
+    for k in 0..run.len() {
+        let Some(c) = now[k] else { continue };
+        // Print moves; and travels into the lead or the bead start where the head
+        // collides at the point itself (no lift clears that).
+        let point = k <= lead && scene.at(run[k].p, axes[k]).is_some();
+        if k <= lead && !point {
+            continue;
+        }
+        if k < lead {
+            if lead_keys.contains_key(&k) || tried[k] {
+                continue;
+            }
+            tried[k] = true;
+            let at = Candidate {
+                k,
+                lead,
+                hits: c.hits,
+            };
+            if let Some(w) = search(scene, run, given, allowed, &none, s, at, limits) {
+                lead_keys.insert(k, w);
+                added = true;
+            }
+            continue;
+        }
+        // A key on the bead that still collides (its move starts from a blended axis):
+        // the point before it takes the same turn.
+        let (k, w, ahead) = match keys.get(&k) {
+            Some(&w)
+                if k > lead
+                    && !keys.contains_key(&(k - 1))
+                    && allowed[k - 1].holds(rotate(given[k - 1], w))
+                    && near(keys, s, k - 1, w, limits) =>
+            {
+                (k - 1, Some(w), true)
+            }
+            // Or a turn of its own, if none was searched there yet, or none that clears
+            // the head at the point alone.
+            Some(_)
+                if k > lead && !keys.contains_key(&(k - 1)) && !(tried[k - 1] && lifted[k - 1]) =>
+            {
+                (k - 1, None, true)
+            }
+            // Or, where the head meets something at the key's point itself, the least turn
+            // that clears it there.
+            Some(_) if !lifted[k] && scene.at(run[k].p, axes[k]).is_some() => (k, None, true),
+            Some(_) => continue,
+            None if tried[k] => continue,
+            None if k > lead && failed.is_some_and(|f| s[k] - f < RETRY_MM) => {
+                waited = true;
+                continue;
+            }
+            None if k > lead && found.is_some_and(|f| s[k] - f < KEY_SPACING_MM) => continue,
+            None => (k, None, false),
+        };
+        let searched = std::mem::replace(&mut tried[k], true);
+        let w = w.or_else(|| {
+            if searched {
+                return None;
+            }
+            let at = Candidate {
+                k,
+                lead,
+                hits: c.hits,
+            };
+            search(scene, run, given, allowed, keys, s, at, limits)
+        });
+        // Against the table, a move no one turn clears (its start needs a larger turn than
+        // its end allows, or the other way about): its start gets a key of its own first,
+        // the least turn towards the allowed axis nearest +Z that clears the head there,
+        // and the move is searched again from it.
+        let w = match w {
+            None if !searched
+                && c.hits == Obstacle::Table
+                && k > lead
+                && !keys.contains_key(&(k - 1)) =>
+            {
+                key_at_start(cx, keys, k, c.hits)
+            }
+            // Or, where the key at its start holds the turn back (the slope between them),
+            // one turn for both: that key moved to it.
+            None if !searched && c.hits == Obstacle::Table && k > lead => {
+                key_moved_to(cx, keys, k, c.hits)
+            }
+            w => w,
+        };
+        // The point before a key whose move still collides, when no turn clears the move
+        // into it: turned so the head clears it there at least, which the move from it
+        // needs.
+        let w = match w {
+            None if ahead && !std::mem::replace(&mut lifted[k], true) => {
+                lift_before_key(cx, keys, k)
+            }
+            w => w,
+        };
+        match w {
+            Some(w) => {
+                keys.insert(k, w);
+                found = Some(s[k]);
+                added = true;
+            }
+            None => failed = Some(s[k]),
+        }
+    }
+    (added, waited)
+}
+
+/// What one continuous path's key search reads: the scene, the run (`lead` travel points
+/// before its bead start), its given axes and allowed axes, its arc lengths and the limits.
+#[derive(Clone, Copy)]
+struct Run<'a> {
+    scene: &'a Scene,
+    run: &'a [PathPoint],
+    given: &'a [V3],
+    allowed: &'a [Allowed],
+    s: &'a [f64],
+    limits: &'a TiltLimits,
+    lead: usize,
+}
+
+/// Against the table, a move `k` no one turn clears: its start gets a key of its own first, the
+/// least turn towards the allowed axis nearest +Z that clears the head there, and the move is
+/// searched again from it; else both ends turned all the way to their highest allowed axes.
+fn key_at_start(cx: &Run, keys: &mut BTreeMap<usize, V3>, k: usize, hits: Obstacle) -> Option<V3> {
+    let Run {
+        scene,
+        run,
+        given,
+        allowed,
+        s,
+        limits,
+        lead,
+    } = *cx;
+    let start = lift(scene, run[k - 1].p, given[k - 1], &allowed[k - 1], |w| {
+        near(keys, s, k - 1, w, limits)
+    });
+    start
+        .and_then(|w0| {
+            keys.insert(k - 1, w0);
+            let at = Candidate { k, lead, hits };
+            let w = search(scene, run, given, allowed, keys, s, at, limits);
+            if w.is_none() {
+                keys.remove(&(k - 1));
+            }
+            w
+        })
+        .or_else(|| {
+            // Else both ends turned all the way to their highest allowed axes.
+            let w0 = towards(given[k - 1], allowed[k - 1].highest());
+            let w1 = towards(given[k], allowed[k].highest());
+            let (a0, a1) = (rotate(given[k - 1], w0), rotate(given[k], w1));
+            let clear = near(keys, s, k - 1, w0, limits)
+                && (k - 1 > lead || scene.at(run[k - 1].p, a0).is_none())
+                && scene.sweep(run[k - 1].p, a0, run[k].p, a1).is_none();
+            if !clear {
+                return None;
+            }
+            keys.insert(k - 1, w0);
+            if near(keys, s, k, w1, limits) {
+                Some(w1)
+            } else {
+                keys.remove(&(k - 1));
+                None
+            }
+        })
+}
+
+/// Where the key at the start of move `k` holds the turn back (the slope between them), one
+/// turn for both: that key moved to it.
+fn key_moved_to(cx: &Run, keys: &mut BTreeMap<usize, V3>, k: usize, hits: Obstacle) -> Option<V3> {
+    let Run {
+        scene,
+        run,
+        given,
+        allowed,
+        s,
+        limits,
+        lead,
+    } = *cx;
+    let old = keys.remove(&(k - 1));
+    let at = Candidate { k, lead, hits };
+    let w = search(scene, run, given, allowed, keys, s, at, limits).filter(|&w| {
+        allowed[k - 1].holds(rotate(given[k - 1], w)) && near(keys, s, k - 1, w, limits)
+    });
+    match (w, old) {
+        (Some(w), _) => {
+            keys.insert(k - 1, w);
+        }
+        (None, Some(old)) => {
+            keys.insert(k - 1, old);
+        }
+        (None, None) => {}
+    }
+    w
+}
+
+/// The point `k` before a key whose move still collides, when no turn clears the move into it:
+/// turned so the head clears it there at least, which the move from it needs.
+fn lift_before_key(cx: &Run, keys: &mut BTreeMap<usize, V3>, k: usize) -> Option<V3> {
+    let Run {
+        scene,
+        run,
+        given,
+        allowed,
+        s,
+        limits,
+        lead,
+    } = *cx;
+    lift(scene, run[k].p, given[k], &allowed[k], |w| {
+        near(keys, s, k, w, limits)
+    })
+    .or_else(|| {
+        // Where the key just before it holds the turn back (the slope between
+        // them), that key moved to the same turn.
+        let j = k.checked_sub(1).filter(|&j| j >= lead)?;
+        let old = keys.remove(&j)?;
+        let w = lift(scene, run[k].p, given[k], &allowed[k], |w| {
+            near(keys, s, k, w, limits)
+                && allowed[j].holds(rotate(given[j], w))
+                && near(keys, s, j, w, limits)
+        });
+        keys.insert(j, w.unwrap_or(old));
+        w
+    })
+}
+
 /// The least turn of the axis `a` at `tip`, towards the allowed axis nearest +Z in steps of
 /// [`FINE_STEP_DEG`], that keeps it allowed, passes `fits` and clears the head there; `None`
 /// when none does (at once when that axis meets the table).
@@ -457,7 +541,7 @@ fn near(keys: &BTreeMap<usize, V3>, s: &[f64], k: usize, w: V3, limits: &TiltLim
     let next = keys.range(k + 1..).next();
     [prev, next].into_iter().flatten().all(|(&j, &wj)| {
         let gap = (s[j] - s[k]).abs();
-        gap > 2.0 * limits.window_mm || norm(sub(w, wj)) <= limits.slope() * gap + SLACK
+        gap > 2.0 * limits.window_mm || norm(sub(w, wj)) <= limits.slope() * gap + ANGLE_SLACK
     })
 }
 
@@ -578,7 +662,7 @@ fn search(
 /// is at most the keys' largest turn over `window`, or the change between two keys over their
 /// distance.
 pub fn blend(keys: &BTreeMap<usize, V3>, s: &[f64], window: f64) -> Vec<V3> {
-    let w = window.max(1e-9);
+    let w = window.max(WINDOW_FLOOR);
     (0..s.len())
         .map(|j| {
             let prev = keys.range(..=j).next_back();
@@ -611,7 +695,7 @@ pub fn blend(keys: &BTreeMap<usize, V3>, s: &[f64], window: f64) -> Vec<V3> {
 /// `a` turned by `w`, or by the largest share of `w` (halved down to a 256th) that stays
 /// allowed; `a` itself when it is not allowed.
 fn apply(a: V3, w: V3, allowed: &Allowed) -> V3 {
-    if norm(w) < 1e-15 || !allowed.holds(a) {
+    if norm(w) < TURN_ZERO || !allowed.holds(a) {
         return a;
     }
     let b = rotate(a, w);

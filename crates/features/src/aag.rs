@@ -129,7 +129,7 @@ pub fn build(brep: &Brep, faces: &[FaceId], mesh: &Mesh, smooth_deg: f64) -> Aag
                 } else {
                     w
                 };
-                d.try_normalize(1e-300)
+                d.try_normalize(crate::tolerance::NORMALISABLE)
             };
             let (Some(d1), Some(d2)) = (into(c1), into(c2)) else {
                 continue;

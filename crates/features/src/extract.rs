@@ -231,11 +231,6 @@ pub fn extract(
         .into_iter()
         .map(|(f, v, a)| (f, (v, a)))
         .collect();
-    let vol_of = |shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]| {
-        fs.iter()
-            .map(|f| shares.get(f).map_or(0.0, |s| s.0))
-            .sum::<f64>()
-    };
     let part_volume =
         vol_of(&shares, &outer).abs() - voids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
     let part_area: f64 = all_faces
@@ -249,8 +244,184 @@ pub fn extract(
     // curve), wherever they sit in the faces' loops; and holes in a face bounded by tangent edges
     // where the face across climbs off the host (a root blended by a concave fillet, which then
     // goes with what grows there).
-    let mut chains: Vec<Vec<EdgeId>> = concave_chains(&b, &outer, &graph);
-    for &f in &outer {
+    let chains = candidate_roots(&b, &outer, &graph, &mopts, &mut warnings)?;
+
+    // Split, heal, repeat. The parent side of a cut holds the draft's anchor: the build-plate
+    // face for the base, the healing faces for a feature split off before.
+    let plate = base_reference(&b, &outer, &mut vec![]).face;
+    let tol = split::Tol::for_size(diag);
+    let mut drafts = vec![Draft {
+        faces: outer.clone(),
+        host: None,
+        heal: vec![],
+    }];
+    let mut ctx = SplitCtx {
+        b: &mut b,
+        shares: &mut shares,
+        origin,
+        mopts: &mopts,
+        tol,
+    };
+    let outcome = split_drafts(&mut ctx, &mut drafts, &chains, plate);
+    let roots = root_loops(part, &chains, outcome, &mut warnings);
+
+    // Shells, parents, measures.
+    let owner: HashMap<FaceId, usize> = drafts
+        .iter()
+        .enumerate()
+        .flat_map(|(k, d)| d.faces.iter().map(move |f| (*f, k)))
+        .collect();
+    // The solid check meshes each feature again: coarser than the analysis mesh, since it asks
+    // only whether every face meshes, the mesh closes and the volume is positive.
+    let check_opts = analysis_options(diag * 4.0);
+    // Each void shell goes with the feature whose shell holds it (the base where none does).
+    let void_owner = void_owners(&b, &drafts, &voids, &check_opts);
+    if !voids.is_empty() {
+        let elsewhere = void_owner.iter().filter(|&&k| k != 0).count();
+        warnings.insert(
+            0,
+            if elsewhere == 0 {
+                format!("{} void shell(s) kept with the base feature", voids.len())
+            } else {
+                format!(
+                    "{} void shell(s) kept with the features holding them ({elsewhere} not in the base)",
+                    voids.len()
+                )
+            },
+        );
+    }
+    let mut features = vec![];
+    for (k, d) in drafts.iter().enumerate() {
+        features.push(make_feature(
+            &mut b,
+            (k, d),
+            (&voids, &void_owner),
+            &shares,
+            &owner,
+            &check_opts,
+            &mut warnings,
+        ));
+    }
+
+    // Order and depth: parents first, and among features ready together the lowest id first
+    // (Kahn's algorithm), so the order reads like the tree.
+    let build_order = build_order(&mut features, &mut warnings);
+    let depth = features.iter().map(|f| f.depth).max().unwrap_or(0);
+    let sum: f64 = features.iter().map(|f| f.volume).sum();
+    if (sum - part_volume).abs() > 5e-3 * part_volume.abs().max(crate::tolerance::VOLUME_FLOOR) {
+        warnings.push(format!(
+            "feature volumes add up to {sum:.3} mm^3, the part has {part_volume:.3} mm^3"
+        ));
+    }
+    Ok(FeatureTree {
+        brep: b,
+        solid,
+        features,
+        build_order,
+        depth,
+        part_volume,
+        part_area,
+        part_faces: all_faces.len(),
+        genus,
+        mesh,
+        roots,
+        warnings,
+    })
+}
+
+/// The volume (mm³) the faces' shares enclose, signed by their orientation.
+fn vol_of(shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]) -> f64 {
+    fs.iter()
+        .map(|f| shares.get(f).map_or(0.0, |s| s.0))
+        .sum::<f64>()
+}
+
+/// Feature `k` made of draft `d`: its shell added to the B-rep, the voids it holds, its
+/// volume, whether it is a valid solid, its parents (the owner of its host face) and reference,
+/// and its kind.
+fn make_feature(
+    b: &mut Brep,
+    (k, d): (usize, &Draft),
+    (voids, void_owner): (&[Vec<FaceId>], &[usize]),
+    shares: &HashMap<FaceId, (f64, f64)>,
+    owner: &HashMap<FaceId, usize>,
+    check_opts: &brep::mesh::MeshOptions,
+    warnings: &mut Vec<String>,
+) -> Feature {
+    let shell = ShellId(b.shells.len() as u32);
+    b.shells.push(Shell {
+        step_id: 0,
+        faces: d.faces.clone(),
+        void: false,
+    });
+    for f in &d.faces {
+        b.faces[f.idx()].shell = shell;
+    }
+    let fvoids: Vec<Vec<FaceId>> = voids
+        .iter()
+        .zip(void_owner)
+        .filter(|(_, &o)| o == k)
+        .map(|(v, _)| v.clone())
+        .collect();
+    let volume = vol_of(shares, &d.faces).abs()
+        - fvoids.iter().map(|v| vol_of(shares, v).abs()).sum::<f64>();
+    let problems = crate::check::check_solid(b, &d.faces, &fvoids, check_opts).problems;
+    let closed = problems.is_empty();
+    if !closed {
+        let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();
+        warnings.push(format!(
+            "feature {k} is not a valid solid: {}{}",
+            list.join("; "),
+            if problems.len() > 4 { "; ..." } else { "" }
+        ));
+    }
+    let (parents, reference) = match &d.host {
+        Some((t, _)) => {
+            let p = owner.get(t).copied().into_iter().collect();
+            (p, host_reference(b, *t))
+        }
+        None => (vec![], base_reference(b, &d.faces, warnings)),
+    };
+    let kind = if reference.surface == "plane" || reference.surface == "build_plate" {
+        FeatureKind::Two5d
+    } else {
+        FeatureKind::Freeform
+    };
+    let subtype = match kind {
+        FeatureKind::Two5d => two5d_subtype(b, &d.faces, &reference),
+        FeatureKind::Freeform => "brep_freeform".to_string(),
+    };
+    Feature {
+        id: k,
+        kind,
+        subtype,
+        reference,
+        parents,
+        faces: d.faces.clone(),
+        voids: fvoids,
+        heal_faces: d.heal.clone(),
+        shell,
+        volume,
+        root_loops: d.host.map_or(0, |h| h.1),
+        depth: 0,
+        closed,
+        problems,
+    }
+}
+
+/// Candidate roots: closed chains of concave edges (a boss's root circle, a blade's root
+/// curve), wherever they sit in the faces' loops; and holes in a face bounded by tangent edges
+/// where the face across climbs off the host (a root blended by a concave fillet, which then
+/// goes with what grows there).
+fn candidate_roots(
+    b: &Brep,
+    outer: &[FaceId],
+    graph: &aag::Aag,
+    mopts: &brep::mesh::MeshOptions,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Vec<EdgeId>>, ExtractError> {
+    let mut chains: Vec<Vec<EdgeId>> = concave_chains(b, outer, graph);
+    for &f in outer {
         let tangent_loop = b.face(f).loops.iter().any(|l| {
             let cs = &b.loops[l.idx()].coedges;
             !cs.is_empty()
@@ -261,7 +432,7 @@ pub fn extract(
         if !tangent_loop {
             continue;
         }
-        for (l, role) in loop_roles(&b, f, &mopts)? {
+        for (l, role) in loop_roles(b, f, mopts)? {
             if role != LoopRole::Inner {
                 continue;
             }
@@ -292,16 +463,18 @@ pub fn extract(
             }
         }
     }
+    Ok(chains)
+}
 
-    // Split, heal, repeat. The parent side of a cut holds the draft's anchor: the build-plate
-    // face for the base, the healing faces for a feature split off before.
-    let plate = base_reference(&b, &outer, &mut vec![]).face;
-    let tol = split::Tol::for_size(diag);
-    let mut drafts = vec![Draft {
-        faces: outer.clone(),
-        host: None,
-        heal: vec![],
-    }];
+/// Split, heal, repeat: each draft, base first, is cut along the live chains lying on its faces
+/// (one at a time with the chains it encloses, then all together for genus > 0) until none
+/// splits; what became of each chain.
+fn split_drafts(
+    ctx: &mut SplitCtx,
+    drafts: &mut Vec<Draft>,
+    chains: &[Vec<EdgeId>],
+    plate: Option<FaceId>,
+) -> Vec<Option<RootOutcome>> {
     let mut outcome: Vec<Option<RootOutcome>> = vec![None; chains.len()];
     let mut i = 0;
     while i < drafts.len() {
@@ -310,9 +483,11 @@ pub fn extract(
             let live: Vec<usize> = (0..chains.len())
                 .filter(|&k| {
                     outcome[k].is_none()
-                        && chains[k]
-                            .iter()
-                            .all(|e| split::edge_faces(&b, *e).iter().any(|f| here.contains(f)))
+                        && chains[k].iter().all(|e| {
+                            split::edge_faces(ctx.b, *e)
+                                .iter()
+                                .any(|f| here.contains(f))
+                        })
                 })
                 .collect();
             if live.is_empty() {
@@ -323,20 +498,13 @@ pub fn extract(
             } else {
                 drafts[i].heal.clone()
             };
-            let mut ctx = SplitCtx {
-                b: &mut b,
-                shares: &mut shares,
-                origin,
-                mopts: &mopts,
-                tol,
-            };
             let mut split_made = false;
             let mut refusals: Vec<(usize, split::Refusal)> = vec![];
             // One chain at a time, with the chains bounding any face it would wrongly take
             // along (the plate's top inside a tube).
             for &k in &live {
-                let group = ctx.with_enclosed(&drafts[i].faces, &anchor, &chains, &live, k);
-                match ctx.split(&mut drafts, i, &anchor, &chains, &group) {
+                let group = ctx.with_enclosed(&drafts[i].faces, &anchor, chains, &live, k);
+                match ctx.split(drafts, i, &anchor, chains, &group) {
                     Ok(f) => {
                         for &g in &group {
                             outcome[g] = Some(RootOutcome::Split(f));
@@ -352,7 +520,7 @@ pub fn extract(
             }
             // Genus > 0: all live chains together (an arch standing on two feet, a collar).
             if live.len() > 1 {
-                if let Ok(f) = ctx.split(&mut drafts, i, &anchor, &chains, &live) {
+                if let Ok(f) = ctx.split(drafts, i, &anchor, chains, &live) {
                     for &k in &live {
                         outcome[k] = Some(RootOutcome::Split(f));
                     }
@@ -368,6 +536,16 @@ pub fn extract(
         }
         i += 1;
     }
+    outcome
+}
+
+/// The root loops, by the part's edge ids, with what became of each; a warning for each kept.
+fn root_loops(
+    part: &Brep,
+    chains: &[Vec<EdgeId>],
+    outcome: Vec<Option<RootOutcome>>,
+    warnings: &mut Vec<String>,
+) -> Vec<RootLoop> {
     let roots: Vec<RootLoop> = chains
         .iter()
         .zip(outcome)
@@ -392,101 +570,16 @@ pub fn extract(
             ));
         }
     }
+    roots
+}
 
-    // Shells, parents, measures.
-    let owner: HashMap<FaceId, usize> = drafts
-        .iter()
-        .enumerate()
-        .flat_map(|(k, d)| d.faces.iter().map(move |f| (*f, k)))
-        .collect();
-    // The solid check meshes each feature again: coarser than the analysis mesh, since it asks
-    // only whether every face meshes, the mesh closes and the volume is positive.
-    let check_opts = analysis_options(diag * 4.0);
-    // Each void shell goes with the feature whose shell holds it (the base where none does).
-    let void_owner = void_owners(&b, &drafts, &voids, &check_opts);
-    if !voids.is_empty() {
-        let elsewhere = void_owner.iter().filter(|&&k| k != 0).count();
-        warnings.insert(
-            0,
-            if elsewhere == 0 {
-                format!("{} void shell(s) kept with the base feature", voids.len())
-            } else {
-                format!(
-                    "{} void shell(s) kept with the features holding them ({elsewhere} not in the base)",
-                    voids.len()
-                )
-            },
-        );
-    }
-    let mut features = vec![];
-    for (k, d) in drafts.iter().enumerate() {
-        let shell = ShellId(b.shells.len() as u32);
-        b.shells.push(Shell {
-            step_id: 0,
-            faces: d.faces.clone(),
-            void: false,
-        });
-        for f in &d.faces {
-            b.faces[f.idx()].shell = shell;
-        }
-        let fvoids: Vec<Vec<FaceId>> = voids
-            .iter()
-            .zip(&void_owner)
-            .filter(|(_, &o)| o == k)
-            .map(|(v, _)| v.clone())
-            .collect();
-        let volume = vol_of(&shares, &d.faces).abs()
-            - fvoids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
-        let problems = crate::check::check_solid(&b, &d.faces, &fvoids, &check_opts).problems;
-        let closed = problems.is_empty();
-        if !closed {
-            let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();
-            warnings.push(format!(
-                "feature {k} is not a valid solid: {}{}",
-                list.join("; "),
-                if problems.len() > 4 { "; ..." } else { "" }
-            ));
-        }
-        let (parents, reference) = match &d.host {
-            Some((t, _)) => {
-                let p = owner.get(t).copied().into_iter().collect();
-                (p, host_reference(&b, *t))
-            }
-            None => (vec![], base_reference(&b, &d.faces, &mut warnings)),
-        };
-        let kind = if reference.surface == "plane" || reference.surface == "build_plate" {
-            FeatureKind::Two5d
-        } else {
-            FeatureKind::Freeform
-        };
-        let subtype = match kind {
-            FeatureKind::Two5d => two5d_subtype(&b, &d.faces, &reference),
-            FeatureKind::Freeform => "brep_freeform".to_string(),
-        };
-        features.push(Feature {
-            id: k,
-            kind,
-            subtype,
-            reference,
-            parents,
-            faces: d.faces.clone(),
-            voids: fvoids,
-            heal_faces: d.heal.clone(),
-            shell,
-            volume,
-            root_loops: d.host.map_or(0, |h| h.1),
-            depth: 0,
-            closed,
-            problems,
-        });
-    }
-
-    // Order and depth: parents first, and among features ready together the lowest id first
-    // (Kahn's algorithm), so the order reads like the tree.
+/// Order and depth: parents first, and among features ready together the lowest id first
+/// (Kahn's algorithm), so the order reads like the tree; each feature's depth set from it.
+fn build_order(features: &mut [Feature], warnings: &mut Vec<String>) -> Vec<usize> {
     // Each feature's children (one entry per parent link, in link order) and parent-link count.
     let mut children: Vec<Vec<usize>> = vec![vec![]; features.len()];
     let mut indegree: Vec<usize> = vec![0; features.len()];
-    for f in &features {
+    for f in features.iter() {
         for &p in &f.parents {
             children[p].push(f.id);
             indegree[f.id] += 1;
@@ -520,27 +613,7 @@ pub fn extract(
             .unwrap_or(0);
         features[k].depth = d;
     }
-    let depth = features.iter().map(|f| f.depth).max().unwrap_or(0);
-    let sum: f64 = features.iter().map(|f| f.volume).sum();
-    if (sum - part_volume).abs() > 5e-3 * part_volume.abs().max(1e-9) {
-        warnings.push(format!(
-            "feature volumes add up to {sum:.3} mm^3, the part has {part_volume:.3} mm^3"
-        ));
-    }
-    Ok(FeatureTree {
-        brep: b,
-        solid,
-        features,
-        build_order,
-        depth,
-        part_volume,
-        part_area,
-        part_faces: all_faces.len(),
-        genus,
-        mesh,
-        roots,
-        warnings,
-    })
+    build_order
 }
 
 /// Closed chains of concave edges: connected sets of concave edges in which every vertex joins
@@ -846,7 +919,8 @@ impl SplitCtx<'_> {
             shares.insert(f, (v, a));
         }
         let (pv, cv) = (vol(&shares, &s.parent), vol(&shares, &s.child));
-        let conserved = (pv + cv - before).abs() <= 2e-3 * before.abs() + 1e-9;
+        let conserved =
+            (pv + cv - before).abs() <= 2e-3 * before.abs() + crate::tolerance::VOLUME_SLACK;
         if pv * before <= 0.0 || cv * before <= 0.0 || !conserved {
             *self.b = saved;
             return Err(split::Refusal::Invalid(format!(

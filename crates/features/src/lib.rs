@@ -9,6 +9,7 @@ pub mod assembly;
 pub mod check;
 pub mod extract;
 pub mod split;
+mod tolerance;
 
 pub use assembly::{extract_all, solid_name, Assembly};
 pub use check::{check_solid, SolidCheck, SolidProblem};

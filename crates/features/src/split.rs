@@ -11,6 +11,7 @@
 //! gets faces on the host surface, facing the other way, bounded by the roots (one face per
 //! outer root, with the roots it encloses as holes).
 
+use crate::tolerance::{EMPTY_SPAN, PERIOD_SLACK};
 use brep::math::P3;
 use brep::mesh::{face_domain, MeshOptions};
 use brep::topology::*;
@@ -389,16 +390,16 @@ fn continuation(b: &Brep, i: &Use, o: &Use, tol: Tol) -> Option<(f64, f64)> {
     if let Some(per) = c.period() {
         // o starts at or past i's end, within one turn.
         a = ti1 + s * (s * (a - ti1)).rem_euclid(per);
-        if (a - ti1).abs() > per - 1e-9 {
+        if (a - ti1).abs() > per - PERIOD_SLACK {
             a = ti1;
         }
         z = a + s * (s * (z - a)).rem_euclid(per);
-        if (z - a).abs() < 1e-12 {
+        if (z - a).abs() < EMPTY_SPAN {
             z = a + s * per;
         }
     }
     let tm = 0.5 * (a + z);
-    if !on(&mid, tm) || (z - a) * s <= 0.0 || (a - ti1) * s < -1e-9 {
+    if !on(&mid, tm) || (z - a) * s <= 0.0 || (a - ti1) * s < -PERIOD_SLACK {
         return None;
     }
     Some((z, (a - ti1).abs()))
@@ -416,6 +417,126 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
         .map(|(k, f)| (*f, k))
         .collect();
     // Every kept use, its successor where known, and the gaps the roots leave.
+    let RootCut {
+        mut uses,
+        mut next,
+        into,
+        out_of,
+        kept_loops,
+        vertex_faces,
+    } = cut_at_roots(b, group, &chain);
+    // (a) A piece of boundary cut short by a root continues along its curve past the gap: the
+    // two pieces become one edge (`i` takes the merged use, `o` goes).
+    let Joins {
+        mut into_left,
+        mut out_left,
+        skip,
+        mut links,
+    } = join_continuations(b, &mut uses, &mut next, (&into, &out_of), tol);
+    // (b) Ends that meet at a vertex of the root join directly, a piece and its own way back
+    // first (a seam that ran into the root; the pair cancels below).
+    let mut lefts: Vec<usize> = into_left.iter().copied().collect();
+    lefts.sort_unstable();
+    for i in lefts {
+        let end = use_end(b, &uses[i]);
+        let mut outs: Vec<usize> = out_left
+            .iter()
+            .copied()
+            .filter(|&o| use_start(b, &uses[o]) == end)
+            .collect();
+        outs.sort_by_key(|&o| (uses[o].edge != uses[i].edge, o));
+        if let Some(&o) = outs.first() {
+            into_left.remove(&i);
+            out_left.remove(&o);
+            next[i] = Some(o);
+            links.push((i, o));
+        }
+    }
+    if !into_left.is_empty() || !out_left.is_empty() {
+        return Err(Refusal::Heal(format!(
+            "{} boundary piece(s) end on the root with nothing to join",
+            into_left.len().max(out_left.len())
+        )));
+    }
+    // Faces joined through a root become one.
+    let mut uf = UnionFind::new(group.faces.len());
+    for (k, u) in uses.iter().enumerate() {
+        if skip.contains(&k) {
+            continue;
+        }
+        if let Some(n) = next[k] {
+            uf.union(fidx[&u.face], fidx[&uses[n].face]);
+        }
+    }
+    for (i, o) in &links {
+        uf.union(fidx[&uses[*i].face], fidx[&uses[*o].face]);
+    }
+    let class: Vec<usize> = (0..group.faces.len()).map(|k| uf.find(k)).collect();
+    // Walk the cycles.
+    let mut seen = vec![false; uses.len()];
+    let mut loops_by_class: HashMap<usize, Vec<Vec<(EdgeId, bool)>>> = HashMap::new();
+    for s in 0..uses.len() {
+        if seen[s] || skip.contains(&s) {
+            continue;
+        }
+        let mut cyc = vec![];
+        let mut k = s;
+        while !seen[k] {
+            seen[k] = true;
+            cyc.push((uses[k].edge, uses[k].fwd));
+            match next[k] {
+                Some(n) if !skip.contains(&n) => k = n,
+                _ => return Err(Refusal::Heal("the host's boundary does not close".into())),
+            }
+        }
+        if k != s {
+            return Err(Refusal::Heal("the host's boundary does not close".into()));
+        }
+        cancel_spikes(&mut cyc);
+        if !cyc.is_empty() {
+            loops_by_class
+                .entry(class[fidx[&uses[s].face]])
+                .or_default()
+                .push(cyc);
+        }
+    }
+    // A closed edge that is a whole loop on its own, once each way in one face, is a seam the
+    // face no longer needs (two faces either side of a torus's seam circle, joined).
+    drop_seam_pairs(&mut loops_by_class);
+    for (f, seq) in kept_loops {
+        loops_by_class.entry(class[fidx[&f]]).or_default().push(seq);
+    }
+    let mut out = vec![];
+    let mut done: HashSet<usize> = HashSet::new();
+    for (k, &f) in group.faces.iter().enumerate() {
+        if !done.insert(class[k]) {
+            continue;
+        }
+        let mut loops = loops_by_class.remove(&class[k]).unwrap_or_default();
+        let has_vertex = vertex_faces.iter().any(|g| class[fidx[g]] == class[k]);
+        if loops.is_empty() && !has_vertex {
+            continue;
+        }
+        loops.sort_by_key(|l| std::cmp::Reverse(l.len()));
+        out.push((f, loops));
+    }
+    Ok(out)
+}
+
+/// A group's host loops cut at the roots: every kept use, its successor where known, and the
+/// gaps the roots leave (`into[k]` is the use before a gap, `out_of[k]` the one after it); the
+/// loops no root touches; the faces with a vertex loop.
+struct RootCut {
+    uses: Vec<Use>,
+    next: Vec<Option<usize>>,
+    into: Vec<usize>,
+    out_of: Vec<usize>,
+    kept_loops: Vec<(FaceId, Vec<(EdgeId, bool)>)>,
+    vertex_faces: Vec<FaceId>,
+}
+
+/// Cuts the loops of a group's host faces at the root edges `chain`.
+fn cut_at_roots(b: &Brep, group: &HostGroup, chain: &HashSet<EdgeId>) -> RootCut {
     let mut uses: Vec<Use> = vec![];
     let mut next: Vec<Option<usize>> = vec![];
     let mut into: Vec<usize> = vec![];
@@ -480,11 +601,37 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
             }
         }
     }
-    // (a) A piece of boundary cut short by a root continues along its curve past the gap: the
-    // two pieces become one edge (`i` takes the merged use, `o` goes).
+    RootCut {
+        uses,
+        next,
+        into,
+        out_of,
+        kept_loops,
+        vertex_faces,
+    }
+}
+
+/// The gaps left after continuing pieces along their curves: the uses before and after a gap
+/// still open, the uses merged away, and the joins made (before, after).
+struct Joins {
+    into_left: HashSet<usize>,
+    out_left: HashSet<usize>,
+    skip: HashSet<usize>,
+    links: Vec<(usize, usize)>,
+}
+
+/// (a) A piece of boundary cut short by a root continues along its curve past the gap: the two
+/// pieces become one edge (`i` takes the merged use, `o` goes), the nearest continuations first.
+fn join_continuations(
+    b: &mut Brep,
+    uses: &mut [Use],
+    next: &mut [Option<usize>],
+    (into, out_of): (&[usize], &[usize]),
+    tol: Tol,
+) -> Joins {
     let mut cands: Vec<(f64, usize, usize, f64)> = vec![];
-    for &i in &into {
-        for &o in &out_of {
+    for &i in into {
+        for &o in out_of {
             if let Some((z, gap)) = continuation(b, &uses[i], &uses[o], tol) {
                 cands.push((gap, i, o, z));
             }
@@ -560,75 +707,17 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
             next[i] = Some(i);
         }
     }
-    // (b) Ends that meet at a vertex of the root join directly, a piece and its own way back
-    // first (a seam that ran into the root; the pair cancels below).
-    let mut lefts: Vec<usize> = into_left.iter().copied().collect();
-    lefts.sort_unstable();
-    for i in lefts {
-        let end = use_end(b, &uses[i]);
-        let mut outs: Vec<usize> = out_left
-            .iter()
-            .copied()
-            .filter(|&o| use_start(b, &uses[o]) == end)
-            .collect();
-        outs.sort_by_key(|&o| (uses[o].edge != uses[i].edge, o));
-        if let Some(&o) = outs.first() {
-            into_left.remove(&i);
-            out_left.remove(&o);
-            next[i] = Some(o);
-            links.push((i, o));
-        }
+    Joins {
+        into_left,
+        out_left,
+        skip,
+        links,
     }
-    if !into_left.is_empty() || !out_left.is_empty() {
-        return Err(Refusal::Heal(format!(
-            "{} boundary piece(s) end on the root with nothing to join",
-            into_left.len().max(out_left.len())
-        )));
-    }
-    // Faces joined through a root become one.
-    let mut uf = UnionFind::new(group.faces.len());
-    for (k, u) in uses.iter().enumerate() {
-        if skip.contains(&k) {
-            continue;
-        }
-        if let Some(n) = next[k] {
-            uf.union(fidx[&u.face], fidx[&uses[n].face]);
-        }
-    }
-    for (i, o) in &links {
-        uf.union(fidx[&uses[*i].face], fidx[&uses[*o].face]);
-    }
-    let class: Vec<usize> = (0..group.faces.len()).map(|k| uf.find(k)).collect();
-    // Walk the cycles.
-    let mut seen = vec![false; uses.len()];
-    let mut loops_by_class: HashMap<usize, Vec<Vec<(EdgeId, bool)>>> = HashMap::new();
-    for s in 0..uses.len() {
-        if seen[s] || skip.contains(&s) {
-            continue;
-        }
-        let mut cyc = vec![];
-        let mut k = s;
-        while !seen[k] {
-            seen[k] = true;
-            cyc.push((uses[k].edge, uses[k].fwd));
-            match next[k] {
-                Some(n) if !skip.contains(&n) => k = n,
-                _ => return Err(Refusal::Heal("the host's boundary does not close".into())),
-            }
-        }
-        if k != s {
-            return Err(Refusal::Heal("the host's boundary does not close".into()));
-        }
-        cancel_spikes(&mut cyc);
-        if !cyc.is_empty() {
-            loops_by_class
-                .entry(class[fidx[&uses[s].face]])
-                .or_default()
-                .push(cyc);
-        }
-    }
-    // A closed edge that is a whole loop on its own, once each way in one face, is a seam the
-    // face no longer needs (two faces either side of a torus's seam circle, joined).
+}
+
+/// Drops the pairs of one-edge loops using a closed edge once each way in one face: a seam the
+/// face no longer needs.
+fn drop_seam_pairs(loops_by_class: &mut HashMap<usize, Vec<Vec<(EdgeId, bool)>>>) {
     for loops in loops_by_class.values_mut() {
         let single = |l: &Vec<(EdgeId, bool)>| (l.len() == 1).then(|| l[0]);
         let mut k = 0;
@@ -647,24 +736,6 @@ fn heal_hosts(b: &mut Brep, group: &HostGroup, tol: Tol) -> Result<Vec<HealedFac
             }
         }
     }
-    for (f, seq) in kept_loops {
-        loops_by_class.entry(class[fidx[&f]]).or_default().push(seq);
-    }
-    let mut out = vec![];
-    let mut done: HashSet<usize> = HashSet::new();
-    for (k, &f) in group.faces.iter().enumerate() {
-        if !done.insert(class[k]) {
-            continue;
-        }
-        let mut loops = loops_by_class.remove(&class[k]).unwrap_or_default();
-        let has_vertex = vertex_faces.iter().any(|g| class[fidx[g]] == class[k]);
-        if loops.is_empty() && !has_vertex {
-            continue;
-        }
-        loops.sort_by_key(|l| std::cmp::Reverse(l.len()));
-        out.push((f, loops));
-    }
-    Ok(out)
 }
 
 /// Removes adjacent uses of one edge in opposite directions (a seam that now leads nowhere).

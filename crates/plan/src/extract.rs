@@ -129,14 +129,14 @@ fn check_size(
     }
     if bead_mm > MAX_BEAD_KM * 1e6 {
         return Err(PlanError::TooBig {
-            volume_m3: volume * MM3_PER_M3_INV,
-            bead_km: bead_mm * KM_PER_MM,
+            volume_m3: volume / MM3_PER_M3,
+            bead_km: bead_mm / MM_PER_KM,
         });
     }
     Ok(())
 }
 
-/// m³ in a mm³.
-const MM3_PER_M3_INV: f64 = 1e-9;
-/// km in a mm.
-const KM_PER_MM: f64 = 1e-6;
+/// mm³ in a m³.
+const MM3_PER_M3: f64 = 1e9;
+/// mm in a km.
+const MM_PER_KM: f64 = 1e6;

@@ -19,6 +19,7 @@
 
 use crate::collisions::{self, Avoided};
 use crate::report::{round, FeatureEntry, FeatureReport, ReferenceEntry};
+use crate::tolerance::HEIGHT_SLACK;
 use brep::section::Plane;
 use collide::Obstacle;
 use features::FeatureTree;
@@ -41,10 +42,6 @@ const FACES_UP: f64 = 1.0 - 1e-6;
 
 /// Pedestals taller than the machine's tallest checked for the height a refusal names.
 const NAMED_TRIES: usize = 4;
-
-/// Heights (mm) within this of each other are one: a pedestal height a whole number of layers
-/// to within rounding.
-const HEIGHT_SLACK: f64 = 1e-9;
 
 /// Why a plan on a pedestal was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -24,14 +24,7 @@ use features::{extract_all, Assembly, ExtractOptions};
 /// How many candidate directions `--orient auto` tries.
 const CANDIDATES: usize = 8;
 
-/// A build direction whose z is below this points below the horizon.
-const BELOW_HORIZON_Z: f64 = -1e-3;
-
-/// Two planar faces' outward normals whose dot product exceeds this point the same way.
-const SAME_DIRECTION_DOT: f64 = 1.0 - 1e-9;
-
-/// A `down` whose z is below this already points down (−Z): the part stands as modelled.
-const STANDS_Z: f64 = -1.0 + 1e-12;
+use crate::tolerance::{BELOW_HORIZON_Z, SAME_DIRECTION_DOT, STANDS_Z};
 
 /// How the part is to stand on the plate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

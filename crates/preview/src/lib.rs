@@ -22,6 +22,7 @@
 mod encode;
 mod machine;
 mod marks;
+mod tolerance;
 
 use encode::{base64_f32, base64_u32};
 pub use machine::{HeadShape, MachineShape};

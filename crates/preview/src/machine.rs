@@ -3,6 +3,7 @@
 //! viewer draws as they are.
 
 use crate::encode::base64_f32;
+use crate::tolerance::AXIS_MIN_LENGTH;
 
 /// Segments of a circle drawn (the table's rim, the head's rings).
 const CIRCLE_SEGMENTS: usize = 48;
@@ -12,9 +13,6 @@ const BED_GRID_CELLS: usize = 10;
 
 /// Generator lines drawn along the head's cone and body.
 const HEAD_GENERATORS: usize = 8;
-
-/// A tool axis shorter than this is no direction; the head is drawn along +Z then.
-const AXIS_MIN_LENGTH: f64 = 1e-9;
 
 /// Largest cone half-angle drawn (degrees): a wider one would be a flat disc at infinity.
 const MAX_HALF_ANGLE_DEG: f64 = 85.0;

@@ -563,74 +563,7 @@ impl Run<'_> {
             return Ok(());
         }
         if let Some(rest) = upper.strip_prefix("PTP ").or(upper.strip_prefix("LIN ")) {
-            let motion = if upper.starts_with("PTP") {
-                Motion::Ptp
-            } else {
-                Motion::Lin
-            };
-            if !self.initialised {
-                return Err(err(file, line, "a motion before BAS (#INITMOV,0 )"));
-            }
-            let rest = rest.trim();
-            let (target, tail) = if rest.starts_with('{') {
-                let close = rest
-                    .find('}')
-                    .ok_or_else(|| err(file, line, "unclosed aggregate"))?;
-                let agg = &rest[..=close];
-                let target = if agg.contains("A1 ") {
-                    Target::Axis(aggregate(agg, &AXIS_KEYS).map_err(|r| err(file, line, r))?)
-                } else {
-                    Target::Frame(aggregate(agg, &FRAME_KEYS).map_err(|r| err(file, line, r))?)
-                };
-                (target, rest[close + 1..].trim())
-            } else {
-                let mut words = rest.split_whitespace();
-                let name = words.next().unwrap_or("").to_ascii_lowercase();
-                let axes = m
-                    .axes
-                    .get(&name)
-                    .or_else(|| {
-                        self.modules
-                            .get(&self.main)
-                            .and_then(|mm| mm.axes.get(&name))
-                    })
-                    .ok_or_else(|| err(file, line, format!("`{name}` is not declared")))?;
-                (Target::Axis(*axes), rest[name.len()..].trim())
-            };
-            let approximated = match (motion, tail) {
-                (_, "") => false,
-                (Motion::Lin, "C_DIS") => true,
-                _ => {
-                    return Err(err(
-                        file,
-                        line,
-                        format!("unexpected `{tail}` after the target"),
-                    ))
-                }
-            };
-            if matches!(target, Target::Frame(_))
-                && (self.out.base.is_none() || self.out.tool.is_none())
-            {
-                return Err(err(file, line, "a Cartesian motion before $BASE and $TOOL"));
-            }
-            if let Some(on) = self.pending.take() {
-                self.extruder = on;
-            }
-            if let Some(v) = self.pending_feed.take() {
-                self.feed = Some(v);
-            }
-            self.out.moves.push(KrlMove {
-                motion,
-                target,
-                approximated,
-                extruder: self.extruder,
-                vel_cp: self.vel,
-                feed: self.feed,
-                file: file.to_string(),
-                line,
-                note: s.note.clone(),
-            });
-            return Ok(());
+            return self.motion(m, s, &upper, rest);
         }
         if let Some(callee) = call_name(&s.text) {
             if self.stack.len() == 1 {
@@ -639,5 +572,87 @@ impl Run<'_> {
             return self.module(&callee);
         }
         Err(err(file, line, format!("unknown statement `{}`", s.text)))
+    }
+
+    /// A `PTP` or `LIN` statement (`rest` after the keyword, `upper` the whole upper-cased):
+    /// its target (an aggregate or a declared axis position), whether it is approximated, and
+    /// the extruder, feed and speed in force, as a move of the program.
+    fn motion(
+        &mut self,
+        m: &Module,
+        s: &Statement,
+        upper: &str,
+        rest: &str,
+    ) -> Result<(), KrlError> {
+        let file = m.src_file.as_str();
+        let line = s.line;
+        let motion = if upper.starts_with("PTP") {
+            Motion::Ptp
+        } else {
+            Motion::Lin
+        };
+        if !self.initialised {
+            return Err(err(file, line, "a motion before BAS (#INITMOV,0 )"));
+        }
+        let rest = rest.trim();
+        let (target, tail) = if rest.starts_with('{') {
+            let close = rest
+                .find('}')
+                .ok_or_else(|| err(file, line, "unclosed aggregate"))?;
+            let agg = &rest[..=close];
+            let target = if agg.contains("A1 ") {
+                Target::Axis(aggregate(agg, &AXIS_KEYS).map_err(|r| err(file, line, r))?)
+            } else {
+                Target::Frame(aggregate(agg, &FRAME_KEYS).map_err(|r| err(file, line, r))?)
+            };
+            (target, rest[close + 1..].trim())
+        } else {
+            let mut words = rest.split_whitespace();
+            let name = words.next().unwrap_or("").to_ascii_lowercase();
+            let axes = m
+                .axes
+                .get(&name)
+                .or_else(|| {
+                    self.modules
+                        .get(&self.main)
+                        .and_then(|mm| mm.axes.get(&name))
+                })
+                .ok_or_else(|| err(file, line, format!("`{name}` is not declared")))?;
+            (Target::Axis(*axes), rest[name.len()..].trim())
+        };
+        let approximated = match (motion, tail) {
+            (_, "") => false,
+            (Motion::Lin, "C_DIS") => true,
+            _ => {
+                return Err(err(
+                    file,
+                    line,
+                    format!("unexpected `{tail}` after the target"),
+                ))
+            }
+        };
+        if matches!(target, Target::Frame(_))
+            && (self.out.base.is_none() || self.out.tool.is_none())
+        {
+            return Err(err(file, line, "a Cartesian motion before $BASE and $TOOL"));
+        }
+        if let Some(on) = self.pending.take() {
+            self.extruder = on;
+        }
+        if let Some(v) = self.pending_feed.take() {
+            self.feed = Some(v);
+        }
+        self.out.moves.push(KrlMove {
+            motion,
+            target,
+            approximated,
+            extruder: self.extruder,
+            vel_cp: self.vel,
+            feed: self.feed,
+            file: file.to_string(),
+            line,
+            note: s.note.clone(),
+        });
+        Ok(())
     }
 }

@@ -31,6 +31,7 @@ pub mod marlin;
 pub mod placement;
 pub mod post;
 pub mod sink;
+mod tolerance;
 pub use toolpath;
 
 pub use delta5::{delta5, delta5_to, Delta5Geometry, Delta5Program, KinematicFigures};

@@ -262,6 +262,48 @@ impl MachineProfile {
                 return Err(bad(field, format!("must be below 500 °C, got {v}")));
             }
         }
+        self.validate_limits()?;
+        for (field, v) in [
+            ("fan_speed", self.fan_speed),
+            ("fan_first_layer", self.fan_first_layer),
+        ] {
+            if !(v.is_finite() && (0.0..=100.0).contains(&v)) {
+                return Err(bad(field, format!("must be a percentage 0..100, got {v}")));
+            }
+        }
+        for (field, text) in [
+            ("start_gcode", &self.start_gcode),
+            ("end_gcode", &self.end_gcode),
+        ] {
+            if let Some(reason) = text.as_deref().and_then(crate::custom::unknown_placeholder) {
+                return Err(bad(field, reason));
+            }
+        }
+        match (self.kind, &self.delta5, &self.kuka) {
+            (MachineKind::Delta5, None, _) => return Err(self.missing_table("[delta5]", "delta5")),
+            (MachineKind::Kuka, _, None) => return Err(self.missing_table("[kuka]", "kuka")),
+            _ => {}
+        }
+        self.head
+            .validate()
+            .map_err(|(field, reason)| bad(field, reason))?;
+        if let Some(d) = &self.delta5 {
+            d.validate(&self.name)?;
+        }
+        if let Some(k) = &self.kuka {
+            k.validate(&self.name)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the upper limits of the figures (past them a figure is a typo: mm for µm, mm/min
+    /// for mm/s) and that every speed is within the machine's largest feed.
+    fn validate_limits(&self) -> Result<(), PostError> {
+        let bad = |field: &'static str, reason: String| PostError::ProfileValue {
+            name: self.name.clone(),
+            field,
+            reason,
+        };
         // Figures past these are typos (mm for µm, mm/min for mm/s), and would make absurd
         // programs.
         for (field, v, max) in [
@@ -295,7 +337,7 @@ impl MachineProfile {
             ("travel_speed", self.travel_speed),
             ("retraction_speed", self.retraction_speed),
         ] {
-            if speed * 60.0 > max_feed + 1e-9 {
+            if speed * 60.0 > max_feed + crate::tolerance::FEED_SLACK {
                 return Err(bad(
                     field,
                     format!(
@@ -304,36 +346,6 @@ impl MachineProfile {
                     ),
                 ));
             }
-        }
-        for (field, v) in [
-            ("fan_speed", self.fan_speed),
-            ("fan_first_layer", self.fan_first_layer),
-        ] {
-            if !(v.is_finite() && (0.0..=100.0).contains(&v)) {
-                return Err(bad(field, format!("must be a percentage 0..100, got {v}")));
-            }
-        }
-        for (field, text) in [
-            ("start_gcode", &self.start_gcode),
-            ("end_gcode", &self.end_gcode),
-        ] {
-            if let Some(reason) = text.as_deref().and_then(crate::custom::unknown_placeholder) {
-                return Err(bad(field, reason));
-            }
-        }
-        match (self.kind, &self.delta5, &self.kuka) {
-            (MachineKind::Delta5, None, _) => return Err(self.missing_table("[delta5]", "delta5")),
-            (MachineKind::Kuka, _, None) => return Err(self.missing_table("[kuka]", "kuka")),
-            _ => {}
-        }
-        self.head
-            .validate()
-            .map_err(|(field, reason)| bad(field, reason))?;
-        if let Some(d) = &self.delta5 {
-            d.validate(&self.name)?;
-        }
-        if let Some(k) = &self.kuka {
-            k.validate(&self.name)?;
         }
         Ok(())
     }

@@ -1,6 +1,7 @@
 //! Where a post puts the part: the machine coordinates of the planned (part) coordinates.
 
 use crate::machine::MachineProfile;
+use crate::tolerance::ROUND_UP_SLACK;
 use crate::PostError;
 use toolpath::vec3::unit;
 use toolpath::{fixed, MoveKind, PathPoint, ToolPath};
@@ -44,7 +45,7 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
             round3(centre[0] - (lo[0] / 2.0 + hi[0] / 2.0)),
             round3(centre[1] - (lo[1] / 2.0 + hi[1] / 2.0)),
             // Up, never down: the lowest bead must not end below the plate.
-            ((-lo[2] - 1e-9) * 1000.0).ceil() / 1000.0,
+            ((-lo[2] - ROUND_UP_SLACK) * 1000.0).ceil() / 1000.0,
         ]
     };
 
@@ -203,6 +204,6 @@ pub fn table_offset(path: &ToolPath) -> [f64; 3] {
         round3(-(lo[0] / 2.0 + hi[0] / 2.0)),
         round3(-(lo[1] / 2.0 + hi[1] / 2.0)),
         // Up, never down: the lowest bead must not end below the table.
-        ((-lo[2] - 1e-9) * 1000.0).ceil() / 1000.0,
+        ((-lo[2] - ROUND_UP_SLACK) * 1000.0).ceil() / 1000.0,
     ]
 }

@@ -8,7 +8,10 @@
 
 use crate::error::PlanError;
 use crate::geom2d::{Point2, Region};
-use crate::tolerance::{DEGENERATE_LENGTH, MICROMETRE, SINGULAR_DET};
+use crate::tolerance::{
+    AREA_ELEMENT_MIN, CHART_RESIDUAL, DEGENERATE_LENGTH, FOOT_OFF_NORMAL, MICROMETRE,
+    PARAMETER_SLACK, PARAMETER_STEP, SINGULAR_DET,
+};
 use crate::top_field::TopField;
 use brep::math::{any_perpendicular, P3, V3};
 use brep::mesh::Mesh;
@@ -97,7 +100,7 @@ impl<'a> Chart<'a> {
                 for _ in 0..40 {
                     let f = self.surf.eval(uv.0, uv.1);
                     let r = [q[0] - (f - c).dot(&e1), q[1] - (f - c).dot(&e2)];
-                    if r[0].abs() + r[1].abs() < 1e-10 {
+                    if r[0].abs() + r[1].abs() < CHART_RESIDUAL {
                         return Some(uv);
                     }
                     x = f + e1 * r[0] + e2 * r[1];
@@ -144,7 +147,9 @@ impl<'a> Chart<'a> {
         }
         let (bu, bv) = self.surf.bounds();
         let inside = |x: f64, r: Option<(f64, f64)>| {
-            r.is_none_or(|(a, b)| x >= a.min(b) - 1e-9 && x <= a.max(b) + 1e-9)
+            r.is_none_or(|(a, b)| {
+                x >= a.min(b) - PARAMETER_SLACK && x <= a.max(b) + PARAMETER_SLACK
+            })
         };
         inside(u, bu) && inside(v, bv)
     }
@@ -302,7 +307,7 @@ impl<'a> Chart<'a> {
             // A foot on the boundary with `p` off its normal: continue onto the extension
             // (Gauss–Newton on the continued surface).
             let off = |f: P3, n: V3| (p - f - n * (p - f).dot(&n)).norm();
-            if off(f, n) > 1e-7 * (1.0 + (p - f).norm()) {
+            if off(f, n) > FOOT_OFF_NORMAL * (1.0 + (p - f).norm()) {
                 let uv = self.surf.unwrap_near((u, v), (u0, v0));
                 u = uv.0;
                 v = uv.1;
@@ -323,7 +328,7 @@ impl<'a> Chart<'a> {
                     let dv = (g[0][0] * rb - g[0][1] * ra) / det;
                     u += du;
                     v += dv;
-                    if du.abs() + dv.abs() < 1e-12 {
+                    if du.abs() + dv.abs() < PARAMETER_STEP {
                         break;
                     }
                 }
@@ -442,7 +447,8 @@ pub(crate) fn choose_chart<'a>(
     let a0 = area(u0, v0);
     // Native when the parameters stay regular under the whole feature.
     let stride = (mesh.positions.len() / 400).max(1);
-    let mut native = a0 > 1e-12 && su.norm() > DEGENERATE_LENGTH && sv.norm() > DEGENERATE_LENGTH;
+    let mut native =
+        a0 > AREA_ELEMENT_MIN && su.norm() > DEGENERATE_LENGTH && sv.norm() > DEGENERATE_LENGTH;
     if native {
         let (mut ulo, mut uhi) = (f64::INFINITY, f64::NEG_INFINITY);
         for p in mesh.positions.iter().step_by(stride) {

@@ -43,8 +43,8 @@ use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
 use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::sst::{Sides, WALL_REACH};
 use crate::support::{reach, sliver_area};
-use crate::tolerance::{FLAT_CURVATURE, MICROMETRE};
-use crate::toolpath::{Bead, MoveKind, PathPoint};
+use crate::tolerance::{FLAT_CURVATURE, HEIGHT_SLACK, MICROMETRE, SHORT_VECTOR};
+use crate::toolpath::{Bead, MoveKind, PathPoint, Role};
 use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
 
 /// The length of bead point `i` of `pts` lays: half of each segment it ends.
@@ -113,7 +113,9 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
     out
 }
 use brep::math::{P3, V3};
+use brep::mesh::Mesh;
 use brep::section::{section, Plane};
+use brep::surface::Surface;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
@@ -200,7 +202,7 @@ pub fn fill_freeform<'a>(
         .ok_or_else(|| err("it has no reference face".into()))?;
     let surf = b.face_surface(rf);
     // N into the feature: the host face's outward normal (the parent's outside).
-    let mut sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
+    let sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
     let tol = slicing_tolerance(params);
     let mesh = feature_mesh(tree, f, tol)?;
     if mesh.positions.is_empty() {
@@ -216,43 +218,12 @@ pub fn fill_freeform<'a>(
     // valley by levels that are translates of its reference along one direction, which cannot
     // fold (issue 17, item 5: crate::chart::translate_chart); transition layers then morph
     // them into its top.
-    let translate = match fold_check(surf, sign, &mesh, tol, params, id) {
-        Ok(()) => None,
-        Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
-        Err(e) => Some(translate_chart(surf, sign, &mesh, tol).ok_or(e)?),
-    };
-    let mut chart = match translate {
-        Some(c) => c,
-        None => choose_chart(surf, sign, id, &mesh)?,
-    };
-    let mut mapped = mapped_mesh(&chart, &mesh, id)?;
-    // The feature lies on the side N points to: check, and turn N round if the face said
-    // otherwise (a translate chart has checked it).
-    let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
-    if mean_d < 0.0 && translate.is_none() {
-        sign = -sign;
-        chart = choose_chart(surf, sign, id, &mesh)?;
-        mapped = mapped_mesh(&chart, &mesh, id)?;
-    }
+    let (chart, mapped, translated) = feature_chart(surf, sign, &mesh, tol, params, id)?;
     let top = mapped.positions.iter().map(|p| p.z).fold(0.0f64, f64::max);
     let mut heights = params.layer_heights(top);
     // Offset deterioration (paper, Fig. 9): the smallest concave radius under the feature
     // (none for translates).
-    let stride = (mapped.positions.len() / 300).max(1);
-    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
-    let mut lambda = 0.0f64;
-    if translate.is_none() {
-        for p in mapped.positions.iter().step_by(stride) {
-            if let Some(l) = chart.min_curvature([p.x, p.y], step) {
-                lambda = lambda.min(l);
-            }
-        }
-    }
-    let concave_radius = if lambda < -FLAT_CURVATURE {
-        -1.0 / lambda
-    } else {
-        f64::INFINITY
-    };
+    let concave_radius = concave_radius(&chart, &mapped, params, !translated);
     let spacing = params.spacing(bead.width);
     let mut fig = FeatureFigures {
         below_plate: below,
@@ -278,44 +249,14 @@ pub fn fill_freeform<'a>(
         vec![]
     };
     // Offset or transition layers (issue 17): see crate::transition.
-    let blend = match params.layer_strategy {
-        LayerStrategy::Offset => None,
-        strategy => {
-            let forced = strategy == LayerStrategy::Transition;
-            match build_top_field(&chart, b, &raw, &tops, &mapped, id)? {
-                None if forced => {
-                    return Err(err(
-                        "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
-                    ))
-                }
-                None => None,
-                Some(field) => match levels(field.range, params) {
-                    Levels::Offset => None,
-                    Levels::Transition(n) => Some((field, n, 0)),
-                    Levels::Infeasible(lo, hi) => {
-                        let (a, _, b) = field.range;
-                        // Offset layers first, a band of transition layers for the rest.
-                        match band(field, params, bead.width) {
-                            Some(banded) => Some(banded),
-                            None => {
-                                let why = format!(
-                                    "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}, and no band of transition layers over offset layers keeps those bounds either",
-                                    params.max_layer_height, params.min_layer_height
-                                );
-                                if forced {
-                                    return Err(err(why));
-                                }
-                                fig.warnings.push(format!(
-                                    "feature {id}: offset layers, not transition layers: {why}"
-                                ));
-                                None
-                            }
-                        }
-                    }
-                },
-            }
-        }
-    };
+    let blend = choose_blend(
+        (&chart, b, &raw),
+        (&tops, &mapped),
+        params,
+        bead.width,
+        id,
+        &mut fig.warnings,
+    )?;
     // Offset layers first (all of them without transition layers), then the transition layers.
     let offset_layers = match &blend {
         Some((field, n, k)) => {
@@ -332,7 +273,6 @@ pub fn fill_freeform<'a>(
     };
     let ff = ff;
     let sides = sst.then(|| Sides::new(&raw, &f.heal_faces, &tops, 1.0));
-    let mut z = 0.0;
     let up = Plane::new(P3::origin(), V3::z());
     // Checked before any layer is planned: nothing is laid down for a feature that folds.
     check_folds(id, &heights, concave_radius)?;
@@ -341,16 +281,7 @@ pub fn fill_freeform<'a>(
         .map(|a| V3::new(a[0], a[1], a[2]).normalize());
     // Each layer's regions and fill depend on that layer alone: computed in parallel, then
     // ordered, lifted and joined by travel one layer after the other.
-    let mut tops = Vec::with_capacity(heights.len());
-    for &dl in &heights[..offset_layers] {
-        tops.push((z + 0.5 * dl, z + dl));
-        z += dl;
-    }
-    if let Some((_, n, _)) = &blend {
-        for k in 0..*n {
-            tops.push(((k as f64 + 0.5) / *n as f64, (k + 1) as f64 / *n as f64));
-        }
-    }
+    let tops = layer_tops(&heights[..offset_layers], blend.as_ref().map(|b| b.1));
     // Transition layers are sliced at morph levels: each vertex's place between where they
     // start and the top over it.
     let blended = blend.as_ref().map(|(field, _, _)| {
@@ -372,37 +303,8 @@ pub fn fill_freeform<'a>(
                 Some((_, _, field)) => (&chart, &mapped, Some((*field, z))),
                 None => (&chart, &mapped, None),
             };
-            let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
-                .iter()
-                .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
-                .collect();
-            let regions = regions_from_loops(&loops);
-            let spacing = params
-                .spacing_for_layer(bead.width, layer)
-                .max(MICROMETRE)
-                .min(spacing.max(MICROMETRE) * 1e3);
-            let mut paths = vec![];
-            let layers = heights.len();
-            for r in &regions {
-                paths.extend(fill_region(
-                    chart,
-                    r,
-                    z,
-                    params,
-                    layer,
-                    bead.width,
-                    spacing,
-                    SLIVER_INSET * bead.width,
-                ));
-                paths.extend(corner_spurs(chart, r, z, bead.width));
-            }
-            if let Some((field, z)) = clip {
-                paths = clip_paths(paths, |q| field.lower(q) >= z - 1e-9);
-            }
-            (
-                regions,
-                crate::region_fill::solid_on_skins(paths, layer, layers),
-            )
+            let at = (layer, heights.len(), mid, z);
+            fill_layer(chart, mapped, clip, &up, at, params, bead.width, spacing)
         })
         .collect();
     drop(blended);
@@ -421,6 +323,175 @@ pub fn fill_freeform<'a>(
         fig,
         ff,
     })
+}
+
+/// The feature's chart and its mesh mapped into it, and whether the chart is a translate:
+/// offsets of the reference where they do not fold (or offset layers are asked for), else
+/// translates of it; N turned round where the feature lies on the other side.
+fn feature_chart<'a>(
+    surf: &'a Surface,
+    mut sign: f64,
+    mesh: &Mesh,
+    tol: f64,
+    params: &LayerParams,
+    id: usize,
+) -> Result<(Chart<'a>, Mesh, bool), PlanError> {
+    let translate = match fold_check(surf, sign, mesh, tol, params, id) {
+        Ok(()) => None,
+        Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
+        Err(e) => Some(translate_chart(surf, sign, mesh, tol).ok_or(e)?),
+    };
+    let mut chart = match translate {
+        Some(c) => c,
+        None => choose_chart(surf, sign, id, mesh)?,
+    };
+    let mut mapped = mapped_mesh(&chart, mesh, id)?;
+    // The feature lies on the side N points to: check, and turn N round if the face said
+    // otherwise (a translate chart has checked it).
+    let mean_d = mapped.positions.iter().map(|p| p.z).sum::<f64>() / mapped.positions.len() as f64;
+    if mean_d < 0.0 && translate.is_none() {
+        sign = -sign;
+        chart = choose_chart(surf, sign, id, mesh)?;
+        mapped = mapped_mesh(&chart, mesh, id)?;
+    }
+    Ok((chart, mapped, translate.is_some()))
+}
+
+/// Each layer's middle and top level: the offset layers' (thicknesses `offsets`) from 0, then
+/// the `transition` layers' morph levels in (0, 1].
+fn layer_tops(offsets: &[f64], transition: Option<usize>) -> Vec<(f64, f64)> {
+    let mut tops = Vec::with_capacity(offsets.len() + transition.unwrap_or(0));
+    let mut z = 0.0;
+    for &dl in offsets {
+        tops.push((z + 0.5 * dl, z + dl));
+        z += dl;
+    }
+    if let Some(n) = transition {
+        for k in 0..n {
+            tops.push(((k as f64 + 0.5) / n as f64, (k + 1) as f64 / n as f64));
+        }
+    }
+    tops
+}
+
+/// Offset deterioration (paper, Fig. 9): the smallest concave radius of the reference under
+/// the feature, sampled at its mapped mesh's points; infinite for translates (`offsets` false)
+/// or a reference that is nowhere concave.
+fn concave_radius(chart: &Chart, mapped: &Mesh, params: &LayerParams, offsets: bool) -> f64 {
+    let stride = (mapped.positions.len() / 300).max(1);
+    let step = (0.5 * params.uniform_layer_height).max(MICROMETRE);
+    let mut lambda = 0.0f64;
+    if offsets {
+        for p in mapped.positions.iter().step_by(stride) {
+            if let Some(l) = chart.min_curvature([p.x, p.y], step) {
+                lambda = lambda.min(l);
+            }
+        }
+    }
+    if lambda < -FLAT_CURVATURE {
+        -1.0 / lambda
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Offset or transition layers (issue 17, see crate::transition): the top's distance field,
+/// the number of transition layers and the number of offset layers under them; `None` for
+/// offset layers only (asked for, no top, or transition layers that would break the layer
+/// height bounds, with a warning).
+fn choose_blend(
+    (chart, b, raw): (&Chart, &brep::Brep, &Mesh),
+    (tops, mapped): (&[brep::topology::FaceId], &Mesh),
+    params: &LayerParams,
+    bead_width: f64,
+    id: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Option<(TopField, usize, usize)>, PlanError> {
+    let err = |msg: String| PlanError::Freeform { id, msg };
+    Ok(match params.layer_strategy {
+        LayerStrategy::Offset => None,
+        strategy => {
+            let forced = strategy == LayerStrategy::Transition;
+            match build_top_field(chart, b, raw, tops, mapped, id)? {
+                None if forced => {
+                    return Err(err(
+                        "layer_strategy = \"transition\" needs a top, and no face of it faces the way it grows".into(),
+                    ))
+                }
+                None => None,
+                Some(field) => match levels(field.range, params) {
+                    Levels::Offset => None,
+                    Levels::Transition(n) => Some((field, n, 0)),
+                    Levels::Infeasible(lo, hi) => {
+                        let (a, _, b) = field.range;
+                        // Offset layers first, a band of transition layers for the rest.
+                        match band(field, params, bead_width) {
+                            Some(banded) => Some(banded),
+                            None => {
+                                let why = format!(
+                                    "its top lies {a:.3} to {b:.3} mm from its base, so transition layers would need at least {lo} layers for max_layer_height = {} and at most {hi} for min_layer_height = {}, and no band of transition layers over offset layers keeps those bounds either",
+                                    params.max_layer_height, params.min_layer_height
+                                );
+                                if forced {
+                                    return Err(err(why));
+                                }
+                                warnings.push(format!(
+                                    "feature {id}: offset layers, not transition layers: {why}"
+                                ));
+                                None
+                            }
+                        }
+                    }
+                },
+            }
+        }
+    })
+}
+
+/// One layer's regions (the section of the mapped mesh at `mid`) and fill paths at offset `z`
+/// (`at`: the layer, the number of layers, `mid` and `z`), clipped to where the transition band
+/// `clip` stays above, skins made solid.
+#[allow(clippy::too_many_arguments)]
+fn fill_layer(
+    chart: &Chart,
+    mapped: &Mesh,
+    clip: Option<(&TopField, f64)>,
+    up: &Plane,
+    (layer, layers, mid, z): (usize, usize, f64, f64),
+    params: &LayerParams,
+    bead_width: f64,
+    spacing: f64,
+) -> (Vec<Region>, Vec<FillPath>) {
+    let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
+        .iter()
+        .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let regions = regions_from_loops(&loops);
+    let spacing = params
+        .spacing_for_layer(bead_width, layer)
+        .max(MICROMETRE)
+        .min(spacing.max(MICROMETRE) * 1e3);
+    let mut paths = vec![];
+    for r in &regions {
+        paths.extend(fill_region(
+            chart,
+            r,
+            z,
+            params,
+            layer,
+            bead_width,
+            spacing,
+            SLIVER_INSET * bead_width,
+        ));
+        paths.extend(corner_spurs(chart, r, z, bead_width));
+    }
+    if let Some((field, z)) = clip {
+        paths = clip_paths(paths, |q| field.lower(q) >= z - HEIGHT_SLACK);
+    }
+    (
+        regions,
+        crate::region_fill::solid_on_skins(paths, layer, layers),
+    )
 }
 
 impl FreeformFill<'_> {
@@ -483,10 +554,7 @@ impl FreeformFill<'_> {
             if banded && layer < offset_layers {
                 offset_regions.extend(regions.iter().cloned());
             }
-            let held_by = match banded && layer == offset_layers {
-                true => Some(&offset_regions),
-                false => None,
-            };
+            let held_by = (banded && layer == offset_layers).then_some(&offset_regions);
             let below = std::mem::replace(&mut prev_regions, regions);
             let start = cursor
                 .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -497,78 +565,30 @@ impl FreeformFill<'_> {
                 order_fill_paths(paths, start)
             };
             // Each path lifted onto the layer and its unsupported points counted, in parallel.
-            let lifted: Vec<(Vec<Lifted>, usize, f64)> = paths
-                .par_iter()
-                .map(|path| {
-                    let mut pts = lift(&chart, path, z, params.tolerance);
-                    // Wall beads: the side-surface-tangent axis (Eq. 3).
-                    if let Some(s) = &sides {
-                        crate::sst::apply(&mut pts, s, |q| thick(q, dl), WALL_REACH * bead.width);
-                    }
-                    // Support: the layer below (or, under the first layer, the reference face):
-                    // points more than half a bead off it are counted (`overhang_points`),
-                    // and the bead of those more than h·tan(overhang limit) off it is
-                    // unsupported area (crate::support).
-                    let mut unheld = 0;
-                    let mut unsupported = 0.0;
-                    for (i, x) in pts.iter().enumerate() {
-                        let (off, limit) = if layer == 0 {
-                            let off = if chart.on_face(x.q) {
-                                0.0
-                            } else {
-                                f64::INFINITY
-                            };
-                            (off, 0.0)
-                        } else {
-                            let s = chart.stretch(x.q, z);
-                            (
-                                outside_regions(&below, x.q) * s,
-                                reach(dl, params.overhang_angle_deg),
-                            )
-                        };
-                        if off > 0.5 * bead.width {
-                            unheld += 1;
-                        }
-                        let off = match held_by {
-                            Some(r) if off > limit => {
-                                outside_regions(r, x.q) * chart.stretch(x.q, z)
-                            }
-                            _ => off,
-                        };
-                        if off > limit {
-                            unsupported += bead_share(&pts, i) * x.w;
-                        }
-                    }
-                    (pts, unheld, unsupported)
-                })
-                .collect();
-            let layer_unsupported: f64 = lifted.iter().map(|l| l.2).sum();
-            if layer_unsupported >= sliver_area(bead.width) {
-                ff.support.add(layer + 1, layer_unsupported);
-            }
+            let support = Support {
+                layer,
+                below: below.as_slice(),
+                held_by: held_by.map(|r| r.as_slice()),
+                reach: reach(dl, params.overhang_angle_deg),
+            };
+            let lifted = lift_paths(
+                &chart,
+                &paths,
+                z,
+                params,
+                (&sides, bead.width),
+                |q| thick(q, dl),
+                support,
+            );
+            note_support(&mut ff, layer, &lifted, bead.width);
             let mut layer_paths: Vec<LayerPath> = vec![];
             for (pts, unheld, _) in lifted {
                 if pts.len() < 2 {
                     continue;
                 }
                 // A fixed axis pointing against the layer's growth lays beads from below.
-                if let Some(a) = fixed {
-                    for x in &pts[1..] {
-                        let c = a.dot(&x.n).clamp(-1.0, 1.0);
-                        if c < 0.0 {
-                            against.0 += 1;
-                            against.1 = against.1.max(c.acos().to_degrees());
-                        }
-                    }
-                }
-                if unheld > 0 {
-                    ff.overhang_points += unheld;
-                    let l = layer + 1;
-                    ff.overhang_layers = Some(match ff.overhang_layers {
-                        Some((a, b)) => (a.min(l), b.max(l)),
-                        None => (l, l),
-                    });
-                }
+                count_against(fixed, &pts, &mut against);
+                note_overhang(&mut ff, unheld, layer);
                 let start = points.len();
                 let axis = |n: V3| {
                     let a = fixed.unwrap_or(n);
@@ -578,118 +598,46 @@ impl FreeformFill<'_> {
                 // (clear of this layer's beads on a curved surface), then down.
                 let first = pts[0];
                 // One layer up, in the chart's level.
-                let step = match levels {
-                    Some((_, n)) => 1.0 / n,
-                    None => dl,
-                };
+                let step = levels.map_or(dl, |(_, n)| 1.0 / n);
                 let lift_to = z + step;
-                let mut travel: Vec<(P3, V3)> = vec![];
-                if let Some(c) = *cursor {
-                    if let Some((qc, dc)) = chart.inverse(&c) {
-                        let hz = lift_to.max(dc + step);
-                        let span = dist2(first.q, qc).sqrt();
-                        let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
-                        for i in 0..=n {
-                            let t = i as f64 / n as f64;
-                            let q = [
-                                qc[0] + (first.q[0] - qc[0]) * t,
-                                qc[1] + (first.q[1] - qc[1]) * t,
-                            ];
-                            if let Some(x) = chart.at(q, hz) {
-                                travel.push(x);
-                            }
-                        }
-                    }
-                }
+                let mut travel = travel_over(&chart, *cursor, first.q, lift_to, step);
                 travel.push((first.p, first.n));
-                for (p, n) in travel {
-                    if let Some(c) = *cursor {
-                        fig.travel_length += (p - c).norm();
-                    }
-                    points.push(PathPoint {
-                        feature: id,
-                        layer,
-                        kind: MoveKind::Travel,
-                        p: [p.x, p.y, p.z],
-                        axis: axis(n),
-                        e: 0.0,
-                        thickness: thick(first.q, dl),
-                        width: bead.width,
-                        role: pts[0].role,
-                    });
-                    *cursor = Some(p);
-                }
+                let head = (thick(first.q, dl), bead.width, pts[0].role);
+                push_travel(
+                    &mut points,
+                    travel,
+                    (id, layer, head),
+                    &axis,
+                    cursor,
+                    &mut fig,
+                );
                 let print_start = points.len();
-                for w in pts.windows(2) {
-                    let l = (w[1].p - w[0].p).norm();
-                    let width = 0.5 * (w[0].w + w[1].w);
-                    // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
-                    let mut t = 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
-                    let mut run = l;
-                    if levels.is_some() || base_chart.along.is_some() {
-                        // A transition layer (or a translate of the reference) leans on the
-                        // direction its levels grow along (N, or a translate chart's `a`): the
-                        // bead is as thick as the layers lie apart across it, t_N·(n_L·N), and
-                        // as long as the segment runs along it (not up its steps over the
-                        // offset layers' staircase, which the layer under it climbs too).
-                        let nl = (w[0].ln + w[1].ln).try_normalize(1e-12).unwrap_or(w[1].ln);
-                        if let Some(g) = base_chart.growth(w[1].q) {
-                            t *= nl.dot(&g).abs();
-                        }
-                        let d = w[1].p - w[0].p;
-                        run = (d - nl * d.dot(&nl)).norm();
-                    }
-                    let e = bead.filament_length(width, t, run);
-                    spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
-                    fig.print_length += l;
-                    fig.filament += e;
-                    points.push(PathPoint {
-                        feature: id,
-                        layer,
-                        kind: MoveKind::Print,
-                        p: [w[1].p.x, w[1].p.y, w[1].p.z],
-                        axis: axis(w[1].n),
-                        e,
-                        thickness: t,
-                        width,
-                        role: w[1].role,
-                    });
-                }
+                let leans = levels.is_some() || base_chart.along.is_some();
+                let seg_thick = |w: &[Lifted]| 0.5 * (thick(w[0].q, dl) + thick(w[1].q, dl));
+                let chart = leans.then_some(&base_chart);
+                let at = (id, layer, bead);
+                push_prints(
+                    &mut points,
+                    &pts,
+                    at,
+                    (seg_thick, chart, &axis),
+                    &mut fig,
+                    &mut spread,
+                );
                 *cursor = pts.last().map(|x| x.p);
                 layer_paths.push(LayerPath {
                     travel: start..print_start,
                     print: print_start..points.len(),
                 });
             }
-            if !layer_paths.is_empty() {
-                layers.push(Layer {
-                    index: layer,
-                    thickness: dl,
-                    surface: match levels {
-                        Some(_) => LayerSurface::Blend { level: z },
-                        None => LayerSurface::Offset { offset: z },
-                    },
-                    paths: layer_paths,
-                });
-            }
+            layers.extend(layer_of(layer, (dl, z), levels.is_some(), layer_paths));
         }
         let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
         fig.finish(id, points.len(), &printed);
         if blend.is_some() && spread.3 > 0 {
             fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
         }
-        if against.0 > 0 {
-            fig.warnings.push(format!(
-                "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",
-                against.1, against.0
-            ));
-        }
-        if let Some((a, b)) = ff.overhang_layers {
-            fig.warnings.push(format!(
-                "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
-                ff.overhang_points
-            ));
-        }
+        lay_warnings(&mut fig, id, against, &ff);
         FeaturePlan {
             feature: id,
             points,
@@ -697,5 +645,273 @@ impl FreeformFill<'_> {
             figures: fig,
             freeform: Some(ff),
         }
+    }
+}
+
+/// The layer `index` of thickness `dl` at chart level `z` (a morph level where `blended`, else
+/// an offset) with its paths; none when it has no path.
+fn layer_of(
+    index: usize,
+    (dl, z): (f64, f64),
+    blended: bool,
+    paths: Vec<LayerPath>,
+) -> Option<Layer> {
+    (!paths.is_empty()).then_some(Layer {
+        index,
+        thickness: dl,
+        surface: if blended {
+            LayerSurface::Blend { level: z }
+        } else {
+            LayerSurface::Offset { offset: z }
+        },
+        paths,
+    })
+}
+
+/// A layer's unsupported area, the sum over its lifted paths, added to `ff`'s support where it
+/// is more than a sliver ([`sliver_area`]).
+fn note_support(
+    ff: &mut FreeformFigures,
+    layer: usize,
+    lifted: &[(Vec<Lifted>, usize, f64)],
+    bead_width: f64,
+) {
+    let area: f64 = lifted.iter().map(|l| l.2).sum();
+    if area >= sliver_area(bead_width) {
+        ff.support.add(layer + 1, area);
+    }
+}
+
+/// Each path lifted onto the layer at `z` (wall beads given the side-surface-tangent axis
+/// where `sides` are), and its points unsupported: off the reference face under the first
+/// layer, else off the regions `below`; in parallel.
+fn lift_paths(
+    chart: &Chart,
+    paths: &[FillPath],
+    z: f64,
+    params: &LayerParams,
+    (sides, bead_width): (&Option<Sides>, f64),
+    thick: impl Fn(Point2) -> f64 + Sync,
+    support: Support,
+) -> Vec<(Vec<Lifted>, usize, f64)> {
+    paths
+        .par_iter()
+        .map(|path| {
+            let mut pts = lift(chart, path, z, params.tolerance);
+            // Wall beads: the side-surface-tangent axis (Eq. 3).
+            if let Some(s) = sides {
+                crate::sst::apply(&mut pts, s, &thick, WALL_REACH * bead_width);
+            }
+            let (unheld, unsupported) = support.of(chart, z, &pts, bead_width);
+            (pts, unheld, unsupported)
+        })
+        .collect()
+}
+
+/// What holds up a curved layer's beads: the layer below (or, under the first layer, the
+/// reference face), and, for the first transition layer over offset layers, any offset layer
+/// under it.
+#[derive(Clone, Copy)]
+struct Support<'a> {
+    /// The layer's index (0: the first, on the reference face).
+    layer: usize,
+    /// The regions of the layer below.
+    below: &'a [Region],
+    /// The offset layers' regions under the first transition layer, if this is it.
+    held_by: Option<&'a [Region]>,
+    /// How far a bead may reach past the layer below, mm (`h·tan(overhang_angle_deg)`).
+    reach: f64,
+}
+
+impl Support<'_> {
+    /// Of the lifted path `pts`: its points more than half a bead off what is below
+    /// (`overhang_points`), and the bead (length × width, mm²) of those more than the reach
+    /// off it, unsupported area ([`crate::support`]).
+    fn of(&self, chart: &Chart, z: f64, pts: &[Lifted], bead_width: f64) -> (usize, f64) {
+        let mut unheld = 0;
+        let mut unsupported = 0.0;
+        for (i, x) in pts.iter().enumerate() {
+            let (off, limit) = if self.layer == 0 {
+                let off = if chart.on_face(x.q) {
+                    0.0
+                } else {
+                    f64::INFINITY
+                };
+                (off, 0.0)
+            } else {
+                let s = chart.stretch(x.q, z);
+                (outside_regions(self.below, x.q) * s, self.reach)
+            };
+            if off > 0.5 * bead_width {
+                unheld += 1;
+            }
+            let off = match self.held_by {
+                Some(r) if off > limit => outside_regions(r, x.q) * chart.stretch(x.q, z),
+                _ => off,
+            };
+            if off > limit {
+                unsupported += bead_share(pts, i) * x.w;
+            }
+        }
+        (unheld, unsupported)
+    }
+}
+
+/// Travel from `cursor` to over `q`: up one layer (`step`, at least to `lift_to`) and along
+/// the layer above, clear of this layer's beads on a curved surface.
+fn travel_over(
+    chart: &Chart,
+    cursor: Option<P3>,
+    q: Point2,
+    lift_to: f64,
+    step: f64,
+) -> Vec<(P3, V3)> {
+    let mut travel: Vec<(P3, V3)> = vec![];
+    if let Some(c) = cursor {
+        if let Some((qc, dc)) = chart.inverse(&c) {
+            let hz = lift_to.max(dc + step);
+            let span = dist2(q, qc).sqrt();
+            let n = (span / 2.0).ceil().clamp(1.0, 1000.0) as usize;
+            for i in 0..=n {
+                let t = i as f64 / n as f64;
+                let q = [qc[0] + (q[0] - qc[0]) * t, qc[1] + (q[1] - qc[1]) * t];
+                if let Some(x) = chart.at(q, hz) {
+                    travel.push(x);
+                }
+            }
+        }
+    }
+    travel
+}
+
+/// A segment `w` of a transition layer (or of a translate of the reference), which leans on the
+/// direction its levels grow along (N, or a translate chart's `a`): the bead is as thick as
+/// the layers lie apart across it, t_N·(n_L·N), and as long as the segment runs along it (not
+/// up its steps over the offset layers' staircase, which the layer under it climbs too). The
+/// thickness `t` so scaled, and that length.
+fn leaning(chart: &Chart, w: &[Lifted], mut t: f64) -> (f64, f64) {
+    let nl = (w[0].ln + w[1].ln)
+        .try_normalize(SHORT_VECTOR)
+        .unwrap_or(w[1].ln);
+    if let Some(g) = chart.growth(w[1].q) {
+        t *= nl.dot(&g).abs();
+    }
+    let d = w[1].p - w[0].p;
+    let run = (d - nl * d.dot(&nl)).norm();
+    (t, run)
+}
+
+/// The warnings of a laid feature: a fixed axis pointing against the layers' growth (`against`:
+/// print points and the worst angle), and print points overhanging the layer below.
+fn lay_warnings(fig: &mut FeatureFigures, id: usize, against: (usize, f64), ff: &FreeformFigures) {
+    if against.0 > 0 {
+        fig.warnings.push(format!(
+            "feature {id}: its fixed_tool_axis points against the layers' growth (more than 90 degrees from their normal, up to {:.1}) at {} print point(s): the nozzle would lay those beads from below",
+            against.1, against.0
+        ));
+    }
+    if let Some((a, b)) = ff.overhang_layers {
+        fig.warnings.push(format!(
+            "feature {id}: {} print point(s) in layers {a}..{b} overhang the layer below (nothing under them on the offsets of its reference surface)",
+            ff.overhang_points
+        ));
+    }
+}
+
+/// Counts the print points of `pts` whose fixed axis points against the layer's growth (lays
+/// beads from below), and the worst angle, into `against`.
+fn count_against(fixed: Option<V3>, pts: &[Lifted], against: &mut (usize, f64)) {
+    if let Some(a) = fixed {
+        for x in &pts[1..] {
+            let c = a.dot(&x.n).clamp(-1.0, 1.0);
+            if c < 0.0 {
+                against.0 += 1;
+                against.1 = against.1.max(c.acos().to_degrees());
+            }
+        }
+    }
+}
+
+/// Counts `unheld` overhanging print points of layer `layer` into the figures.
+fn note_overhang(ff: &mut FreeformFigures, unheld: usize, layer: usize) {
+    if unheld > 0 {
+        ff.overhang_points += unheld;
+        let l = layer + 1;
+        ff.overhang_layers = Some(match ff.overhang_layers {
+            Some((a, b)) => (a.min(l), b.max(l)),
+            None => (l, l),
+        });
+    }
+}
+
+/// The print points of the lifted path `pts` (feature, layer, bead: `at`), each segment's
+/// filament by Eq. 1 with its thickness (`thick`; scaled by [`leaning`] on `leaning_on`'s
+/// levels) and the axis `axis` makes of its normal; lengths, filament and thickness spread
+/// added to the figures.
+fn push_prints(
+    points: &mut Vec<PathPoint>,
+    pts: &[Lifted],
+    (id, layer, bead): (usize, usize, Bead),
+    (thick, leaning_on, axis): (
+        impl Fn(&[Lifted]) -> f64,
+        Option<&Chart>,
+        &dyn Fn(V3) -> [f64; 3],
+    ),
+    fig: &mut FeatureFigures,
+    spread: &mut (f64, f64, f64, usize),
+) {
+    for w in pts.windows(2) {
+        let l = (w[1].p - w[0].p).norm();
+        let width = 0.5 * (w[0].w + w[1].w);
+        // Eq. 1 with the segment's thickness (its ends' mean on a transition layer).
+        let t = thick(w);
+        let (t, run) = match leaning_on {
+            Some(chart) => leaning(chart, w, t),
+            None => (t, l),
+        };
+        let e = bead.filament_length(width, t, run);
+        *spread = (spread.0.min(t), spread.1 + t, spread.2.max(t), spread.3 + 1);
+        fig.print_length += l;
+        fig.filament += e;
+        points.push(PathPoint {
+            feature: id,
+            layer,
+            kind: MoveKind::Print,
+            p: [w[1].p.x, w[1].p.y, w[1].p.z],
+            axis: axis(w[1].n),
+            e,
+            thickness: t,
+            width,
+            role: w[1].role,
+        });
+    }
+}
+
+/// The travel points `travel` (feature, layer, and the bead's thickness, width and role:
+/// `at`), each from the cursor, which follows them; their length added to the figures.
+fn push_travel(
+    points: &mut Vec<PathPoint>,
+    travel: Vec<(P3, V3)>,
+    (id, layer, (thickness, width, role)): (usize, usize, (f64, f64, Role)),
+    axis: &dyn Fn(V3) -> [f64; 3],
+    cursor: &mut Option<P3>,
+    fig: &mut FeatureFigures,
+) {
+    for (p, n) in travel {
+        if let Some(c) = *cursor {
+            fig.travel_length += (p - c).norm();
+        }
+        points.push(PathPoint {
+            feature: id,
+            layer,
+            kind: MoveKind::Travel,
+            p: [p.x, p.y, p.z],
+            axis: axis(n),
+            e: 0.0,
+            thickness,
+            width,
+            role,
+        });
+        *cursor = Some(p);
     }
 }

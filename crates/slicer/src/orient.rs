@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+use crate::tolerance::{PARALLEL_HEADING, RATE_SLACK, SHORT_VECTOR, TILT_MARGIN_DEG};
 use crate::vec3::{cross, dot, norm, scale, sub, unit, V3};
 
 /// Which filter smooths the axes (the paper's two variants, §3.2).
@@ -338,13 +339,13 @@ pub fn limit_tilt(
     slack_deg: f64,
 ) -> BTreeMap<usize, (usize, f64)> {
     let mut out: BTreeMap<usize, (usize, f64)> = BTreeMap::new();
-    let target = (max_tilt_deg - 1e-7).to_radians();
+    let target = (max_tilt_deg - TILT_MARGIN_DEG).to_radians();
     for p in &mut path.points {
         let Some(a) = unit(p.axis) else { continue };
         let tilt = a[2].clamp(-1.0, 1.0).acos();
         let over = tilt.to_degrees() - max_tilt_deg;
         let r = a[0].hypot(a[1]);
-        if over <= 0.0 || over > slack_deg || r < 1e-12 {
+        if over <= 0.0 || over > slack_deg || r < SHORT_VECTOR {
             continue;
         }
         let (s, c) = target.sin_cos();
@@ -388,7 +389,7 @@ pub fn cone_correct(smoothed: [f64; 3], original: [f64; 3], cone_angle_deg: f64)
     }
     // Eq. 5 (sign and normalisation as documented above).
     let h0 = cross(b, t);
-    let h0 = if norm(h0) > 1e-9 {
+    let h0 = if norm(h0) > PARALLEL_HEADING {
         h0
     } else {
         // T_S opposite to b: any normal to b; cross b with the world axis it is least along.
@@ -494,7 +495,7 @@ pub fn smooth(path: &mut ToolPath, params: &SmoothParams) -> BTreeMap<usize, Ori
             // step a little more than planned (uneven spacing there): a path that smoothing
             // would make rougher keeps its planned axes.
             let after = orientation_step_rate(run);
-            if after.0 > before.0 + 1e-9 || after.1 > before.1 + 1e-9 {
+            if after.0 > before.0 + RATE_SLACK || after.1 > before.1 + RATE_SLACK {
                 for (q, a) in run.iter_mut().zip(planned) {
                     q.axis = a;
                 }

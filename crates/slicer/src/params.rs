@@ -6,6 +6,7 @@
 //! are snake case (`uniform`, `contour_zigzag`). A misspelled key is an error, not a silent
 //! default.
 
+use crate::tolerance::{COUNT_SLACK, HEIGHT_SLACK, ZERO_AXIS};
 use serde::{Deserialize, Serialize};
 
 /// The most layers [`LayerParams::layer_heights`] returns; more means the parameters are wrong
@@ -242,7 +243,7 @@ impl LayerParams {
                 if !(h.is_finite() && h > 0.0) {
                     return Vec::new();
                 }
-                let n = (extent / h - 1e-9).ceil().max(1.0);
+                let n = (extent / h - COUNT_SLACK).ceil().max(1.0);
                 if !n.is_finite() || n > MAX_LAYERS as f64 {
                     return Vec::new();
                 }
@@ -254,7 +255,7 @@ impl LayerParams {
                 if list.is_empty() || list.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
                     return Vec::new();
                 }
-                let eps = 1e-9;
+                let eps = HEIGHT_SLACK;
                 let mut out = Vec::new();
                 let mut z = 0.0;
                 for &h in list.iter().cycle() {
@@ -343,7 +344,7 @@ impl LayerParams {
         }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-            if !(n.is_finite() && n > 1e-9) {
+            if !(n.is_finite() && n > ZERO_AXIS) {
                 return Err(format!(
                     "fixed_tool_axis must be a non-zero finite vector, got {a:?}"
                 ));

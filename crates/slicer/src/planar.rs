@@ -21,6 +21,7 @@ use rayon::prelude::*;
 pub use crate::error::PlanError;
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FeatureFigures;
+use crate::tolerance::{COLLINEAR, KEY_GRID};
 pub use toolpath::Bead;
 
 /// The reference plane of a two5d feature: through its healing faces (or build-plate face),
@@ -420,10 +421,6 @@ impl SectionKey {
     }
 }
 
-/// The step sections are compared in, mm: a ten-thousandth of a micrometre, far below any
-/// tolerance of the fill (a layer taking another's fill lays it on a section this close).
-const KEY_GRID: f64 = 1e-7;
-
 /// A closed ring without its vertices that lie between their neighbours on the segment joining
 /// them (to within rounding: 1e-12 of the segment's length squared), each judged against the
 /// neighbours left after the ones before it are dropped.
@@ -433,7 +430,7 @@ fn without_straight_vertices(ring: &[Point2]) -> Vec<Point2> {
         let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
         let len2 = v[0] * v[0] + v[1] * v[1];
         let along = u[0] * v[0] + u[1] * v[1];
-        (u[0] * v[1] - u[1] * v[0]).abs() <= 1e-12 * len2 && along > 0.0 && along < len2
+        (u[0] * v[1] - u[1] * v[0]).abs() <= COLLINEAR * len2 && along > 0.0 && along < len2
     };
     for &p in ring {
         while out.len() >= 2 && straight(out[out.len() - 2], out[out.len() - 1], p) {

@@ -13,6 +13,7 @@
 use crate::geom2d::Point2;
 use crate::lift::Lifted;
 
+use crate::tolerance::{DEGENERATE_NORMAL, NONZERO, SHORT_VECTOR};
 use brep::math::{P3, V3};
 use brep::mesh::Mesh;
 use brep::topology::FaceId;
@@ -79,7 +80,7 @@ impl Sides {
                         let [x, y, z] = self.tris[t as usize];
                         let n = (y - x).cross(&(z - x));
                         let len = n.norm();
-                        if len < 1e-15 {
+                        if len < DEGENERATE_NORMAL {
                             continue;
                         }
                         let d = triangle_distance(p, &x, &y, &z);
@@ -115,7 +116,7 @@ pub(crate) fn apply(
         let t = pts[(i + 1).min(n - 1)].p - pts[i.saturating_sub(1)].p;
         let axis = sides
             .normal_near(&centre, reach)
-            .zip(t.try_normalize(1e-12))
+            .zip(t.try_normalize(SHORT_VECTOR))
             .and_then(|(ns, t)| sst_axis(&ns, &t, &x.n));
         axes.push(axis);
     }
@@ -145,13 +146,13 @@ pub(crate) fn sst_axis(ns: &V3, t: &V3, layer_normal: &V3) -> Option<V3> {
 fn triangle_distance(p: &P3, a: &P3, b: &P3, c: &P3) -> f64 {
     let seg = |u: &P3, v: &P3| {
         let uv = v - u;
-        let t = ((p - u).dot(&uv) / uv.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+        let t = ((p - u).dot(&uv) / uv.norm_squared().max(NONZERO)).clamp(0.0, 1.0);
         (p - (u + uv * t)).norm()
     };
     let n = (b - a).cross(&(c - a));
     let nn = n.norm();
     let edges = seg(a, b).min(seg(b, c)).min(seg(c, a));
-    if nn < 1e-15 {
+    if nn < DEGENERATE_NORMAL {
         return edges;
     }
     let nu = n / nn;

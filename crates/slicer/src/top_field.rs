@@ -3,6 +3,7 @@
 //! past the top's footprint, and with offset layers first the top of their stack `D(q)`.
 
 use crate::geom2d::Point2;
+use crate::tolerance::COUNT_SLACK;
 use std::collections::VecDeque;
 
 /// The top's distance from the base along the reference's normal, `h_T(q)`, sampled on a grid
@@ -133,7 +134,7 @@ impl TopField {
                 .h
                 .iter()
                 .zip(&self.env)
-                .map(|(h, e)| h - h0 * (e / h0 + 1e-9).floor())
+                .map(|(h, e)| h - h0 * (e / h0 + COUNT_SLACK).floor())
                 .fold(0.0, f64::max),
             None => self.range.2,
         }
@@ -148,7 +149,7 @@ impl TopField {
     /// layers first the top of their stack there, `D(q)` (a staircase of whole layers).
     pub fn lower(&self, q: Point2) -> f64 {
         match self.band {
-            Some((_, h0)) => h0 * (self.lower_smooth(q) / h0 + 1e-9).floor(),
+            Some((_, h0)) => h0 * (self.lower_smooth(q) / h0 + COUNT_SLACK).floor(),
             None => 0.0,
         }
     }

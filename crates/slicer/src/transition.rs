@@ -42,6 +42,7 @@ use crate::chart::{mapped_mesh, refined, Chart};
 use crate::error::PlanError;
 use crate::geom2d::Point2;
 use crate::params::LayerParams;
+use crate::tolerance::{BARYCENTRIC_SLACK, COUNT_SLACK, TRIANGLE_DET};
 pub use crate::top_field::TopField;
 use brep::math::P3;
 use brep::mesh::{FaceTriangulation, Mesh};
@@ -251,7 +252,7 @@ fn compact(m: &Mesh) -> Mesh {
 #[allow(clippy::too_many_arguments)]
 fn raster(h: &mut [f64], origin: Point2, cell: f64, nx: usize, ny: usize, a: P3, b: P3, c: P3) {
     let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-    if det.abs() < 1e-12 {
+    if det.abs() < TRIANGLE_DET {
         return;
     }
     let ix = |x: f64| ((x - origin[0]) / cell - 0.5).max(0.0);
@@ -260,7 +261,7 @@ fn raster(h: &mut [f64], origin: Point2, cell: f64, nx: usize, ny: usize, a: P3,
     let x1 = (ix(a.x.max(b.x).max(c.x)).ceil() as usize).min(nx - 1);
     let y0 = iy(a.y.min(b.y).min(c.y)).floor() as usize;
     let y1 = (iy(a.y.max(b.y).max(c.y)).ceil() as usize).min(ny - 1);
-    let eps = 1e-9;
+    let eps = BARYCENTRIC_SLACK;
     for y in y0..=y1 {
         for x in x0..=x1 {
             let px = origin[0] + (x as f64 + 0.5) * cell;
@@ -299,8 +300,12 @@ pub(crate) fn levels(range: (f64, f64, f64), params: &LayerParams) -> Levels {
     if hmax - hmin <= params.tolerance {
         return Levels::Offset;
     }
-    let lo = ((hmax / params.max_layer_height) - 1e-9).ceil().max(1.0) as usize;
-    let hi = ((hmin / params.min_layer_height) + 1e-9).floor().max(0.0) as usize;
+    let lo = ((hmax / params.max_layer_height) - COUNT_SLACK)
+        .ceil()
+        .max(1.0) as usize;
+    let hi = ((hmin / params.min_layer_height) + COUNT_SLACK)
+        .floor()
+        .max(0.0) as usize;
     if lo > hi {
         return Levels::Infeasible(lo, hi);
     }
@@ -335,7 +340,7 @@ pub(crate) fn band(
     let f = field.with_band(c, h0, h0 / (0.5 * bead_width));
     let (mut lo, mut hi, mut sum, mut top) = (f64::INFINITY, 0.0f64, 0.0, 0.0f64);
     for (h, e) in f.h.iter().zip(&f.env) {
-        let d = h0 * (e / h0 + 1e-9).floor();
+        let d = h0 * (e / h0 + COUNT_SLACK).floor();
         let b = h - d;
         lo = lo.min(b);
         hi = hi.max(b);
@@ -343,13 +348,17 @@ pub(crate) fn band(
         top = top.max(d);
     }
     let mean = sum / f.h.len().max(1) as f64;
-    let nlo = ((hi / params.max_layer_height) - 1e-9).ceil().max(1.0) as usize;
-    let nhi = ((lo / params.min_layer_height) + 1e-9).floor().max(0.0) as usize;
+    let nlo = ((hi / params.max_layer_height) - COUNT_SLACK)
+        .ceil()
+        .max(1.0) as usize;
+    let nhi = ((lo / params.min_layer_height) + COUNT_SLACK)
+        .floor()
+        .max(0.0) as usize;
     if nlo > nhi {
         return None;
     }
     let n = ((mean / params.uniform_layer_height).round().max(1.0) as usize).clamp(nlo, nhi);
-    let k = (top / h0 + 1e-9).round() as usize;
+    let k = (top / h0 + COUNT_SLACK).round() as usize;
     Some((f, n, k))
 }
 

@@ -73,7 +73,7 @@ pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
         });
     }
     let expected = f.volume * f.fill;
-    let rel = (f.extruded - expected) / expected.max(1e-12);
+    let rel = (f.extruded - expected) / expected.max(crate::tolerance::VOLUME_FLOOR);
     (rel.abs() > f.tolerance.max(VOLUME_TOLERANCE)).then(|| PlanProblem::Volume {
         id: f.id,
         kind: f.kind.clone(),

@@ -240,7 +240,7 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
             "{name} feature {k}: {} layers, {} points, chart {}, concave radius {:.2}, volume {:.2} extruded {:.2} ({:+.2}%), worst offset error {:.4} mm, axis {:.3}°, support gap {:.3} mm, overhang found {found:.4} reported {reported:.4}",
             fig.layers,
             pts.len(),
-            ff.chart,
+            ff.chart.as_str(),
             ff.concave_radius,
             f.volume,
             extruded,

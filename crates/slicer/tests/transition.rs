@@ -81,7 +81,8 @@ fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<
         .unwrap_or_else(|e| panic!("{name} feature {id}: {e}"));
     let ff = plan.freeform.expect("freeform figures");
     assert_eq!(
-        ff.layers, "transition",
+        ff.layers,
+        slicer::figures::Layering::Transition,
         "{name} feature {id}: auto chose offset layers"
     );
     let pts: Vec<PathPoint> = plan.points.clone();
@@ -336,7 +337,10 @@ fn trough_rib_is_carried_over_its_valley_by_transition_layers() {
     check_transition_along("trough_rib", &t, id, Some(V3::z()));
     let plan = plan_freeform(&t, &t.features[id], &LayerParams::default(), BEAD, None)
         .expect("the rib plans");
-    assert_eq!(plan.freeform.expect("freeform").chart, "translate");
+    assert_eq!(
+        plan.freeform.expect("freeform").chart,
+        slicer::figures::LayerChart::Translate
+    );
     // Every print point within the rib: |y| ≤ 1, z ≤ 19, above the trough's surface.
     for p in plan.points.iter().filter(|p| p.kind == MoveKind::Print) {
         let [x, y, z] = p.p;
@@ -368,7 +372,10 @@ fn a_top_too_close_to_the_base_for_the_bounds_keeps_offset_layers_or_is_refused_
         ..LayerParams::default()
     };
     let auto = plan_freeform(&t, f, &tight, BEAD, None).expect("plans");
-    assert_eq!(auto.freeform.expect("figures").layers, "offset");
+    assert_eq!(
+        auto.freeform.expect("figures").layers,
+        slicer::figures::Layering::Offset
+    );
     assert!(
         auto.figures
             .warnings

@@ -15,6 +15,7 @@ mod bead;
 mod fixed;
 mod path;
 mod role;
+mod tolerance;
 pub mod vec3;
 
 pub use bead::Bead;

@@ -41,5 +41,5 @@ pub fn norm(a: V3) -> f64 {
 /// `a / |a|`, or `None` for a zero, tiny or non-finite vector.
 pub fn unit(a: V3) -> Option<V3> {
     let n = norm(a);
-    (n.is_finite() && n > 1e-12).then(|| [a[0] / n, a[1] / n, a[2] / n])
+    (n.is_finite() && n > crate::tolerance::UNIT_MIN).then(|| [a[0] / n, a[1] / n, a[2] / n])
 }

@@ -10,7 +10,7 @@ use super::options::{face_err, MeshError, MeshOptions};
 use super::uv::{signed_area, Pt};
 use crate::math::P3;
 use crate::surface::Surface;
-use crate::tolerance::{POINT_COINCIDENCE, SURFACE_COINCIDENCE};
+use crate::tolerance::{LENGTH_FLOOR, PARAMETER_AREA, POINT_COINCIDENCE, SURFACE_COINCIDENCE};
 use crate::topology::{Brep, EdgeId, FaceId};
 use std::collections::HashMap;
 
@@ -92,18 +92,7 @@ pub(super) fn face_polygons(
     let periods = [s.u_period(), s.v_period()];
     let sense = if face.same_sense { 1.0 } else { -1.0 };
     // Which B-rep edges each boundary point lies on (vertices: all their edges in this face).
-    let mut edge_of: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &l in &face.loops {
-        for &c in &brep.loops[l.idx()].coedges {
-            let e = brep.coedges[c.idx()].edge;
-            for &i in edge_pts.get(&e).into_iter().flatten() {
-                let v = edge_of.entry(i).or_default();
-                if !v.contains(&e.0) {
-                    v.push(e.0);
-                }
-            }
-        }
-    }
+    let edge_of = edges_of_points(brep, f, edge_pts);
 
     // 1. Each loop into the parameter domain.
     let (chains, pole_vertices) = loop_chains(brep, f, edge_pts, vert_idx, positions)?;
@@ -129,78 +118,8 @@ pub(super) fn face_polygons(
             polys.push(join_wrapping(a, b, axis, per, s, positions, opts));
         } else {
             // Close through the singular line on the side the face lies.
-            let lines = if axis == 0 { &sing_v } else { &sing_u };
-            let other = 1 - axis;
-            let level = a.iter().map(|p| p.uv[other]).sum::<f64>() / a.len() as f64;
-            // Travelling +axis with the face on the left means the face is on the +other side
-            // for axis u; for axis v the left is the -u side.
-            let dir = wa[axis].signum() as f64 * sense * if axis == 0 { 1.0 } else { -1.0 };
-            let pick = lines
-                .iter()
-                .copied()
-                .filter(|x| (x - level) * dir > 0.0)
-                .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
-                .or_else(|| {
-                    lines
-                        .iter()
-                        .copied()
-                        .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
-                });
-            let Some(line) = pick else {
-                return Err(face_err(
-                    brep,
-                    f,
-                    "a boundary loop wraps around the surface and nothing closes it",
-                ));
-            };
-            let first = a[0].uv;
-            let mut uv_end = first;
-            uv_end[axis] += wa[axis] as f64 * per;
-            let mut c1 = uv_end;
-            c1[other] = line;
-            let mut c2 = first;
-            c2[other] = line;
-            let p3 = s.eval(c1[0], c1[1]);
-            let pole = pole_vertices
-                .iter()
-                .copied()
-                .find(|&i| {
-                    (positions[i as usize] - p3).norm()
-                        < POINT_COINCIDENCE * (1.0 + p3.coords.norm())
-                })
-                .unwrap_or_else(|| {
-                    positions.push(p3);
-                    (positions.len() - 1) as u32
-                });
-            let sk = if axis == 0 { 1 } else { 2 };
-            let mut poly = a;
-            let start = poly[0];
-            let end = Pt {
-                uv: uv_end,
-                idx: start.idx,
-                sing: start.sing,
-            };
-            // The two sides of the cut from the loop to the pole are one curve on the surface
-            // (a meridian of a sphere): sample it like an edge, the same vertices on both sides.
-            let mut shift = [0.0; 2];
-            shift[axis] = wa[axis] as f64 * per;
-            let cut = cut_points(s, uv_end, c1, positions, opts);
-            poly.push(end);
-            poly.extend(cut.iter().copied());
-            poly.push(Pt {
-                uv: c1,
-                idx: pole,
-                sing: sk,
-            });
-            poly.push(Pt {
-                uv: c2,
-                idx: pole,
-                sing: sk,
-            });
-            poly.extend(cut.iter().rev().map(|p| Pt {
-                uv: [p.uv[0] - shift[0], p.uv[1] - shift[1]],
-                ..*p
-            }));
+            let closed = (&sing_v, &sing_u, &pole_vertices[..]);
+            let poly = close_through_pole(brep, f, a, wa, closed, positions, opts)?;
             polys.push(poly);
         }
     }
@@ -246,6 +165,119 @@ pub(super) fn face_polygons(
     Ok((polys, edge_of))
 }
 
+/// Which B-rep edges each boundary point of a face lies on (vertices: all their edges in this
+/// face).
+fn edges_of_points(
+    brep: &Brep,
+    f: FaceId,
+    edge_pts: &HashMap<EdgeId, Vec<u32>>,
+) -> HashMap<u32, Vec<u32>> {
+    let face = brep.face(f);
+    let mut edge_of: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &l in &face.loops {
+        for &c in &brep.loops[l.idx()].coedges {
+            let e = brep.coedges[c.idx()].edge;
+            for &i in edge_pts.get(&e).into_iter().flatten() {
+                let v = edge_of.entry(i).or_default();
+                if !v.contains(&e.0) {
+                    v.push(e.0);
+                }
+            }
+        }
+    }
+    edge_of
+}
+
+/// A loop `a` wrapping once around periodic direction `wa` with no partner, closed through the
+/// singular line (of `sing_v` for `u`, `sing_u` for `v`) on the side the face lies: the cut to
+/// the pole sampled like an edge, the same vertices on both sides.
+fn close_through_pole(
+    brep: &Brep,
+    f: FaceId,
+    a: Vec<Pt>,
+    wa: [i64; 2],
+    (sing_v, sing_u, pole_vertices): (&Vec<f64>, &Vec<f64>, &[u32]),
+    positions: &mut Vec<P3>,
+    opts: &MeshOptions,
+) -> Result<Vec<Pt>, MeshError> {
+    let s = brep.face_surface(f);
+    let sense = if brep.face(f).same_sense { 1.0 } else { -1.0 };
+    let axis = if wa[0] != 0 { 0 } else { 1 };
+    let per = [s.u_period(), s.v_period()][axis].unwrap_or(0.0);
+    let lines = if axis == 0 { &sing_v } else { &sing_u };
+    let other = 1 - axis;
+    let level = a.iter().map(|p| p.uv[other]).sum::<f64>() / a.len() as f64;
+    // Travelling +axis with the face on the left means the face is on the +other side
+    // for axis u; for axis v the left is the -u side.
+    let dir = wa[axis].signum() as f64 * sense * if axis == 0 { 1.0 } else { -1.0 };
+    let pick = lines
+        .iter()
+        .copied()
+        .filter(|x| (x - level) * dir > 0.0)
+        .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
+        .or_else(|| {
+            lines
+                .iter()
+                .copied()
+                .min_by(|x, y| (x - level).abs().total_cmp(&(y - level).abs()))
+        });
+    let Some(line) = pick else {
+        return Err(face_err(
+            brep,
+            f,
+            "a boundary loop wraps around the surface and nothing closes it",
+        ));
+    };
+    let first = a[0].uv;
+    let mut uv_end = first;
+    uv_end[axis] += wa[axis] as f64 * per;
+    let mut c1 = uv_end;
+    c1[other] = line;
+    let mut c2 = first;
+    c2[other] = line;
+    let p3 = s.eval(c1[0], c1[1]);
+    let pole = pole_vertices
+        .iter()
+        .copied()
+        .find(|&i| {
+            (positions[i as usize] - p3).norm() < POINT_COINCIDENCE * (1.0 + p3.coords.norm())
+        })
+        .unwrap_or_else(|| {
+            positions.push(p3);
+            (positions.len() - 1) as u32
+        });
+    let sk = if axis == 0 { 1 } else { 2 };
+    let mut poly = a;
+    let start = poly[0];
+    let end = Pt {
+        uv: uv_end,
+        idx: start.idx,
+        sing: start.sing,
+    };
+    // The two sides of the cut from the loop to the pole are one curve on the surface
+    // (a meridian of a sphere): sample it like an edge, the same vertices on both sides.
+    let mut shift = [0.0; 2];
+    shift[axis] = wa[axis] as f64 * per;
+    let cut = cut_points(s, uv_end, c1, positions, opts);
+    poly.push(end);
+    poly.extend(cut.iter().copied());
+    poly.push(Pt {
+        uv: c1,
+        idx: pole,
+        sing: sk,
+    });
+    poly.push(Pt {
+        uv: c2,
+        idx: pole,
+        sing: sk,
+    });
+    poly.extend(cut.iter().rev().map(|p| Pt {
+        uv: [p.uv[0] - shift[0], p.uv[1] - shift[1]],
+        ..*p
+    }));
+    Ok(poly)
+}
+
 /// Whether a boundary polygon closes through a pole (two consecutive points on one singular
 /// line).
 fn has_bridge(poly: &[Pt]) -> bool {
@@ -289,7 +321,7 @@ fn fix_bridge_orientation(poly: &mut [Pt], periods: [Option<f64>; 2], sense: f64
     let starts: Vec<usize> = (1..n)
         .filter(|&k| is_break(&poly[k - 1], &poly[k]))
         .collect();
-    if starts.is_empty() || signed_area(poly) * sense > 1e-12 {
+    if starts.is_empty() || signed_area(poly) * sense > PARAMETER_AREA {
         return;
     }
     let mut best = (signed_area(poly) * sense, None);
@@ -333,10 +365,9 @@ fn full_domain(
     let (nu, nv) = (step_count(ur, du, 4), step_count(vr, dv, 4));
     let size = s.size_hint();
     let new_vertex = |p: P3, positions: &mut Vec<P3>| -> u32 {
-        if let Some(&i) = pole_vertices
-            .iter()
-            .find(|&&i| (positions[i as usize] - p).norm() <= SURFACE_COINCIDENCE * size.max(1e-9))
-        {
+        if let Some(&i) = pole_vertices.iter().find(|&&i| {
+            (positions[i as usize] - p).norm() <= SURFACE_COINCIDENCE * size.max(LENGTH_FLOOR)
+        }) {
             return i;
         }
         positions.push(p);
@@ -345,7 +376,7 @@ fn full_domain(
     // A side collapses when all its points coincide.
     let collapsed = |pts: &[P3]| {
         pts.iter()
-            .all(|p| (p - pts[0]).norm() <= SURFACE_COINCIDENCE * size.max(1e-9))
+            .all(|p| (p - pts[0]).norm() <= SURFACE_COINCIDENCE * size.max(LENGTH_FLOOR))
     };
     let side_u = |v: f64| -> Vec<P3> {
         (0..=nu)

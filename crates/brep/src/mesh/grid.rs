@@ -2,6 +2,7 @@
 
 use super::options::MeshOptions;
 use crate::surface::Surface;
+use crate::tolerance::{CURVATURE_RELATIVE, DERIVATIVE_ZERO, PARAMETER_SPAN_FLOOR};
 
 /// How many steps of `step` cover `range`: at least `min`, at most 400 (a grid's side).
 pub(super) fn step_count(range: (f64, f64), step: f64, min: usize) -> usize {
@@ -24,8 +25,8 @@ pub(super) fn grid_steps(
     }
     let n = 8;
     let (mut du, mut dv) = (f64::INFINITY, f64::INFINITY);
-    let hu = (ub.1 - ub.0).max(1e-9) * 1e-3;
-    let hv = (vb.1 - vb.0).max(1e-9) * 1e-3;
+    let hu = (ub.1 - ub.0).max(PARAMETER_SPAN_FLOOR) * 1e-3;
+    let hv = (vb.1 - vb.0).max(PARAMETER_SPAN_FLOOR) * 1e-3;
     for i in 0..=n {
         for j in 0..=n {
             // Sample cell centres: second differences at a clamped domain edge are meaningless.
@@ -38,15 +39,15 @@ pub(super) fn grid_steps(
             let svv =
                 (s.eval(u, v + hv).coords - p.coords * 2.0 + s.eval(u, v - hv).coords) / (hv * hv);
             let (muu, mvv) = (suu.norm(), svv.norm());
-            if muu > 1e-9 * (1.0 + su.norm()) {
+            if muu > CURVATURE_RELATIVE * (1.0 + su.norm()) {
                 du = du.min((8.0 * opts.chord_tol / muu).sqrt());
-                if su.norm() > 1e-12 {
+                if su.norm() > DERIVATIVE_ZERO {
                     du = du.min(opts.angle_tol * su.norm() / muu);
                 }
             }
-            if mvv > 1e-9 * (1.0 + sv.norm()) {
+            if mvv > CURVATURE_RELATIVE * (1.0 + sv.norm()) {
                 dv = dv.min((8.0 * opts.chord_tol / mvv).sqrt());
-                if sv.norm() > 1e-12 {
+                if sv.norm() > DERIVATIVE_ZERO {
                     dv = dv.min(opts.angle_tol * sv.norm() / mvv);
                 }
             }

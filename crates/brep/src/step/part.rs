@@ -2,6 +2,7 @@
 
 use super::error::ReadError;
 use super::p21::P21File;
+use crate::tolerance::PARALLEL;
 use crate::topology::Brep;
 use std::path::Path;
 
@@ -84,7 +85,7 @@ pub fn turn_down(n: [f64; 3]) -> [[f64; 3]; 3] {
     let (kx, ky) = (-n[1], n[0]);
     let s = (kx * kx + ky * ky).sqrt();
     let c = -n[2];
-    if s < 1e-12 {
+    if s < PARALLEL {
         return if c > 0.0 {
             [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         } else {

@@ -10,16 +10,15 @@
 //! when the profile does not say).
 
 pub mod motion;
+mod tolerance;
 
 use motion::Move;
 use robot_post::machine::{MachineProfile, DEFAULT_JERK};
 use slicer::toolpath::{MoveKind, PathPoint, ToolPath};
+use tolerance::MIN_MOVE;
 
 /// PLA's density, g/cm³, for profiles without `filament_density`.
 pub const PLA_DENSITY: f64 = 1.24;
-
-/// Moves shorter than this (mm) take no time and do not turn.
-const MIN_MOVE: f64 = 1e-9;
 
 /// A plan's estimate.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

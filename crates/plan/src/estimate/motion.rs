@@ -76,7 +76,11 @@ fn junction_speed(a: &Move, b: &Move, jerk: f64) -> f64 {
         + (a.dir[1] - b.dir[1]).powi(2)
         + (a.dir[2] - b.dir[2]).powi(2))
     .sqrt();
-    let turn = if du > 1e-12 { jerk / du } else { f64::INFINITY };
+    let turn = if du > super::tolerance::NO_TURN {
+        jerk / du
+    } else {
+        f64::INFINITY
+    };
     a.speed.min(b.speed).min(turn)
 }
 

@@ -2,6 +2,7 @@
 //! kinematic error plot (SVG).
 
 use crate::gcode::comment_text;
+use crate::tolerance::{AXIS_MAX_FLOOR, TICK_END_SLACK, TICK_STEP_FLOOR};
 use toolpath::fixed;
 
 /// Kinematic figures of one feature's print moves (paper Fig. 16).
@@ -38,7 +39,7 @@ fn xml(s: &str) -> String {
 
 /// A round tick step (1, 2 or 5 times a power of ten) giving about `count` ticks over `span`.
 fn tick_step(span: f64, count: f64) -> f64 {
-    let raw = (span / count).max(1e-12);
+    let raw = (span / count).max(TICK_STEP_FLOOR);
     let p = 10f64.powf(raw.log10().floor());
     [1.0, 2.0, 5.0, 10.0]
         .into_iter()
@@ -61,7 +62,7 @@ pub(super) fn error_plot(samples: &[(usize, f64, f64)], goal: f64, source: &str)
     let (w, h) = (900.0, 420.0);
     let (left, right, top, bottom) = (80.0, 160.0, 40.0, 60.0);
     let (pw, ph) = (w - left - right, h - top - bottom);
-    let x_max = samples.last().map_or(0.0, |s| s.1).max(1e-9);
+    let x_max = samples.last().map_or(0.0, |s| s.1).max(AXIS_MAX_FLOOR);
     let y_top = samples.iter().map(|s| s.2).fold(goal, f64::max) * 1.15;
     let sx = |x: f64| left + pw * x / x_max;
     let sy = |y: f64| top + ph * (1.0 - y / y_top);
@@ -85,7 +86,7 @@ pub(super) fn error_plot(samples: &[(usize, f64, f64)], goal: f64, source: &str)
     ));
     let xs = tick_step(x_max, 8.0);
     let mut x = 0.0;
-    while x <= x_max * (1.0 + 1e-9) {
+    while x <= x_max * (1.0 + TICK_END_SLACK) {
         let px = sx(x);
         o.push_str(&format!(
             "<line x1=\"{px:.2}\" y1=\"{}\" x2=\"{px:.2}\" y2=\"{}\" stroke=\"black\"/><text x=\"{px:.2}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
@@ -98,7 +99,7 @@ pub(super) fn error_plot(samples: &[(usize, f64, f64)], goal: f64, source: &str)
     }
     let ys = tick_step(y_top, 6.0);
     let mut y = 0.0;
-    while y <= y_top * (1.0 + 1e-9) {
+    while y <= y_top * (1.0 + TICK_END_SLACK) {
         let py = sy(y);
         o.push_str(&format!(
             "<line x1=\"{}\" y1=\"{py:.2}\" x2=\"{}\" y2=\"{py:.2}\" stroke=\"#dddddd\"/><text x=\"{}\" y=\"{:.2}\" text-anchor=\"end\">{}</text>\n",

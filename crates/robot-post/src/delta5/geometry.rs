@@ -3,14 +3,10 @@
 
 use crate::PostError;
 
-/// Below this |(n_x, n_y)| the tool axis is the singular point itself: θ is undefined.
-pub(super) const POLE: f64 = 1e-9;
+pub(super) use crate::tolerance::{ANGLE_TOLERANCE, POLE};
 
 /// Slack (mm) allowed when checking the work envelope.
 pub(super) const FIT_TOLERANCE: f64 = 1e-6;
-
-/// Slack (degrees) allowed when checking the B and C limits.
-pub(super) const ANGLE_TOLERANCE: f64 = 1e-9;
 
 /// The bed's geometry and the controller's resolutions: the `[delta5]` table of a `delta5`
 /// machine profile. `profiles/delta5.toml` documents every key; lengths in mm, angles in

@@ -3,6 +3,7 @@
 //! inside the singularity cone.
 
 use super::geometry::{Delta5Geometry, ANGLE_TOLERANCE, POLE};
+use crate::tolerance::ARC_ZERO;
 use crate::PostError;
 use toolpath::vec3::{norm, sub, unit};
 use toolpath::{fixed, MoveKind, PathPoint};
@@ -260,7 +261,7 @@ fn plan_run(
     for i in (0..n).filter(|&i| singular[i]) {
         c[i] = match (before[i], after[i]) {
             (Some(j), Some(k)) => {
-                let f = if s[k] - s[j] > 1e-12 {
+                let f = if s[k] - s[j] > ARC_ZERO {
                     (s[i] - s[j]) / (s[k] - s[j])
                 } else {
                     (i - j) as f64 / (k - j) as f64

@@ -11,6 +11,7 @@ use super::kinematics::{
 };
 use crate::gcode::{e_text, mergeable, push_line, Extrusion, Fan, LayerMarks};
 use crate::machine::MachineProfile;
+use crate::tolerance::{MOVE_ZERO, STEP_COUNT_SLACK};
 use crate::PostError;
 use toolpath::vec3::{norm, sub, unit};
 use toolpath::{fixed, PathPoint};
@@ -381,8 +382,8 @@ impl<'a> Writer<'a> {
             if to == from || (de == 0 && mergeable(xyz, rotary)) {
                 continue;
             }
-            let distance = if xyz > 1e-9 { xyz } else { rotary };
-            let f = if part_step > 1e-9 && distance > 0.0 {
+            let distance = if xyz > MOVE_ZERO { xyz } else { rotary };
+            let f = if part_step > MOVE_ZERO && distance > 0.0 {
                 60.0 * v * distance / part_step
             } else {
                 60.0 * v
@@ -469,7 +470,8 @@ impl<'a> Writer<'a> {
     ) -> (Vec<Joints>, Vec<MoveError>) {
         let g = self.g;
         let dc = (pq.c - pa.c).abs();
-        let mut n = ((dc / g.max_c_step_deg - 1e-9).ceil().max(1.0) as usize).min(MAX_SUBDIVISION);
+        let mut n = ((dc / g.max_c_step_deg - STEP_COUNT_SLACK).ceil().max(1.0) as usize)
+            .min(MAX_SUBDIVISION);
         loop {
             let moves = self.sub_moves(a, pa, q, pq, n);
             let mut from = start;

@@ -15,6 +15,7 @@ use super::{Discard, FitError};
 use crate::kuka::{part_offset, start_frame, KukaCell, Pose};
 use crate::machine::MachineProfile;
 use crate::placement::bed_gaps_xy;
+use crate::tolerance::MIN_AXIS;
 use crate::PostError;
 use toolpath::vec3::{add, norm, scale};
 use toolpath::{MoveKind, ToolPath};
@@ -36,9 +37,6 @@ const MAX_CONFIRMED: usize = 6;
 
 /// Slack (mm) of the table-edge test.
 const EDGE_SLACK: f64 = 1e-6;
-
-/// Tool axes shorter than this are not directions (the post refuses them).
-const MIN_AXIS: f64 = 1e-9;
 
 /// A place on the table where every point is in reach.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,6 +8,7 @@ use super::rotation::{
 };
 use crate::machine::MachineProfile;
 use crate::placement::bed_offset;
+use crate::tolerance::{FEED_RATIO_CHANGE, POSE_SAME_DEG, POSE_SAME_MM};
 use crate::PostError;
 use std::collections::VecDeque;
 use toolpath::vec3::{add, cross, norm, scale, sub, V3};
@@ -375,7 +376,10 @@ impl Motion {
             .map(|q| q.e)
             .sum();
         let ratio = e / length;
-        if self.feed.is_none_or(|f| (f - ratio).abs() > 1e-7) {
+        if self
+            .feed
+            .is_none_or(|f| (f - ratio).abs() > FEED_RATIO_CHANGE)
+        {
             self.feed = Some(ratio);
             self.steps.push_back(Step::Feed(ratio));
         }
@@ -384,7 +388,8 @@ impl Motion {
     /// Whether `pose` is the previous motion's (within 1e-9 mm and 1e-9°).
     fn goes_nowhere(&self, pose: &Pose) -> bool {
         self.last.is_some_and(|(last, _)| {
-            norm(sub(last.t, pose.t)) < 1e-9 && rotation_angle_deg(&last.r, &pose.r) < 1e-9
+            norm(sub(last.t, pose.t)) < POSE_SAME_MM
+                && rotation_angle_deg(&last.r, &pose.r) < POSE_SAME_DEG
         })
     }
 

@@ -5,6 +5,7 @@ use super::cell::ArmModel;
 use std::f64::consts::PI;
 
 use super::rotation::{col, mul, rot_y, rot_z, transpose, wrap180, Pose};
+use crate::tolerance::{COSINE_SLACK, WRIST_SINGULAR};
 use toolpath::vec3::{add, scale, sub};
 
 /// The arm's kinematics (OPW: Brandstötter, Angerer & Hofbaur 2014).
@@ -73,7 +74,7 @@ impl ArmModel {
             let q1 = c[1].atan2(c[0]) - self.b.atan2(cx1);
             let (u, v) = (cx1 - self.a1, c[2] - self.c1);
             let cos_phi = (u * u + v * v - self.c2 * self.c2 - k * k) / (2.0 * self.c2 * k);
-            if cos_phi.is_nan() || cos_phi.abs() > 1.0 + 1e-12 {
+            if cos_phi.is_nan() || cos_phi.abs() > 1.0 + COSINE_SLACK {
                 continue;
             }
             let acos = cos_phi.clamp(-1.0, 1.0).acos();
@@ -86,7 +87,7 @@ impl ArmModel {
                 let s5 = rce[0][2].hypot(rce[1][2]);
                 let q5 = s5.atan2(rce[2][2]);
                 let mut push = |q: [f64; 6]| out.push((q, self.config(&q)));
-                if s5 > 1e-12 {
+                if s5 > WRIST_SINGULAR {
                     let q4 = rce[1][2].atan2(rce[0][2]);
                     let q6 = rce[2][1].atan2(-rce[2][0]);
                     push([q1, q2, q3, q4, q5, q6]);

@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 
 use toolpath::vec3::{add, cross, dot, norm, scale, sub, V3};
 
-/// `cos B` below which a rotation is treated as gimbal-locked (B = ±90°).
-pub(super) const GIMBAL_EPS: f64 = 1e-9;
+pub(super) use crate::tolerance::GIMBAL_EPS;
+use crate::tolerance::{FRAME_HINT_MIN, PARALLEL_AXES, ROTATION_ZERO, SMALL_ROTATION};
 
 /// A rotation matrix, rows: `r[i][j]` is row i, column j; column j is the rotated frame's
 /// j-th axis.
@@ -117,7 +117,7 @@ pub(super) fn angle_of(r: &Mat3) -> (f64, V3) {
 /// Rotation vector (axis · angle, radians) of a rotation matrix.
 pub(super) fn log_rot(r: &Mat3) -> V3 {
     let (angle, w) = angle_of(r);
-    if angle < 1e-9 {
+    if angle < SMALL_ROTATION {
         return scale(w, 0.5);
     }
     if angle > PI - 1e-6 {
@@ -147,7 +147,7 @@ pub(super) fn log_rot(r: &Mat3) -> V3 {
 /// Rotation matrix of a rotation vector (Rodrigues).
 pub(super) fn exp_rot(v: V3) -> Mat3 {
     let angle = norm(v);
-    if angle < 1e-15 {
+    if angle < ROTATION_ZERO {
         return IDENTITY;
     }
     let k = scale(v, 1.0 / angle);
@@ -191,7 +191,7 @@ pub(super) fn transport(r: &Mat3, z: V3) -> Mat3 {
     let c = cross(z0, z);
     let s = norm(c);
     let d = dot(z0, z);
-    let turn = if s < 1e-12 {
+    let turn = if s < PARALLEL_AXES {
         if d > 0.0 {
             IDENTITY
         } else {
@@ -202,7 +202,7 @@ pub(super) fn transport(r: &Mat3, z: V3) -> Mat3 {
         exp_rot(scale(c, s.atan2(d) / s))
     };
     let x = apply(&turn, x0);
-    frame_from_zx(z, x, 1e-9).unwrap_or(*r)
+    frame_from_zx(z, x, FRAME_HINT_MIN).unwrap_or(*r)
 }
 
 /// A rigid transform: rotation `r` then translation `t` (mm).

@@ -4,7 +4,7 @@
 use super::region::{bounds, region_shapes};
 use super::{Contour, Shapes};
 use crate::geom2d::{area2, dist, perimeter, seg_dist, Point2, Region};
-use crate::tolerance::ROUND_OFF;
+use crate::tolerance::{EMPTY_AREA2, ROUND_OFF};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 use i_overlay::mesh::math::MathMode;
@@ -230,7 +230,7 @@ pub(super) fn drop_specks(shapes: Shapes) -> Shapes {
         .filter_map(|shape| {
             let mut it = shape.into_iter().filter(|c| c.len() >= 3);
             let outer = it.next()?;
-            if area2(&outer).abs() <= 1e-18 {
+            if area2(&outer).abs() <= EMPTY_AREA2 {
                 return None;
             }
             let mut s = vec![outer];

@@ -6,7 +6,9 @@ use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
 use crate::geom2d::{area2, dist, perimeter, Point2};
-use crate::tolerance::ROUND_OFF;
+use crate::tolerance::{
+    AREA_SLACK, COUNT_SLACK, DEGENERATE_LENGTH, NONZERO, PARALLEL_RAY, ROUND_OFF,
+};
 use crate::toolpath::Role;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -23,7 +25,7 @@ fn ray_to_boundary(base: &Shapes, p: Point2, d: Point2) -> Option<f64> {
             let (a, b) = (c[i], c[(i + 1) % n]);
             let e = [b[0] - a[0], b[1] - a[1]];
             let den = cross(d, e);
-            if den.abs() <= 1e-15 * (1.0 + e[0].abs() + e[1].abs()) {
+            if den.abs() <= PARALLEL_RAY * (1.0 + e[0].abs() + e[1].abs()) {
                 continue;
             }
             let ap = [a[0] - p[0], a[1] - p[1]];
@@ -105,7 +107,7 @@ pub(super) fn rings(
         } else {
             opening(&cur, OPEN_SHARE * ctx.spacing, ctx)
         };
-        let opened = !clean && shapes_area(&ring) < shapes_area(&cur) - 1e-9;
+        let opened = !clean && shapes_area(&ring) < shapes_area(&cur) - AREA_SLACK;
         if lost || opened {
             let edge = match &before {
                 Some(b) => erode(b, half, &ctx.join),
@@ -235,7 +237,7 @@ fn principal_angle(shape: &Shape) -> f64 {
             sxy += (x0 * y1 + 2.0 * x0 * y0 + 2.0 * x1 * y1 + x1 * y0) * cr / 24.0;
         }
     }
-    if a.abs() < 1e-300 {
+    if a.abs() < NONZERO {
         return 0.0;
     }
     let (cx, cy) = (sx / a, sy / a);
@@ -299,23 +301,7 @@ pub(super) fn scan_fill(
     let (sn, cs) = angle.sin_cos();
     let rot = |p: Point2| [p[0] * cs + p[1] * sn, -p[0] * sn + p[1] * cs];
     let unrot = |p: Point2| [p[0] * cs - p[1] * sn, p[0] * sn + p[1] * cs];
-    let mut rings: Vec<Ring> = Vec::new();
-    let (mut ymin, mut ymax) = (f64::INFINITY, -f64::INFINITY);
-    for c in area.iter().flatten() {
-        if c.len() < 3 {
-            continue;
-        }
-        let pts: Vec<Point2> = c.iter().map(|&p| rot(p)).collect();
-        let mut cum = Vec::with_capacity(pts.len());
-        let mut l = 0.0;
-        for i in 0..pts.len() {
-            cum.push(l);
-            l += dist(pts[i], pts[(i + 1) % pts.len()]);
-            ymin = ymin.min(pts[i][1]);
-            ymax = ymax.max(pts[i][1]);
-        }
-        rings.push(Ring { pts, cum, len: l });
-    }
+    let (rings, ymin, ymax) = scan_rings(area, rot);
     let h = ymax - ymin;
     let eps = ROUND_OFF * (1.0 + ymin.abs().max(ymax.abs()));
     let lines = h / spacing;
@@ -324,63 +310,17 @@ pub(super) fn scan_fill(
     }
     // Lines centred on the area's extent; the outermost pulled a hair inside so a line on a
     // boundary edge still cuts the area.
-    let n = (h / spacing + 1e-9).floor() as usize + 1;
+    let n = (h / spacing + COUNT_SLACK).floor() as usize + 1;
     let y0 = ymin + 0.5 * (h - (n - 1) as f64 * spacing);
     let ys: Vec<f64> = (0..n)
         .map(|j| (y0 + j as f64 * spacing).clamp(ymin + eps, ymax - eps))
         .collect();
 
     // Crossings of every line with every edge (half-open in y, so vertices count once).
-    let mut hits: Vec<Vec<(f64, usize, usize, f64)>> = vec![Vec::new(); n];
-    for (ri, r) in rings.iter().enumerate() {
-        let m = r.pts.len();
-        for i in 0..m {
-            let (p, q) = (r.pts[i], r.pts[(i + 1) % m]);
-            if p[1] == q[1] {
-                continue;
-            }
-            let (lo, hi) = if p[1] < q[1] {
-                (p[1], q[1])
-            } else {
-                (q[1], p[1])
-            };
-            let el = dist(p, q);
-            let mut j = ys.partition_point(|&y| y < lo);
-            while j < n && ys[j] < hi {
-                let t = (ys[j] - p[1]) / (q[1] - p[1]);
-                let x = p[0] + t * (q[0] - p[0]);
-                hits[j].push((x, ri, i, r.cum[i] + t * el));
-                j += 1;
-            }
-        }
-    }
+    let mut hits = crossings(&rings, &ys);
 
     // Segments: even-odd pairs of crossings along each line.
-    let mut ends: Vec<End> = Vec::new();
-    let mut segs: Vec<(usize, [usize; 2])> = Vec::new();
-    let mut by_line: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (j, hs) in hits.iter_mut().enumerate() {
-        hs.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for pair in hs.chunks_exact(2) {
-            let (a, b) = (pair[0], pair[1]);
-            if b.0 - a.0 <= 1e-9 || b.0.is_nan() || a.0.is_nan() {
-                continue;
-            }
-            let sid = segs.len();
-            let mk = |h: (f64, usize, usize, f64), side| End {
-                seg: sid,
-                side,
-                ring: h.1,
-                edge: h.2,
-                pos: h.3,
-                p: [h.0, ys[j]],
-            };
-            ends.push(mk(a, 0));
-            ends.push(mk(b, 1));
-            segs.push((j, [ends.len() - 2, ends.len() - 1]));
-            by_line[j].push(sid);
-        }
-    }
+    let (ends, segs, by_line) = segments(&mut hits, &ys);
     // Where a free end runs on to (in the scan frame): along its line, outward, to the
     // boundary of `reach.base`, but no more than half the way to the next piece of the line.
     let mut slot = vec![0usize; segs.len()];
@@ -423,17 +363,7 @@ pub(super) fn scan_fill(
     }
 
     // Ends in order along each ring: neighbours there have no other line ending between them.
-    let mut order: Vec<Vec<usize>> = vec![Vec::new(); rings.len()];
-    for (e, end) in ends.iter().enumerate() {
-        order[end.ring].push(e);
-    }
-    let mut rank = vec![0usize; ends.len()];
-    for o in order.iter_mut() {
-        o.sort_by(|&a, &b| ends[a].pos.total_cmp(&ends[b].pos));
-        for (k, &e) in o.iter().enumerate() {
-            rank[e] = k;
-        }
-    }
+    let (order, rank) = ring_order(&ends, rings.len());
     let cap = 10.0 * spacing;
     let mut used = vec![false; segs.len()];
     for line in &by_line {
@@ -493,6 +423,110 @@ pub(super) fn scan_fill(
             });
         }
     }
+}
+
+/// The area's rings of three points or more turned into the scan frame by `rot`, with their
+/// arc lengths, and the frame's y extent.
+fn scan_rings(area: &Shapes, rot: impl Fn(Point2) -> Point2) -> (Vec<Ring>, f64, f64) {
+    let mut rings: Vec<Ring> = Vec::new();
+    let (mut ymin, mut ymax) = (f64::INFINITY, -f64::INFINITY);
+    for c in area.iter().flatten() {
+        if c.len() < 3 {
+            continue;
+        }
+        let pts: Vec<Point2> = c.iter().map(|&p| rot(p)).collect();
+        let mut cum = Vec::with_capacity(pts.len());
+        let mut l = 0.0;
+        for i in 0..pts.len() {
+            cum.push(l);
+            l += dist(pts[i], pts[(i + 1) % pts.len()]);
+            ymin = ymin.min(pts[i][1]);
+            ymax = ymax.max(pts[i][1]);
+        }
+        rings.push(Ring { pts, cum, len: l });
+    }
+    (rings, ymin, ymax)
+}
+
+/// Crossings of every scan line (at `ys`) with every edge of the rings (half-open in y, so
+/// vertices count once): x, ring, edge and arc length, per line.
+fn crossings(rings: &[Ring], ys: &[f64]) -> Vec<Vec<(f64, usize, usize, f64)>> {
+    let mut hits: Vec<Vec<(f64, usize, usize, f64)>> = vec![Vec::new(); ys.len()];
+    for (ri, r) in rings.iter().enumerate() {
+        let m = r.pts.len();
+        for i in 0..m {
+            let (p, q) = (r.pts[i], r.pts[(i + 1) % m]);
+            if p[1] == q[1] {
+                continue;
+            }
+            let (lo, hi) = if p[1] < q[1] {
+                (p[1], q[1])
+            } else {
+                (q[1], p[1])
+            };
+            let el = dist(p, q);
+            let mut j = ys.partition_point(|&y| y < lo);
+            while j < ys.len() && ys[j] < hi {
+                let t = (ys[j] - p[1]) / (q[1] - p[1]);
+                let x = p[0] + t * (q[0] - p[0]);
+                hits[j].push((x, ri, i, r.cum[i] + t * el));
+                j += 1;
+            }
+        }
+    }
+    hits
+}
+
+/// Segments: even-odd pairs of crossings along each line (sorted in place). Their ends, each
+/// segment's line and ends, and each line's segments.
+#[allow(clippy::type_complexity)]
+fn segments(
+    hits: &mut [Vec<(f64, usize, usize, f64)>],
+    ys: &[f64],
+) -> (Vec<End>, Vec<(usize, [usize; 2])>, Vec<Vec<usize>>) {
+    let mut ends: Vec<End> = Vec::new();
+    let mut segs: Vec<(usize, [usize; 2])> = Vec::new();
+    let mut by_line: Vec<Vec<usize>> = vec![Vec::new(); ys.len()];
+    for (j, hs) in hits.iter_mut().enumerate() {
+        hs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for pair in hs.chunks_exact(2) {
+            let (a, b) = (pair[0], pair[1]);
+            if b.0 - a.0 <= DEGENERATE_LENGTH || b.0.is_nan() || a.0.is_nan() {
+                continue;
+            }
+            let sid = segs.len();
+            let mk = |h: (f64, usize, usize, f64), side| End {
+                seg: sid,
+                side,
+                ring: h.1,
+                edge: h.2,
+                pos: h.3,
+                p: [h.0, ys[j]],
+            };
+            ends.push(mk(a, 0));
+            ends.push(mk(b, 1));
+            segs.push((j, [ends.len() - 2, ends.len() - 1]));
+            by_line[j].push(sid);
+        }
+    }
+    (ends, segs, by_line)
+}
+
+/// Ends in order along each ring (neighbours there have no other line ending between them),
+/// and each end's rank in its ring's order.
+fn ring_order(ends: &[End], rings: usize) -> (Vec<Vec<usize>>, Vec<usize>) {
+    let mut order: Vec<Vec<usize>> = vec![Vec::new(); rings];
+    for (e, end) in ends.iter().enumerate() {
+        order[end.ring].push(e);
+    }
+    let mut rank = vec![0usize; ends.len()];
+    for o in order.iter_mut() {
+        o.sort_by(|&a, &b| ends[a].pos.total_cmp(&ends[b].pos));
+        for (k, &e) in o.iter().enumerate() {
+            rank[e] = k;
+        }
+    }
+    (order, rank)
 }
 
 /// Pushes the ring's vertices strictly between end `e` and the point `len` further along the

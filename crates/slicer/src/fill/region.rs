@@ -2,7 +2,7 @@
 
 use super::{Contour, Shape, Shapes, MAX_COORD};
 use crate::geom2d::{area2, inside, on_boundary, perimeter, Point2, Region};
-use crate::tolerance::ROUND_OFF;
+use crate::tolerance::{ROUND_OFF, SLIVER_AREA};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
@@ -32,7 +32,7 @@ fn clean_loop(pts: &[Point2]) -> Option<Vec<Point2>> {
     let a = area2(&out).abs();
     let scale = perimeter(&out);
     // Zero-area slivers (all points on a line) carry nothing to fill.
-    if a.is_nan() || a <= 1e-12 * scale * scale.max(1.0) {
+    if a.is_nan() || a <= SLIVER_AREA * scale * scale.max(1.0) {
         return None;
     }
     Some(out)

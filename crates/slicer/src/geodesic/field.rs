@@ -3,6 +3,7 @@
 
 use super::mesh::LayerMesh;
 use crate::geom2d::Point2;
+use crate::tolerance::{BOX_SLACK, CELL_FLOOR, SHORT_VECTOR};
 use brep::math::{P3, V3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -50,11 +51,6 @@ struct Cell {
     lo: P3,
     hi: P3,
 }
-
-/// Squared distance (mm²) by which a cell's box must lie beyond the least segment distance so
-/// far for the cell to be passed over: far above the round-off of either (some 1e-13 mm² for
-/// parts a metre across), far below any distance that matters.
-const BOX_SLACK: f64 = 1e-9;
 
 /// The largest `x` with `x.sqrt() <= r` (`r` ≥ 0), so that `x.sqrt() <= r` is `x <= limit` for
 /// every `x`: the square root is monotone and correctly rounded, so the answer is exactly that of
@@ -105,7 +101,7 @@ fn triangle_update(pa: &P3, pb: &P3, pc: &P3, da: f64, db: f64) -> f64 {
     let along_edges = (da + (pc - pa).norm()).min(db + (pc - pb).norm());
     let ab = pb - pa;
     let c = ab.norm();
-    if c < 1e-12 {
+    if c < SHORT_VECTOR {
         return along_edges;
     }
     let ex = ab / c;
@@ -113,7 +109,7 @@ fn triangle_update(pa: &P3, pb: &P3, pc: &P3, da: f64, db: f64) -> f64 {
     let cx = ac.dot(&ex);
     let cy = (ac - ex * cx).norm();
     let gx = (db - da) / c;
-    if cy < 1e-12 || gx.abs() >= 1.0 {
+    if cy < SHORT_VECTOR || gx.abs() >= 1.0 {
         return along_edges;
     }
     let gy = (1.0 - gx * gx).sqrt();
@@ -134,7 +130,7 @@ impl LayerMesh {
     pub fn boundary_seeds(&self, reach: f64) -> Vec<(u32, f64)> {
         // A grid of half-reach cells in the surface-isotropic frame (about mm): the boundary
         // segments within `reach` of a vertex lie in the 5 × 5 cells around it.
-        let cell = (0.5 * reach).max(1e-9);
+        let cell = (0.5 * reach).max(CELL_FLOOR);
         let frame = self.frame.unwrap_or([1.0, 0.0, 1.0]);
         let key = |q: Point2| {
             let y = [frame[0] * q[0] + frame[1] * q[1], frame[2] * q[1]];

@@ -2,6 +2,7 @@
 //! the layer surface.
 
 use crate::geom2d::{dist2, Point2, Region, RegionIndex};
+use crate::tolerance::METRIC_DEGENERATE;
 use brep::math::P3;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 
@@ -368,10 +369,10 @@ impl LayerMesh {
     /// [`LayerMesh::q`]. A degenerate metric falls back to the chart's own frame.
     pub fn build_with_metric(region: &Region, step: f64, g: [[f64; 2]; 2]) -> LayerMesh {
         let a = g[0][0];
-        let m = if a > 1e-12 {
+        let m = if a > METRIC_DEGENERATE {
             let (m00, m01) = (a.sqrt(), g[0][1] / a.sqrt());
             let c = g[1][1] - m01 * m01;
-            (c > 1e-12 * g[1][1].max(1e-12)).then(|| [m00, m01, c.sqrt()])
+            (c > METRIC_DEGENERATE * g[1][1].max(METRIC_DEGENERATE)).then(|| [m00, m01, c.sqrt()])
         } else {
             None
         };

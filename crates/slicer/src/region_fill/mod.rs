@@ -15,6 +15,7 @@ use crate::chart::Chart;
 use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
 use crate::geom2d::{Point2, Region};
 use crate::params::{LayerParams, PathMode};
+use crate::tolerance::{ROUND_OFF, SHORT_VECTOR};
 use crate::toolpath::Role;
 use border::Border;
 use brep::math::{P3, V3};
@@ -139,18 +140,9 @@ pub(crate) fn fill_region(
     sliver_inset: f64,
 ) -> Vec<FillPath> {
     let mut out = vec![];
-    let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
-    if lm.tris.is_empty() {
+    let Some(lm) = lifted_mesh(chart, region, z, spacing) else {
         return out;
-    }
-    let mut pts = Vec::with_capacity(lm.q.len());
-    for q in &lm.q {
-        match chart.point(*q, z) {
-            Some(p) => pts.push(p),
-            None => return out,
-        }
-    }
-    lm.p = pts;
+    };
     // Exact distances (to the lifted boundary) three spacings deep: the rings of the default
     // contour-zig-zag, the infill's edge and a thin blade's ridge all lie there, so they do
     // not depend on how well the front is marched over the lattice.
@@ -168,100 +160,20 @@ pub(crate) fn fill_region(
     // two full 0.45 mm beads). Where what is left is wider than a bead by less than the gap
     // fill's narrowest bead, the ring widens to take it. A ring less than a tenth of a bead
     // below the deepest point is left out.
-    let rings = match params.path_mode {
-        PathMode::Raster | PathMode::Zigzag => 0,
-        PathMode::Contour => usize::MAX,
-        PathMode::ContourZigzag => params.perimeters,
-    };
-    let levels: Vec<f64> = (0..rings)
-        .map(|j| 0.5 * width + j as f64 * spacing)
-        .take_while(|c| *c <= dmax - 0.1 * width)
-        .collect();
+    let (rings, levels) = ring_levels(params, width, spacing, dmax);
     let gap_inset = 0.02 * width;
     // The ridge is needed only where the rings' iso-lines and the gap fills between them run:
     // at both ends of each lattice edge those levels cross.
-    let ridge = if levels.is_empty() {
-        vec![]
-    } else {
-        // Each level with the highest ridge its fill tells apart: a ring's width (a full bead
-        // above the gap fill's narrowest one past its edge) and the gap fill between rings
-        // (nothing at or above the next ring's level).
-        let wanted: Vec<(f64, f64)> = levels
-            .iter()
-            .map(|&c| {
-                (
-                    c,
-                    c - 0.5 * width + GAP_MIN_WIDTH_SHARE.mul_add(width, width),
-                )
-            })
-            .chain(
-                levels
-                    .iter()
-                    .skip(1)
-                    .map(|&c| (c - 0.5 * width + gap_inset, c)),
-            )
-            .collect();
-        ridge(&lm, &db, &wanted, spacing)
-    };
-    let mut last_ring = None;
-    // Where the last ring's paths (and the gap fill before it) begin ([`conserve::conserve_core`]).
-    let mut last_ring_from = 0;
-    for (j, &c) in levels.iter().enumerate() {
-        last_ring_from = out.len();
-        let edge = c - 0.5 * width;
-        if j > 0 {
-            // Where this ring does not reach (the region's half width is under `c` there),
-            // the strip the ring before leaves along the ridge gets its gap fill.
-            let gap = Gap {
-                edge,
-                inset: gap_inset,
-                min_width: GAP_MIN_WIDTH_SHARE * width,
-                below: c,
-            };
-            out.extend(gap_fill(&lm, &db, &ridge, gap, width));
-        }
-        for line in lm.iso_lines(&db, c, &ridge) {
-            let widths = line
-                .other
-                .iter()
-                .map(|r| {
-                    let room = r - edge;
-                    if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
-                        room.max(0.2 * width)
-                    } else {
-                        width
-                    }
-                })
-                .collect();
-            let role = if j == 0 {
-                Role::ExternalPerimeter
-            } else {
-                Role::Perimeter
-            };
-            out.push(FillPath {
-                points: line.q,
-                widths,
-                role,
-            });
-        }
-        last_ring = Some(c);
-    }
+    let ridge = ring_ridge(&lm, &db, &levels, (width, gap_inset), spacing);
+    let (last_ring, last_ring_from) =
+        lay_rings(&lm, &db, &ridge, &levels, (width, gap_inset), &mut out);
     // Infill where the rings stop: lines end a spacing past the last ring, joined along that
     // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
     // the rings leave only a strip narrower than that (a thin blade), the lines cross the strip
     // from the edge of the last ring's bead instead, filling the gap.
     // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
     // it), within what that core holds.
-    let core_fill = |gap: Gap| {
-        let ridge = ridge_for(&lm, &db, gap, spacing, width);
-        conserved(
-            gap_fill(&lm, &db, &ridge, gap, width),
-            &lm,
-            &db,
-            gap.edge,
-            |a, b| surface_length(chart, z, a, b),
-        )
-    };
+    let core_fill = |gap: Gap| core_fill(&lm, &db, chart, z, gap, (spacing, width));
     let inner = match last_ring {
         Some(c) if dmax > c + 1.5 * spacing => c + spacing,
         Some(c) => {
@@ -300,52 +212,11 @@ pub(crate) fn fill_region(
     };
     let zig = params.path_mode != PathMode::Raster;
     let infill = crate::fill::infill_role(width, spacing);
-    let angle = if zig && layer % 2 == 1 {
-        params.raster_angle_deg + 90.0
-    } else {
-        params.raster_angle_deg
-    }
-    .to_radians();
-    let dir = [angle.cos(), angle.sin()];
+    let dir = raster_dir(params, zig && layer % 2 == 1);
     let nrm = [-dir[1], dir[0]];
     // The seed curve: the chart line along `dir` through the deepest point; the field is the
     // signed geodesic distance to it, so its iso-lines are geodesic parallels.
-    let q0 = lm.q[deep];
-    let l: Vec<f64> =
-        lm.q.iter()
-            .map(|q| (q[0] - q0[0]) * nrm[0] + (q[1] - q0[1]) * nrm[1])
-            .collect();
-    // Vertices within a spacing of the seed line start at their distance across it: the
-    // chart offset times the surface's stretch across the line there, i.e. the part of the
-    // surface step along the chart normal that is square to the line's own surface direction
-    // (a sheared chart does not map the chart normal to the surface normal of the line).
-    let stretch = {
-        let e = 1e-3;
-        let step = |d: [f64; 2]| -> Option<V3> {
-            let a = chart.point([q0[0] + e * d[0], q0[1] + e * d[1]], z)?;
-            let b = chart.point([q0[0] - e * d[0], q0[1] - e * d[1]], z)?;
-            Some((a - b) / (2.0 * e))
-        };
-        match (step(dir), step(nrm)) {
-            (Some(t), Some(n)) if t.norm() > 1e-12 => {
-                let t = t / t.norm();
-                (n - t * n.dot(&t)).norm()
-            }
-            _ => 1.0,
-        }
-    };
-    let seeds: Vec<(u32, f64)> = l
-        .iter()
-        .enumerate()
-        .filter(|(_, x)| x.abs() * stretch <= spacing)
-        .map(|(i, x)| (i as u32, x.abs() * stretch))
-        .collect();
-    let dist = lm.march(&seeds);
-    let phi: Vec<f64> = dist
-        .iter()
-        .zip(&l)
-        .map(|(d, l)| if *l < 0.0 { -d } else { *d })
-        .collect();
+    let phi = seed_field(&lm, chart, z, lm.q[deep], (dir, nrm), spacing);
     // The infill's area: inside the inner edge of the last ring's bead (half a spacing short
     // of the infill boundary), or the whole region without rings.
     let edge = if last_ring.is_some() {
@@ -378,10 +249,118 @@ pub(crate) fn fill_region(
     // it (`fill::bead_end_reach`, as on planar layers): every raster end, and the two free
     // ends of each zig-zag chain.
     let reach = RunOn { width, edge };
+    let pieces = infill_pieces(
+        &lm,
+        chart,
+        z,
+        (&phi, &db),
+        (lo, spacing, j0..=j1),
+        (inner, reach),
+        dir,
+    );
+    if !zig {
+        out.extend(
+            pieces
+                .into_iter()
+                .map(|(_, p)| FillPath::uniform(p.reaching(), width, infill)),
+        );
+        return out;
+    }
+    // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
+    // infill boundary (the iso-line where the lines were cut), when that way is short.
+    let border = lm.iso_lines(&db, inner, &db);
+    join_zigzag(
+        pieces,
+        &Border::new(&border),
+        spacing,
+        width,
+        infill,
+        &mut out,
+    );
+    out
+}
+
+/// The rings asked for by the path mode, and their levels: half a bead in, then a spacing
+/// apart, down to a tenth of a bead below the deepest point `dmax`.
+fn ring_levels(params: &LayerParams, width: f64, spacing: f64, dmax: f64) -> (usize, Vec<f64>) {
+    let rings = match params.path_mode {
+        PathMode::Raster | PathMode::Zigzag => 0,
+        PathMode::Contour => usize::MAX,
+        PathMode::ContourZigzag => params.perimeters,
+    };
+    let levels: Vec<f64> = (0..rings)
+        .map(|j| 0.5 * width + j as f64 * spacing)
+        .take_while(|c| *c <= dmax - 0.1 * width)
+        .collect();
+    (rings, levels)
+}
+
+/// The chart direction of the infill's lines: the raster angle, turned a quarter on the odd
+/// layers of a zig-zag (`turned`).
+fn raster_dir(params: &LayerParams, turned: bool) -> [f64; 2] {
+    let angle = if turned {
+        params.raster_angle_deg + 90.0
+    } else {
+        params.raster_angle_deg
+    }
+    .to_radians();
+    [angle.cos(), angle.sin()]
+}
+
+/// The lattice of a region at offset `z`, lifted onto the layer surface; `None` where it has no
+/// triangle or a point does not lift.
+fn lifted_mesh(chart: &Chart, region: &Region, z: f64, spacing: f64) -> Option<LayerMesh> {
+    let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
+    if lm.tris.is_empty() {
+        return None;
+    }
+    let mut pts = Vec::with_capacity(lm.q.len());
+    for q in &lm.q {
+        match chart.point(*q, z) {
+            Some(p) => pts.push(p),
+            None => return None,
+        }
+    }
+    lm.p = pts;
+    Some(lm)
+}
+
+/// The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond it),
+/// within what that core holds.
+fn core_fill(
+    lm: &LayerMesh,
+    db: &[f64],
+    chart: &Chart,
+    z: f64,
+    gap: Gap,
+    (spacing, width): (f64, f64),
+) -> Vec<FillPath> {
+    let ridge = ridge_for(lm, db, gap, spacing, width);
+    conserved(
+        gap_fill(lm, db, &ridge, gap, width),
+        lm,
+        db,
+        gap.edge,
+        |a, b| surface_length(chart, z, a, b),
+    )
+}
+
+/// The infill's lines: iso-lines of `phi` at levels `j0..=j1` (a spacing apart from `lo`),
+/// clipped to `inner` and run on to the reach's edge, each along `dir`; with their level index.
+fn infill_pieces(
+    lm: &LayerMesh,
+    chart: &Chart,
+    z: f64,
+    (phi, db): (&[f64], &[f64]),
+    (lo, spacing, levels): (f64, f64, std::ops::RangeInclusive<i64>),
+    (inner, reach): (f64, RunOn),
+    dir: [f64; 2],
+) -> Vec<(i64, Piece)> {
+    let RunOn { width, edge } = reach;
     let mut pieces: Vec<(i64, Piece)> = vec![];
-    for j in j0..=j1 {
+    for j in levels {
         let level = lo + (j as f64 + 0.5) * spacing;
-        for line in lm.iso_lines(&phi, level, &db) {
+        for line in lm.iso_lines(phi, level, db) {
             let len = |a, b| surface_length(chart, z, a, b);
             let mut cut = clip_reaching(&line, inner, reach, len);
             if cut.is_empty() {
@@ -402,18 +381,159 @@ pub(crate) fn fill_region(
             }
         }
     }
-    if !zig {
-        out.extend(
-            pieces
-                .into_iter()
-                .map(|(_, p)| FillPath::uniform(p.reaching(), width, infill)),
-        );
-        return out;
+    pieces
+}
+
+/// The ridge of the distance to the boundary where the rings at `levels` and the gap fills
+/// between them run (at both ends of each lattice edge those levels cross); empty without
+/// rings.
+fn ring_ridge(
+    lm: &LayerMesh,
+    db: &[f64],
+    levels: &[f64],
+    (width, gap_inset): (f64, f64),
+    spacing: f64,
+) -> Vec<f64> {
+    if levels.is_empty() {
+        vec![]
+    } else {
+        // Each level with the highest ridge its fill tells apart: a ring's width (a full bead
+        // above the gap fill's narrowest one past its edge) and the gap fill between rings
+        // (nothing at or above the next ring's level).
+        let wanted: Vec<(f64, f64)> = levels
+            .iter()
+            .map(|&c| {
+                (
+                    c,
+                    c - 0.5 * width + GAP_MIN_WIDTH_SHARE.mul_add(width, width),
+                )
+            })
+            .chain(
+                levels
+                    .iter()
+                    .skip(1)
+                    .map(|&c| (c - 0.5 * width + gap_inset, c)),
+            )
+            .collect();
+        ridge(lm, db, &wanted, spacing)
     }
-    // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
-    // infill boundary (the iso-line where the lines were cut), when that way is short.
-    let border = lm.iso_lines(&db, inner, &db);
-    let along = Border::new(&border);
+}
+
+/// The rings at `levels` (the first the external perimeter), each narrowed or widened to the
+/// room left before the ridge, with the gap fill of the strip the ring before leaves where a
+/// ring does not reach; pushed onto `out`. The last ring's level.
+fn lay_rings(
+    lm: &LayerMesh,
+    db: &[f64],
+    ridge: &[f64],
+    levels: &[f64],
+    (width, gap_inset): (f64, f64),
+    out: &mut Vec<FillPath>,
+) -> (Option<f64>, usize) {
+    let mut last_ring = None;
+    let mut last_ring_from = out.len();
+    for (j, &c) in levels.iter().enumerate() {
+        last_ring_from = out.len();
+        let edge = c - 0.5 * width;
+        if j > 0 {
+            // Where this ring does not reach (the region's half width is under `c` there),
+            // the strip the ring before leaves along the ridge gets its gap fill.
+            let gap = Gap {
+                edge,
+                inset: gap_inset,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: c,
+            };
+            out.extend(gap_fill(lm, db, ridge, gap, width));
+        }
+        for line in lm.iso_lines(db, c, ridge) {
+            let widths = line
+                .other
+                .iter()
+                .map(|r| {
+                    let room = r - edge;
+                    if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
+                        room.max(0.2 * width)
+                    } else {
+                        width
+                    }
+                })
+                .collect();
+            let role = if j == 0 {
+                Role::ExternalPerimeter
+            } else {
+                Role::Perimeter
+            };
+            out.push(FillPath {
+                points: line.q,
+                widths,
+                role,
+            });
+        }
+        last_ring = Some(c);
+    }
+    (last_ring, last_ring_from)
+}
+
+/// The infill's field: the signed geodesic distance to the seed curve, the chart line along
+/// `dir` through `q0` (the deepest point), so its iso-lines are geodesic parallels.
+fn seed_field(
+    lm: &LayerMesh,
+    chart: &Chart,
+    z: f64,
+    q0: Point2,
+    (dir, nrm): ([f64; 2], [f64; 2]),
+    spacing: f64,
+) -> Vec<f64> {
+    let l: Vec<f64> =
+        lm.q.iter()
+            .map(|q| (q[0] - q0[0]) * nrm[0] + (q[1] - q0[1]) * nrm[1])
+            .collect();
+    // Vertices within a spacing of the seed line start at their distance across it: the
+    // chart offset times the surface's stretch across the line there, i.e. the part of the
+    // surface step along the chart normal that is square to the line's own surface direction
+    // (a sheared chart does not map the chart normal to the surface normal of the line).
+    let stretch = {
+        let e = 1e-3;
+        let step = |d: [f64; 2]| -> Option<V3> {
+            let a = chart.point([q0[0] + e * d[0], q0[1] + e * d[1]], z)?;
+            let b = chart.point([q0[0] - e * d[0], q0[1] - e * d[1]], z)?;
+            Some((a - b) / (2.0 * e))
+        };
+        match (step(dir), step(nrm)) {
+            (Some(t), Some(n)) if t.norm() > SHORT_VECTOR => {
+                let t = t / t.norm();
+                (n - t * n.dot(&t)).norm()
+            }
+            _ => 1.0,
+        }
+    };
+    let seeds: Vec<(u32, f64)> = l
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.abs() * stretch <= spacing)
+        .map(|(i, x)| (i as u32, x.abs() * stretch))
+        .collect();
+    let dist = lm.march(&seeds);
+    let phi: Vec<f64> = dist
+        .iter()
+        .zip(&l)
+        .map(|(d, l)| if *l < 0.0 { -d } else { *d })
+        .collect();
+    phi
+}
+
+/// Zig-zag: each line's end joined to the nearest end of a line on the next level, along the
+/// infill boundary `along` (the iso-line where the lines were cut), when that way is short;
+/// the chains pushed onto `out`.
+fn join_zigzag(
+    pieces: Vec<(i64, Piece)>,
+    along: &Border,
+    spacing: f64,
+    width: f64,
+    infill: Role,
+    out: &mut Vec<FillPath>,
+) {
     let mut used = vec![false; pieces.len()];
     for s in 0..pieces.len() {
         if used[s] {
@@ -459,7 +579,6 @@ pub(crate) fn fill_region(
         pts.extend(tail);
         out.push(FillPath::uniform(pts, width, infill));
     }
-    out
 }
 
 /// The paths of layer `layer` of `layers` with their internal infill made solid where the
@@ -534,7 +653,7 @@ fn conserved(
         })
         .sum();
     let held = lm.area_above(db, edge);
-    if covered > 0.0 && (covered - held).abs() > 1e-9 * held {
+    if covered > 0.0 && (covered - held).abs() > ROUND_OFF * held {
         let k = (held / covered).min(MAX_CORE_WIDENING);
         for p in &mut paths {
             for w in &mut p.widths {

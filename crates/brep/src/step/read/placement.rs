@@ -2,6 +2,7 @@
 //! point and direction it reads while the body is placed.
 
 use crate::math::{Frame, P3, V3};
+use crate::tolerance::{ROTATION_EQUAL, ROTATION_IDENTITY, SHIFT_ZERO};
 use nalgebra::Matrix3;
 
 /// A rigid placement: `p -> rot * p + shift` (mm).
@@ -55,10 +56,11 @@ impl Placement {
     }
 
     pub(super) fn is_identity(&self) -> bool {
-        (self.rot - Matrix3::identity()).abs().max() < 1e-12 && self.shift.norm() < 1e-9
+        (self.rot - Matrix3::identity()).abs().max() < ROTATION_IDENTITY
+            && self.shift.norm() < SHIFT_ZERO
     }
 
     pub(super) fn near(&self, o: &Placement) -> bool {
-        (self.rot - o.rot).abs().max() < 1e-9 && (self.shift - o.shift).norm() < 1e-6
+        (self.rot - o.rot).abs().max() < ROTATION_EQUAL && (self.shift - o.shift).norm() < 1e-6
     }
 }

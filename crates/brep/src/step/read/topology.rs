@@ -4,7 +4,7 @@ use super::translator::{Translator, R};
 use crate::curve::Curve;
 use crate::math::V3;
 use crate::step::error::ReadError;
-use crate::tolerance::{NONZERO, PERIOD_FRACTION, POINT_COINCIDENCE};
+use crate::tolerance::{LENGTH_FLOOR, NONZERO, PERIOD_FRACTION, POINT_COINCIDENCE};
 use crate::topology::*;
 use std::collections::HashMap;
 
@@ -105,7 +105,7 @@ impl<'a> Translator<'a> {
                     &self.brep,
                     &self.brep.shells[shells[0].idx()].faces,
                 );
-                let slack = POINT_COINCIDENCE * outer_box.diagonal().max(1e-9);
+                let slack = POINT_COINCIDENCE * outer_box.diagonal().max(LENGTH_FLOOR);
                 let mut own = vec![];
                 let first = shells[0];
                 shells.retain(|&sh| {
