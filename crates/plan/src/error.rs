@@ -18,7 +18,7 @@ pub enum PlanError {
     Process(#[from] crate::ProcessError),
     /// A feature could not be planned.
     #[error(transparent)]
-    Feature(#[from] slicer::planar::PlanError),
+    Feature(#[from] slicer::planar::FeatureError),
     /// The post could not write the program.
     #[error(transparent)]
     Post(#[from] robot_post::PostError),

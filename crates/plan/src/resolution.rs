@@ -47,7 +47,7 @@ pub fn below_resolution(
     points: &[PathPoint],
     min_bead: f64,
     nozzle: f64,
-) -> Result<Option<BelowResolution>, slicer::planar::PlanError> {
+) -> Result<Option<BelowResolution>, slicer::planar::FeatureError> {
     let (mut total, mut narrow) = (0.0, 0.0);
     for q in points
         .iter()

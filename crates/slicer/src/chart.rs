@@ -6,7 +6,7 @@
 //! pole), the orthogonal projection onto the tangent plane at the feature's centre
 //! ([`ChartKind::Ortho`]). Also the feature's mesh mapped into `(s, t, d)`.
 
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::geom2d::{Point2, Region};
 use crate::tolerance::{
     AREA_ELEMENT_MIN, CHART_RESIDUAL, DEGENERATE_LENGTH, FOOT_OFF_NORMAL, MICROMETRE,
@@ -433,8 +433,8 @@ pub(crate) fn choose_chart<'a>(
     sign: f64,
     id: usize,
     mesh: &Mesh,
-) -> Result<Chart<'a>, PlanError> {
-    let err = |msg: String| PlanError::Freeform { id, msg };
+) -> Result<Chart<'a>, FeatureError> {
+    let err = |msg: String| FeatureError::Freeform { id, msg };
     let n = mesh.positions.len().max(1) as f64;
     let centroid = mesh.positions.iter().fold(V3::zeros(), |a, p| a + p.coords) / n;
     let centroid = P3::from(centroid);
@@ -642,10 +642,10 @@ pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
 }
 
 /// Chart coordinates and distance of every mesh vertex, as a mesh in `(s, t, d)` space.
-pub(crate) fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, PlanError> {
+pub(crate) fn mapped_mesh(chart: &Chart, mesh: &Mesh, id: usize) -> Result<Mesh, FeatureError> {
     let mut m = mesh.clone();
     for (i, p) in mesh.positions.iter().enumerate() {
-        let (q, d) = chart.inverse(p).ok_or_else(|| PlanError::Freeform {
+        let (q, d) = chart.inverse(p).ok_or_else(|| FeatureError::Freeform {
             id,
             msg: format!(
                 "a point ({:.3}, {:.3}, {:.3}) of it has no foot on its reference surface",

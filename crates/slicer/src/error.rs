@@ -2,7 +2,7 @@
 
 /// Why a feature could not be planned.
 #[derive(Debug, thiserror::Error)]
-pub enum PlanError {
+pub enum FeatureError {
     /// The feature is freeform: [`crate::freeform::plan_freeform`] plans it.
     #[error("feature {0} is freeform, not two5d")]
     NotTwo5d(usize),

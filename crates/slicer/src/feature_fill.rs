@@ -2,7 +2,7 @@
 //! planning a feature that does not depend on the feature printed before it, so a part's
 //! features are filled in parallel and laid one after the other.
 
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::feature_plan::FeaturePlan;
 use crate::freeform::{fill_freeform, FreeformFill};
 use crate::params::LayerParams;
@@ -28,7 +28,7 @@ pub fn fill_feature<'a>(
     f: &Feature,
     params: &LayerParams,
     bead: Bead,
-) -> Result<FeatureFill<'a>, PlanError> {
+) -> Result<FeatureFill<'a>, FeatureError> {
     Ok(match f.kind {
         FeatureKind::Two5d => FeatureFill::Two5d(fill_two5d(tree, f, params, bead)?),
         FeatureKind::Freeform => FeatureFill::Freeform(fill_freeform(tree, f, params, bead)?),

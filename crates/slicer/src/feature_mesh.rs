@@ -1,6 +1,6 @@
 //! The mesh a feature is sliced from, and its chord tolerance.
 
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::params::LayerParams;
 use crate::tolerance::MICROMETRE;
 use brep::mesh::{mesh_faces, MeshOptions};
@@ -19,14 +19,14 @@ pub(crate) fn feature_mesh(
     tree: &FeatureTree,
     f: &Feature,
     tol: f64,
-) -> Result<brep::mesh::Mesh, PlanError> {
+) -> Result<brep::mesh::Mesh, FeatureError> {
     let mut faces = f.faces.clone();
     for v in &f.voids {
         faces.extend(v.iter().copied());
     }
     let mesh_at = |tol: f64| {
         mesh_faces(&tree.brep, &faces, &MeshOptions::with_tolerance(tol)).map_err(|e| {
-            PlanError::Mesh {
+            FeatureError::Mesh {
                 id: f.id,
                 msg: e.to_string(),
             }

@@ -2,7 +2,7 @@
 //! concave with a radius of curvature under a layer's offset, the offset folds over itself.
 
 use crate::chart::{root, Chart, ChartKind};
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::params::LayerParams;
 use crate::tolerance::{DEGENERATE_LENGTH, FLAT_CURVATURE, MICROMETRE};
 
@@ -20,7 +20,7 @@ pub(crate) fn fold_check(
     tol: f64,
     params: &LayerParams,
     id: usize,
-) -> Result<(), PlanError> {
+) -> Result<(), FeatureError> {
     // The root: mesh vertices on the reference surface.
     let Some((roots, (u0, v0))) = root(surf, mesh, tol) else {
         return Ok(());
@@ -67,12 +67,12 @@ pub(crate) fn fold_check(
 
 /// `Err(OffsetFolds)` at the first of the layers (thicknesses `heights`) whose top reaches
 /// `radius`, the radius of a concave valley of the reference (infinite: none).
-pub(crate) fn check_folds(id: usize, heights: &[f64], radius: f64) -> Result<(), PlanError> {
+pub(crate) fn check_folds(id: usize, heights: &[f64], radius: f64) -> Result<(), FeatureError> {
     let mut z = 0.0;
     for (layer, dl) in heights.iter().enumerate() {
         z += dl;
         if z >= radius {
-            return Err(PlanError::OffsetFolds {
+            return Err(FeatureError::OffsetFolds {
                 id,
                 layer: layer + 1,
                 offset: z,

@@ -14,7 +14,7 @@
 //!   evaluated from the exact S and N point by point. Deterioration (paper, Fig. 9: where the
 //!   reference is concave with a radius of curvature under `z_k` the offset folds over itself)
 //!   is detected from the principal curvatures of S under the feature: the plan stops with
-//!   [`PlanError::OffsetFolds`], naming the feature and the first layer that would fold.
+//!   [`FeatureError::OffsetFolds`], naming the feature and the first layer that would fold.
 //! - **Spatial slicing.** The feature's exact-surface mesh is mapped into `(s, t, d)`; its
 //!   section by the plane `d = z_k − h_k/2` (the middle of layer k) gives the layer's region
 //!   in the chart, boundaries sampled within the mesh tolerance.
@@ -30,7 +30,7 @@
 //!   layer's thickness and each point's bead width.
 
 use crate::chart::{choose_chart, mapped_mesh, refined, translate_chart, MAX_MAPPED_EDGE};
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FreeformFigures;
@@ -149,7 +149,7 @@ pub fn plan_freeform(
     params: &LayerParams,
     bead: Bead,
     entry: Option<P3>,
-) -> Result<FeaturePlan, PlanError> {
+) -> Result<FeaturePlan, FeatureError> {
     Ok(fill_freeform(tree, f, params, bead)?.lay(entry))
 }
 
@@ -186,15 +186,15 @@ pub fn fill_freeform<'a>(
     f: &Feature,
     params: &LayerParams,
     bead: Bead,
-) -> Result<FreeformFill<'a>, PlanError> {
+) -> Result<FreeformFill<'a>, FeatureError> {
     let id = f.id;
-    let err = |msg: String| PlanError::Freeform { id, msg };
+    let err = |msg: String| FeatureError::Freeform { id, msg };
     if f.kind != FeatureKind::Freeform {
         return Err(err("it is not freeform".into()));
     }
     params
         .validate()
-        .map_err(|msg| PlanError::Params { id, msg })?;
+        .map_err(|msg| FeatureError::Params { id, msg })?;
     let b = &tree.brep;
     let rf = f
         .reference
@@ -335,7 +335,7 @@ fn feature_chart<'a>(
     tol: f64,
     params: &LayerParams,
     id: usize,
-) -> Result<(Chart<'a>, Mesh, bool), PlanError> {
+) -> Result<(Chart<'a>, Mesh, bool), FeatureError> {
     let translate = match fold_check(surf, sign, mesh, tol, params, id) {
         Ok(()) => None,
         Err(e) if params.layer_strategy == LayerStrategy::Offset => return Err(e),
@@ -406,8 +406,8 @@ fn choose_blend(
     bead_width: f64,
     id: usize,
     warnings: &mut Vec<String>,
-) -> Result<Option<(TopField, usize, usize)>, PlanError> {
-    let err = |msg: String| PlanError::Freeform { id, msg };
+) -> Result<Option<(TopField, usize, usize)>, FeatureError> {
+    let err = |msg: String| FeatureError::Freeform { id, msg };
     Ok(match params.layer_strategy {
         LayerStrategy::Offset => None,
         strategy => {

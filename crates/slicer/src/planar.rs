@@ -18,7 +18,7 @@ use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
-pub use crate::error::PlanError;
+pub use crate::error::FeatureError;
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FeatureFigures;
 use crate::tolerance::{COLLINEAR, KEY_GRID};
@@ -149,7 +149,7 @@ pub fn plan_two5d(
     params: &LayerParams,
     bead: Bead,
     entry: Option<P3>,
-) -> Result<FeaturePlan, PlanError> {
+) -> Result<FeaturePlan, FeatureError> {
     Ok(fill_two5d(tree, f, params, bead)?.lay(entry))
 }
 
@@ -172,14 +172,14 @@ pub fn fill_two5d(
     f: &Feature,
     params: &LayerParams,
     bead: Bead,
-) -> Result<Two5dFill, PlanError> {
+) -> Result<Two5dFill, FeatureError> {
     if f.kind != FeatureKind::Two5d {
-        return Err(PlanError::NotTwo5d(f.id));
+        return Err(FeatureError::NotTwo5d(f.id));
     }
     params
         .validate()
-        .map_err(|msg| PlanError::Params { id: f.id, msg })?;
-    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+        .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
+    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
     let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
     let top = mesh
         .positions
@@ -229,8 +229,8 @@ pub fn plate_regions(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
-) -> Result<(Plane, Vec<Region>), PlanError> {
-    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+) -> Result<(Plane, Vec<Region>), FeatureError> {
+    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
     let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
     let top = mesh
         .positions

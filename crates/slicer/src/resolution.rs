@@ -4,7 +4,7 @@
 //! than a bead). The beads of a fill do not tell this: the gap fill of the strip between a
 //! wall's rings is a loop of beads half the strip wide, however wide the wall.
 
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{regions_from_loops, thinner_than, Region};
 use crate::geom2d::area2;
@@ -36,7 +36,7 @@ pub fn narrow_sections(
     f: &Feature,
     params: &LayerParams,
     limit: f64,
-) -> Result<Option<NarrowSections>, PlanError> {
+) -> Result<Option<NarrowSections>, FeatureError> {
     if f.kind != FeatureKind::Two5d || limit.is_nan() || limit <= 0.0 {
         return Ok(None);
     }

@@ -15,7 +15,7 @@
 //! path is filled, so a placement can be ranked by it ([`feature_support`] sections the
 //! feature's mesh at each layer's middle, as the planar planner does, and stops there).
 
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{pieces_outside, regions_from_loops};
 use crate::geom2d::Region;
@@ -119,14 +119,14 @@ pub fn feature_support(
     params: &LayerParams,
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
-) -> Result<Option<FeatureSupport>, PlanError> {
+) -> Result<Option<FeatureSupport>, FeatureError> {
     if f.kind != FeatureKind::Two5d {
         return Ok(None);
     }
     params
         .validate()
-        .map_err(|msg| PlanError::Params { id: f.id, msg })?;
-    let plane = reference_plane(tree, f).ok_or(PlanError::NoPlane(f.id))?;
+        .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
+    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
     let tol = slicing_tolerance(params);
     let mesh = feature_mesh(tree, f, tol)?;
     let top = mesh

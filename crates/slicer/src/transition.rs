@@ -39,7 +39,7 @@
 //! - **Orientation (TSN).** The layer surface's normal, from the chart by central differences.
 
 use crate::chart::{mapped_mesh, refined, Chart};
-use crate::error::PlanError;
+use crate::error::FeatureError;
 use crate::geom2d::Point2;
 use crate::params::LayerParams;
 use crate::tolerance::{BARYCENTRIC_SLACK, COUNT_SLACK, TRIANGLE_DET};
@@ -83,7 +83,7 @@ pub(crate) fn build_top_field(
     tops: &[FaceId],
     mapped: &Mesh,
     id: usize,
-) -> Result<Option<TopField>, PlanError> {
+) -> Result<Option<TopField>, FeatureError> {
     // The top faces, each as its own triangles (refined, so that d is near linear over
     // every triangle of the chart).
     let top = Mesh {

@@ -8,7 +8,7 @@ mod support;
 use features::{FeatureKind, FeatureTree};
 use slicer::freeform::plan_freeform;
 use slicer::params::{LayerParams, LayerStrategy, PathMode};
-use slicer::planar::{Bead, PlanError};
+use slicer::planar::{Bead, FeatureError};
 use slicer::toolpath::{MoveKind, PathPoint};
 use std::collections::HashMap;
 use support::{distance_to_mesh, tree};
@@ -327,7 +327,7 @@ fn every_path_mode_keeps_points_on_the_offsets_and_inside() {
 fn a_two5d_feature_is_refused_by_the_freeform_planner() {
     let t = tree("capsule");
     let e = plan_freeform(&t, &t.features[0], &LayerParams::default(), BEAD, None).unwrap_err();
-    assert!(matches!(e, PlanError::Freeform { id: 0, .. }), "{e}");
+    assert!(matches!(e, FeatureError::Freeform { id: 0, .. }), "{e}");
 }
 
 #[test]

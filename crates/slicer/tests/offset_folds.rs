@@ -8,7 +8,7 @@ mod support;
 use features::FeatureKind;
 use slicer::freeform::plan_freeform;
 use slicer::params::{LayerParams, LayerStrategy};
-use slicer::planar::{Bead, PlanError};
+use slicer::planar::{Bead, FeatureError};
 use support::tree;
 
 const BEAD: Bead = Bead {
@@ -48,7 +48,7 @@ fn a_rib_taller_than_its_trough_radius_is_refused_at_the_first_folding_layer() {
         panic!("the rib is refused");
     };
     let msg = e.to_string();
-    let PlanError::OffsetFolds {
+    let FeatureError::OffsetFolds {
         id,
         layer,
         offset,
