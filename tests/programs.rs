@@ -173,6 +173,8 @@ fn delta5_impeller_program_has_no_empty_moves_and_feeds_within_the_limit() {
             "--machine",
             "delta5",
             "--allow-collisions",
+            // The blades' edges on the hub's flank are refused by the support check.
+            "--keep-going",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -257,6 +259,8 @@ fn krl_feed_follows_the_planned_flow_per_lin() {
             "--machine",
             "kuka",
             "--allow-collisions",
+            // The blades' edges on the hub's flank are refused by the support check.
+            "--keep-going",
             "--allow-unreachable",
             "-o",
             out.to_str().unwrap(),
@@ -452,6 +456,8 @@ fn the_progress_bar_covers_the_whole_run_on_a_terminal_only() {
             "--machine",
             "delta5",
             "--allow-collisions",
+            // The blades' edges on the hub's flank are refused by the support check.
+            "--keep-going",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -469,6 +475,8 @@ fn the_progress_bar_covers_the_whole_run_on_a_terminal_only() {
             "--machine",
             "delta5",
             "--allow-collisions",
+            // The blades' edges on the hub's flank are refused by the support check.
+            "--keep-going",
             "-o",
             out.to_str().unwrap(),
         ],
