@@ -67,7 +67,13 @@ pub fn head_check(
     let ctx = pedestal::Context {
         trees,
         params: &params,
-        setting: base.pedestal,
+        // A 3-axis printer's head stays above what it lays: no pedestal unless asked for.
+        setting: match (machine.kind, base.pedestal) {
+            (robot_post::MachineKind::Marlin, slicer::params::Pedestal::Auto) => {
+                slicer::params::Pedestal::Off
+            }
+            (_, p) => p,
+        },
         bead: machine.bead(),
         machine,
         id: trees.iter().map(|t| t.features.len()).sum(),
