@@ -3,7 +3,7 @@
 //! the slicer's ([`slicer::support`]): planar layers from the features alone, before any path
 //! is filled ([`planar`], also what `--orient auto` ranks placements by), curved layers as
 //! they are laid (`FreeformFigures::support`). A feature with unsupported area fails the plan
-//! like the self-check ([`crate::PlanError::Unsupported`], one [`line`] each).
+//! like the self-check ([`crate::Gate::Unsupported`], one [`line()`] each).
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
@@ -109,7 +109,7 @@ pub fn line(id: usize, held: &Held) -> Option<String> {
     ))
 }
 
-/// One [`line`] for each feature with unsupported area, by id.
+/// One [`line()`] for each feature with unsupported area, by id.
 pub fn lines(held: &BTreeMap<usize, Held>) -> Vec<String> {
     held.iter().filter_map(|(id, h)| line(*id, h)).collect()
 }

@@ -65,7 +65,7 @@ impl ReachShift {
 /// Points (of the path's) the `kuka` post finds out of the arm's reach or joint limits, as it
 /// places the part on the table: the sum of [`crate::KukaFigures::unreachable_points`].
 ///
-/// Errors as [`crate::kuka`]'s (not a valid `kuka` profile, a non-finite point, a tool axis
+/// Errors as [`crate::kuka()`]'s (not a valid `kuka` profile, a non-finite point, a tool axis
 /// that is not a unit vector).
 pub fn unreachable_points(path: &ToolPath, m: &MachineProfile) -> Result<usize, PostError> {
     let program = crate::kuka::kuka_to(path, m, "fit", "", &[], &mut Discard)?;
