@@ -233,9 +233,7 @@ fn run(
     // A KUKA part out of the arm's reach is moved on the table first.
     let moved = reach::into_reach(&stages.checked.toolpath, machine, options);
     let machine = moved.as_ref().map_or(machine, |m| &m.machine);
-    let settings = settings::entry(process, machine, &process.base());
-    let est = estimate::estimate(&stages.checked.toolpath, machine);
-    let notes = post::notes(&est, &stages.checked, &settings);
+    let (settings, est, notes) = post::header(&stages.checked, process, machine);
     let program = match post::post(
         &stages.checked.toolpath,
         machine,
@@ -272,9 +270,7 @@ fn refuse(
     machine: &MachineProfile,
     options: &Options,
 ) -> PlanError {
-    let settings = settings::entry(process, machine, &process.base());
-    let est = estimate::estimate(&stages.checked.toolpath, machine);
-    let notes = post::notes(&est, &stages.checked, &settings);
+    let (settings, est, notes) = post::header(&stages.checked, process, machine);
     let gate = match post::post(
         &stages.checked.toolpath,
         machine,

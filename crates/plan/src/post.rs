@@ -10,6 +10,19 @@ use robot_post::machine::MachineProfile;
 use robot_post::{Job, Program, ProgramSink};
 use slicer::toolpath::ToolPath;
 
+/// What a program's header is made of: the settings, the estimate of `checked`'s tool path on
+/// `machine`, and the notes they give ([`notes`]).
+pub fn header(
+    checked: &Checked,
+    process: &crate::Process,
+    machine: &MachineProfile,
+) -> (SettingsEntry, Estimate, Vec<String>) {
+    let settings = crate::settings::entry(process, machine, &process.base());
+    let est = estimate::estimate(&checked.toolpath, machine);
+    let notes = notes(&est, checked, &settings);
+    (settings, est, notes)
+}
+
 /// The header notes of a program: the estimate, the pedestal (when the part stands on one),
 /// then every setting.
 pub fn notes(est: &Estimate, checked: &Checked, settings: &SettingsEntry) -> Vec<String> {
