@@ -179,13 +179,7 @@ pub fn fill_two5d(
     params
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
-    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
-    let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
-    let top = mesh
-        .positions
-        .iter()
-        .map(|p| plane.height(p))
-        .fold(0.0f64, f64::max);
+    let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
     let heights = params.layer_heights(top);
     let spacing = params.spacing(bead.width);
     let fig = FeatureFigures {
@@ -204,11 +198,7 @@ pub fn fill_two5d(
         .par_iter()
         .map(|&(mid, _, _)| {
             let cut = plane.offset(mid);
-            let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
-                .iter()
-                .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
-                .collect();
-            regions_from_loops(&loops)
+            section_regions(&mesh, &cut, &cut)
         })
         .collect();
     let filled = fill_sections(sections, params, bead.width, spacing);
@@ -230,22 +220,50 @@ pub fn plate_regions(
     f: &Feature,
     params: &LayerParams,
 ) -> Result<(Plane, Vec<Region>), FeatureError> {
+    let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
+    let Some(&first) = params.layer_heights(top).first() else {
+        return Ok((plane, vec![]));
+    };
+    let regions = section_regions(&mesh, &plane.offset(0.5 * first), &plane);
+    Ok((plane, regions))
+}
+
+/// A two5d feature's reference plane, its mesh at the slicing tolerance, and its top: the
+/// height of its highest mesh point over the plane ([`mesh_and_top`]).
+pub(crate) fn plane_mesh_top(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+) -> Result<(Plane, brep::mesh::Mesh, f64), FeatureError> {
     let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
+    let (mesh, top) = mesh_and_top(tree, f, params, &plane)?;
+    Ok((plane, mesh, top))
+}
+
+/// A feature's mesh at the slicing tolerance, and the height of its highest point over `plane`.
+pub(crate) fn mesh_and_top(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    plane: &Plane,
+) -> Result<(brep::mesh::Mesh, f64), FeatureError> {
     let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
     let top = mesh
         .positions
         .iter()
         .map(|p| plane.height(p))
         .fold(0.0f64, f64::max);
-    let Some(&first) = params.layer_heights(top).first() else {
-        return Ok((plane, vec![]));
-    };
-    let cut = plane.offset(0.5 * first);
-    let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
+    Ok((mesh, top))
+}
+
+/// The regions of `mesh`'s section by the plane `cut`, in the 2-D frame of `frame` (a plane
+/// parallel to it).
+pub(crate) fn section_regions(mesh: &brep::mesh::Mesh, cut: &Plane, frame: &Plane) -> Vec<Region> {
+    let loops: Vec<Vec<[f64; 2]>> = section(mesh, cut)
         .iter()
-        .map(|l| l.iter().map(|p| plane.to_2d(p)).collect())
+        .map(|l| l.iter().map(|p| frame.to_2d(p)).collect())
         .collect();
-    Ok((plane, regions_from_loops(&loops)))
+    regions_from_loops(&loops)
 }
 
 /// A prism's layers filled like a two5d feature's (feature `id`): `layers` layers `height` mm

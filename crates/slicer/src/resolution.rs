@@ -5,12 +5,10 @@
 //! wall's rings is a loop of beads half the strip wide, however wide the wall.
 
 use crate::error::FeatureError;
-use crate::feature_mesh::{feature_mesh, slicing_tolerance};
-use crate::fill::{regions_from_loops, thinner_than, Region};
+use crate::fill::{thinner_than, Region};
 use crate::geom2d::area2;
 use crate::params::LayerParams;
 use crate::planar::reference_plane;
-use brep::section::section;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
@@ -43,12 +41,7 @@ pub fn narrow_sections(
     let Some(plane) = reference_plane(tree, f) else {
         return Ok(None);
     };
-    let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
-    let top = mesh
-        .positions
-        .iter()
-        .map(|p| plane.height(p))
-        .fold(0.0f64, f64::max);
+    let (mesh, top) = crate::planar::mesh_and_top(tree, f, params, &plane)?;
     let mut mids = vec![];
     let mut z = 0.0;
     for dl in params.layer_heights(top) {
@@ -60,12 +53,8 @@ pub fn narrow_sections(
         .par_iter()
         .map(|&(mid, dl)| {
             let cut = plane.offset(mid);
-            let loops: Vec<Vec<[f64; 2]>> = section(&mesh, &cut)
-                .iter()
-                .map(|l| l.iter().map(|p| cut.to_2d(p)).collect())
-                .collect();
             let mut out = (0.0, 0.0, f64::INFINITY);
-            for r in regions_from_loops(&loops) {
+            for r in crate::planar::section_regions(&mesh, &cut, &cut) {
                 let v = region_area(&r) * dl;
                 out.0 += v;
                 if thinner_than(&r, 0.5 * limit) {

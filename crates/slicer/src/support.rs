@@ -17,11 +17,10 @@
 
 use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
-use crate::fill::{pieces_outside, regions_from_loops};
+use crate::fill::pieces_outside;
 use crate::geom2d::Region;
 use crate::params::LayerParams;
-use crate::planar::reference_plane;
-use brep::section::{section, Plane};
+use brep::section::Plane;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
@@ -98,11 +97,7 @@ pub fn unsupported_area(
 
 /// A planar section of `mesh` by `plane`, as regions in the plane's frame.
 fn section_regions(mesh: &brep::mesh::Mesh, plane: &Plane) -> Vec<Region> {
-    let loops: Vec<Vec<[f64; 2]>> = section(mesh, plane)
-        .iter()
-        .map(|l| l.iter().map(|p| plane.to_2d(p)).collect())
-        .collect();
-    regions_from_loops(&loops)
+    crate::planar::section_regions(mesh, plane, plane)
 }
 
 /// The support of a two5d feature's planar layers (as [`crate::planar`] lays them: parallel to
@@ -126,14 +121,8 @@ pub fn feature_support(
     params
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
-    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
     let tol = slicing_tolerance(params);
-    let mesh = feature_mesh(tree, f, tol)?;
-    let top = mesh
-        .positions
-        .iter()
-        .map(|p| plane.height(p))
-        .fold(0.0f64, f64::max);
+    let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
     let heights = params.layer_heights(top);
     let mut mids = Vec::with_capacity(heights.len());
     let mut z = 0.0;
