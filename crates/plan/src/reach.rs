@@ -4,7 +4,7 @@
 //! assumed). The move is the cell's `part_position`, which the post honours.
 
 use crate::Options;
-use robot_post::fit::{reach_shift, unreachable_points};
+use robot_post::fit::reach_shift;
 use robot_post::machine::MachineProfile;
 use robot_post::MachineKind;
 use slicer::toolpath::ToolPath;
@@ -29,15 +29,13 @@ pub fn into_reach(path: &ToolPath, machine: &MachineProfile, options: &Options) 
     if machine.kind != MachineKind::Kuka || options.allow_unreachable {
         return None;
     }
-    let before = unreachable_points(path, machine).ok()?;
-    if before == 0 {
-        return None;
-    }
+    // The search counts the points out of reach where the profile places the part first
+    // (one run of the post's reach check), and moves nothing when there are none.
     let s = reach_shift(path, machine).ok()?;
-    Some(Moved {
+    (s.unreachable_before > 0).then(|| Moved {
         machine: s.apply(machine),
         part_position: s.part_position,
         distance_mm: s.shift[0].hypot(s.shift[1]),
-        unreachable_before: before,
+        unreachable_before: s.unreachable_before,
     })
 }
