@@ -12,6 +12,7 @@ use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
 use std::path::PathBuf;
 use std::process::Command;
+use std::sync::{Arc, Mutex, OnceLock};
 
 const BIN: &str = env!("CARGO_BIN_EXE_features");
 
@@ -33,7 +34,6 @@ impl Drop for Out {
 }
 
 struct Planned {
-    _dir: Out,
     plan: Value,
     points: Vec<Pt>,
     program: String,
@@ -41,9 +41,27 @@ struct Planned {
     collisions: String,
 }
 
+/// [`plan_once`] of the fixture `name` for `machine`, made once for the whole binary: two
+/// tests read the impeller's and the fan's delta5 plans, the longest runs of the suite, and
+/// share them (a second caller waits for the first's).
+fn plan(name: &str, machine: &str) -> Arc<Planned> {
+    type Cell = Arc<OnceLock<Arc<Planned>>>;
+    static PLANS: OnceLock<Mutex<HashMap<(String, String), Cell>>> = OnceLock::new();
+    let cell = PLANS
+        .get_or_init(Default::default)
+        .lock()
+        .expect("the cache's lock")
+        .entry((name.to_string(), machine.to_string()))
+        .or_default()
+        .clone();
+    cell.get_or_init(|| Arc::new(plan_once(name, machine)))
+        .clone()
+}
+
 /// Plans the fixture `name` for `machine`, written even where it collides or fails its
-/// self-check (bladed_hub: two blades 3.7 % short, a slicer matter apart from this issue).
-fn plan(name: &str, machine: &str) -> Planned {
+/// self-check (bladed_hub: two blades 3.7 % short, a slicer matter apart from this issue),
+/// and reads what was written; the directory is removed.
+fn plan_once(name: &str, machine: &str) -> Planned {
     // One directory per call: tests run in parallel and may plan the same part.
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -82,8 +100,8 @@ fn plan(name: &str, machine: &str) -> Planned {
     let points = readback::rows(&read("toolpath.csv"));
     let program = read("program.gcode");
     let collisions = read("collisions.csv");
+    drop(dir);
     Planned {
-        _dir: dir,
         plan,
         points,
         program,
