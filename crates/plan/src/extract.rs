@@ -8,7 +8,7 @@
 //! prints only along +Z, `planar` when some feature grows along another direction
 //! ([`tilted_features`]), with a warning for each such feature.
 
-use crate::tolerance::PLUS_Z_SLACK;
+use crate::tolerance::{PLUS_Z_SLACK, SAME_POINT_MM};
 use crate::warning::{Warning, WarningKind};
 use crate::{PlanError, Process, MAX_BEAD_KM};
 use brep::math::V3;
@@ -88,8 +88,7 @@ pub fn arrange(
     process: &Process,
     machine: &MachineProfile,
 ) -> Result<Extracted, PlanError> {
-    let (assembly, slicing, warnings) =
-        choose_slicing(assembly, brep, process.base().slicing, machine.kind)?;
+    let (assembly, slicing, warnings) = choose_slicing(assembly, brep, process, machine.kind)?;
     let trees = &assembly.trees;
     process.validate_feature_ids(trees.iter().map(|t| t.features.len()).sum())?;
     let plates = trees
@@ -123,21 +122,21 @@ pub fn arrange(
     Ok(extracted)
 }
 
-/// The assembly to plan for `slicing` on a machine of `kind`, how it is sliced, and a warning
-/// for each feature `auto` put into planar layers. `features` keeps `assembly`; `planar`
-/// makes [`planar_assembly`] of `brep` (unless `assembly` already is one); `auto` does so on a
-/// machine that prints only along +Z when [`tilted_features`] finds any.
+/// The assembly to plan for the process's `slicing` on a machine of `kind`, how it is sliced,
+/// and a warning for each feature `auto` put into planar layers. `features` keeps `assembly`;
+/// `planar` makes [`planar_assembly`] of `brep` (unless `assembly` already is one); `auto`
+/// does so on a machine that prints only along +Z when [`tilted_features`] finds any.
 pub fn choose_slicing(
     assembly: Assembly,
     brep: &Brep,
-    slicing: Slicing,
+    process: &Process,
     kind: MachineKind,
 ) -> Result<(Assembly, Slicing, Vec<Warning>), PlanError> {
     let whole = features::is_whole_part(&assembly);
-    match slicing {
+    match process.base().slicing {
         Slicing::Planar if !whole => Ok((planar_assembly(brep)?, Slicing::Planar, vec![])),
         Slicing::Auto if !whole && kind.plus_z_only() => {
-            let tilted = tilted_features(&assembly);
+            let tilted = tilted_features(&assembly, process);
             if tilted.is_empty() {
                 return Ok((assembly, Slicing::Features, vec![]));
             }
@@ -159,16 +158,37 @@ pub fn choose_slicing(
 }
 
 /// The features of `assembly` whose build direction is not +Z: every freeform feature, and
-/// every two5d feature whose reference normal is more than [`PLUS_Z_SLACK`] off +Z. Each with
+/// every two5d feature whose reference normal's z falls short of 1 by more than 0.001 (about
+/// 2.6° off +Z, the crate's `PLUS_Z_SLACK`). A freeform feature whose process fixes its tool
+/// axis to +Z (`fixed_tool_axis`) is not one: its curved layers are laid along +Z. Each with
 /// its file-wide id, its kind's name and the direction it grows along (where one is known).
-pub fn tilted_features(assembly: &Assembly) -> Vec<(usize, &'static str, Option<[f64; 3]>)> {
+pub fn tilted_features(
+    assembly: &Assembly,
+    process: &Process,
+) -> Vec<(usize, &'static str, Option<[f64; 3]>)> {
+    let base = process.base();
+    let plus_z = |a: V3| 1.0 - a.z <= PLUS_Z_SLACK;
+    let fixed_plus_z = |id: usize| {
+        let fixed = process
+            .params_for(&base, id)
+            .ok()
+            .and_then(|p| p.fixed_tool_axis);
+        fixed
+            .and_then(|a| V3::new(a[0], a[1], a[2]).try_normalize(SAME_POINT_MM))
+            .is_some_and(plus_z)
+    };
     let mut out = vec![];
     let mut offset = 0usize;
     for t in &assembly.trees {
         for f in &t.features {
-            let normal = f.reference.normal.map(|n| V3::new(n[0], n[1], n[2]));
-            let up = normal.is_some_and(|n| 1.0 - n.z <= PLUS_Z_SLACK);
-            if f.kind == FeatureKind::Freeform || !up {
+            let tilted = match f.kind {
+                FeatureKind::Freeform => !fixed_plus_z(offset + f.id),
+                FeatureKind::Two5d => !f
+                    .reference
+                    .normal
+                    .is_some_and(|n| plus_z(V3::new(n[0], n[1], n[2]))),
+            };
+            if tilted {
                 let along = growth(t, f).map(|d| [d.x, d.y, d.z]);
                 out.push((offset + f.id, f.kind.as_str(), along));
             }
@@ -195,7 +215,7 @@ fn growth(tree: &FeatureTree, f: &Feature) -> Option<V3> {
         })
     };
     let d = middle(&f.faces)? - middle(&f.heal_faces)?;
-    d.try_normalize(PLUS_Z_SLACK)
+    d.try_normalize(SAME_POINT_MM)
 }
 
 /// The bead the features need at the least (volume over the thickest layer and the widest

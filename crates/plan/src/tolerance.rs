@@ -23,3 +23,6 @@ pub const HEIGHT_SLACK: f64 = 1e-9;
 /// A build direction whose z is within this of 1 is +Z (`slicing = "auto"` on a machine that
 /// prints only along +Z): about 2.6° off.
 pub const PLUS_Z_SLACK: f64 = 1e-3;
+
+/// Two points closer than this (mm) give no direction from one to the other.
+pub const SAME_POINT_MM: f64 = 1e-9;
