@@ -334,8 +334,19 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
             ))
         })
         .unwrap_or_default();
+    // Planar slicing `auto` chose (issue 33): the features' own directions were not +Z.
+    let chosen = plan.report.settings.process["defaults"]["slicing"].as_str() == Some("auto");
+    let planar =
+        if chosen && plan.report.slicing == "planar" {
+            format!(
+            " sliced whole in planar layers along +Z (slicing auto: `{}` prints only along +Z),",
+            plan.report.settings.machine["kind"].as_str().unwrap_or("the machine")
+        )
+        } else {
+            String::new()
+        };
     format!(
-        "{}: {} feature(s),{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
+        "{}: {} feature(s),{planar}{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
         args.part.display(),
         plan.features().len(),
         plan.toolpath.points.len(),

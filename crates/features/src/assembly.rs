@@ -13,7 +13,7 @@
 
 use crate::extract::{extract, ExtractError, ExtractOptions, FeatureTree};
 use brep::math::{Aabb, P3};
-use brep::topology::Brep;
+use brep::topology::{Brep, SolidId};
 use parry3d::na::Point3;
 use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
@@ -64,11 +64,20 @@ pub fn solid_name(t: &FeatureTree) -> String {
 ///
 /// Fails on the first solid whose extraction fails, or when no solid encloses a volume.
 pub fn extract_all(brep: &Brep, opts: &ExtractOptions) -> Result<Assembly, ExtractError> {
+    assemble(brep, |b, s| extract(b, s, opts))
+}
+
+/// Each solid of `brep` made a tree by `tree_of`, then ordered and checked together (see
+/// [`extract_all`]).
+pub(crate) fn assemble(
+    brep: &Brep,
+    tree_of: impl Fn(&Brep, SolidId) -> Result<FeatureTree, ExtractError>,
+) -> Result<Assembly, ExtractError> {
     let mut trees = vec![];
     let mut warnings = vec![];
     let mut empty = vec![];
     for s in brep.solid_ids() {
-        let t = extract(brep, s, opts)?;
+        let t = tree_of(brep, s)?;
         if t.part_volume < EMPTY_VOLUME {
             empty.push(t);
         } else {

@@ -1,7 +1,8 @@
 //! `features`: what a part is built from. AM feature recognition after the feature-based
 //! five-axis AM paper: an attributed adjacency graph with edge convexity ([`aag`]), concave
 //! loops, shell splitting and healing, classification into `two5d` and `freeform` features and
-//! their dependency graph ([`extract`](mod@extract)); the solids of a file together ([`assembly`]).
+//! their dependency graph ([`extract`](mod@extract)); the solids of a file together ([`assembly`]);
+//! each solid whole as one planar feature ([`whole`]).
 #![warn(missing_docs)]
 
 pub mod aag;
@@ -10,6 +11,7 @@ pub mod check;
 pub mod extract;
 pub mod split;
 mod tolerance;
+pub mod whole;
 
 pub use assembly::{extract_all, solid_name, Assembly};
 pub use check::{check_solid, SolidCheck, SolidProblem};
@@ -17,3 +19,4 @@ pub use extract::{
     extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference, RootLoop,
     RootOutcome,
 };
+pub use whole::{is_whole_part, whole_part_features};

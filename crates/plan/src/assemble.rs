@@ -75,6 +75,7 @@ impl Stages {
         // The part's warnings: the lay stage's, extraction's, the post's, then what the
         // gates let pass.
         let mut all = warnings;
+        all.extend(extracted.warnings.iter().cloned());
         all.extend(
             extracted
                 .assembly
@@ -95,6 +96,7 @@ impl Stages {
             schema: PLAN_SCHEMA,
             source: options.source.clone(),
             machine: machine.name.clone(),
+            slicing: extracted.slicing.as_str(),
             complete: passed.complete,
             features: reports,
             warnings: texts(&all),

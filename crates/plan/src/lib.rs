@@ -174,7 +174,7 @@ pub fn plan_file_into(
     let placed = place::place(file, options.placement, process, machine.bead().width)?;
     process.validate_for_nozzle(machine.nozzle_diameter)?;
     let extracted = match placed.assembly {
-        Some(assembly) => extract::arrange(assembly, process, machine)?,
+        Some(assembly) => extract::arrange(assembly, &placed.part.brep, process, machine)?,
         None => extract::extract(&placed.part, process, machine)?,
     };
     run(

@@ -82,11 +82,13 @@ impl Process {
             for (key, set) in [
                 ("pedestal", patch.pedestal.is_some()),
                 ("pedestal_inset", patch.pedestal_inset.is_some()),
+                ("slicing", patch.slicing.is_some()),
             ] {
                 if set {
                     return Err(ProcessError(format!(
-                        "process file{}: [features.{id}] {key}: the pedestal is the part's, not a feature's: set it in [defaults]",
-                        process.at("features", id, key)
+                        "process file{}: [features.{id}] {key}: the {what} is the part's, not a feature's: set it in [defaults]",
+                        process.at("features", id, key),
+                        what = if key == "slicing" { "slicing" } else { "pedestal" },
                     )));
                 }
             }

@@ -299,6 +299,9 @@ pub struct PlanReport {
     pub source: String,
     /// The machine profile's name.
     pub machine: String,
+    /// How the part was sliced: `features` (each recognised feature on its own reference) or
+    /// `planar` (each solid whole, in planar layers along +Z); the process key `slicing`.
+    pub slicing: &'static str,
     /// Whether every feature passed the self-check.
     pub complete: bool,
     /// Every feature, in build order.

@@ -19,3 +19,10 @@ pub const STANDS_Z: f64 = -1.0 + 1e-12;
 /// Heights (mm) within this of each other are one: a pedestal height a whole number of layers
 /// to within rounding.
 pub const HEIGHT_SLACK: f64 = 1e-9;
+
+/// A build direction whose z is within this of 1 is +Z (`slicing = "auto"` on a machine that
+/// prints only along +Z): about 2.6° off.
+pub const PLUS_Z_SLACK: f64 = 1e-3;
+
+/// Two points closer than this (mm) give no direction from one to the other.
+pub const SAME_POINT_MM: f64 = 1e-9;

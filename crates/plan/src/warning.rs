@@ -62,6 +62,16 @@ pub enum WarningKind {
     Collisions(String),
     /// Layers nothing holds up and `keep_going` wrote the plan anyway: the feature's line.
     Unsupported(String),
+    /// A recognised feature grows along another direction than +Z on a machine that prints
+    /// only along +Z: `slicing = "auto"` planned the part whole in planar layers.
+    PlanarInstead {
+        /// The recognised feature's file-wide id.
+        feature: usize,
+        /// Its kind (`two5d`, `freeform`).
+        kind: &'static str,
+        /// The unit direction it grows along, where one is known.
+        along: Option<[f64; 3]>,
+    },
 }
 
 impl Warning {
@@ -121,6 +131,25 @@ impl std::fmt::Display for Warning {
                 "feature {id}: {axes} tool axes tilted by up to {worst_deg:.3} degrees towards +Z to stay within the machine's B limit of {limit_deg} degrees"
             ),
             WarningKind::SelfCheck(p) => write!(f, "{p}"),
+            WarningKind::PlanarInstead {
+                feature,
+                kind,
+                along,
+            } => {
+                // Rounded first, so that no "-0.000" is written.
+                let r = |x: f64| (x * 1e3).round() / 1e3 + 0.0;
+                match along {
+                    Some(d) => write!(
+                        f,
+                        "feature {feature} ({kind}) grows along ({:.3}, {:.3}, {:.3})",
+                        r(d[0]),
+                        r(d[1]),
+                        r(d[2])
+                    )?,
+                    None => write!(f, "feature {feature} ({kind}) grows from a curved surface")?,
+                }
+                f.write_str(": planned with the part in planar layers along +Z; a 5-axis machine (delta5, kuka) prints it without support")
+            }
         }
     }
 }

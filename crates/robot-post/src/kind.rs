@@ -28,6 +28,11 @@ impl MachineKind {
         }
     }
 
+    /// Whether the machine prints only along +Z (its tool axis cannot tilt): `marlin`.
+    pub fn plus_z_only(self) -> bool {
+        matches!(self, MachineKind::Marlin)
+    }
+
     /// The kind named `name` (as [`MachineKind::as_str`] writes it), if any.
     pub fn from_name(name: &str) -> Option<MachineKind> {
         MachineKind::ALL.into_iter().find(|k| k.as_str() == name)

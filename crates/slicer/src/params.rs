@@ -120,6 +120,47 @@ impl<'de> Deserialize<'de> for Pedestal {
     }
 }
 
+/// How the part is cut into what is planned (issue 33, the process key `slicing`): the part's,
+/// so set in `[defaults]` only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Slicing {
+    /// `features` on a machine that can tilt its tool axis; on one that prints only along +Z,
+    /// `planar` when some feature grows along another direction (the default).
+    #[default]
+    Auto,
+    /// Each recognised AM feature planned on its own reference (two5d or freeform layers).
+    Features,
+    /// Each solid planned whole as one two5d feature, in planar layers along +Z from its
+    /// lowest point, as a planar slicer slices it.
+    Planar,
+}
+
+impl<'de> Deserialize<'de> for Slicing {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let w = String::deserialize(d)?;
+        match w.as_str() {
+            "auto" => Ok(Slicing::Auto),
+            "features" => Ok(Slicing::Features),
+            "planar" => Ok(Slicing::Planar),
+            _ => Err(serde::de::Error::custom(format!(
+                "slicing must be \"auto\", \"features\" or \"planar\", got \"{w}\""
+            ))),
+        }
+    }
+}
+
+impl Slicing {
+    /// The name as written in a process file (`auto`, `features`, `planar`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Slicing::Auto => "auto",
+            Slicing::Features => "features",
+            Slicing::Planar => "planar",
+        }
+    }
+}
+
 /// Layer and path parameters of one feature.
 ///
 /// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
@@ -171,6 +212,9 @@ pub struct LayerParams {
     pub pedestal: Pedestal,
     /// How far the pedestal's outline lies inside the build-plate face's, mm (≥ 0). Default 0.
     pub pedestal_inset: f64,
+    /// How the part is cut into what is planned ([`Slicing`]); the part's, so set in
+    /// `[defaults]` only. Default `auto`.
+    pub slicing: Slicing,
 }
 
 impl Default for LayerParams {
@@ -194,6 +238,7 @@ impl Default for LayerParams {
             overhang_angle_deg: DEFAULT_OVERHANG_ANGLE_DEG,
             pedestal: Pedestal::Auto,
             pedestal_inset: 0.0,
+            slicing: Slicing::Auto,
         }
     }
 }
@@ -410,6 +455,9 @@ impl LayerParams {
         if let Some(v) = p.pedestal_inset {
             out.pedestal_inset = v;
         }
+        if let Some(v) = p.slicing {
+            out.slicing = v;
+        }
         out
     }
 }
@@ -474,6 +522,9 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::pedestal_inset`] (`[defaults]` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pedestal_inset: Option<f64>,
+    /// Overrides [`LayerParams::slicing`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slicing: Option<Slicing>,
 }
 
 #[cfg(test)]
