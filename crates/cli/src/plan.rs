@@ -320,6 +320,13 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
     } else {
         String::new()
     };
+    // Support material (issue 33): laid apart from the part's volume.
+    let support: f64 = plan.features().iter().map(|f| f.support_volume_mm3).sum();
+    let support = if support > 0.0 {
+        format!(", {support:.1} mm^3 of support material")
+    } else {
+        String::new()
+    };
     // Where it went: the folder, or the program file `-o` named.
     let to = outputs.shown();
     // The pedestal, if the part stands on one (issue 31).
@@ -335,7 +342,7 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
         })
         .unwrap_or_default();
     format!(
-        "{}: {} feature(s),{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
+        "{}: {} feature(s),{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}{support}, {warnings} warning(s) -> {to}\n",
         args.part.display(),
         plan.features().len(),
         plan.toolpath.points.len(),
