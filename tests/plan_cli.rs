@@ -1243,11 +1243,13 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
 fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate() {
     let s = Scratch::new("plate_on_boss");
     // Standing on the small boss's top (face #521), the 60 × 40 plate is laid in the air round
-    // the r = 12 boss, itself round the r = 5 one: refused, nothing written.
+    // the r = 12 boss, itself round the r = 5 one: without support material, refused, nothing
+    // written.
     let out = s.path("top");
+    let off = ["--set", "support_material=off"];
     let o = plan(
         "plate_boss_boss.step",
-        &["--base-face", "521", "-o", out.to_str().unwrap()],
+        &[&off[..], &["--base-face", "521", "-o", out.to_str().unwrap()]].concat(),
     );
     assert_refused(&o, &["overhang limit", "no program written"]);
     assert!(!out.join("program.gcode").exists());
@@ -1272,12 +1274,16 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
     let o = plan(
         "plate_boss_boss.step",
         &[
-            "--base-face",
-            "521",
-            "--keep-going",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+            &off[..],
+            &[
+                "--base-face",
+                "521",
+                "--keep-going",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let report: Value =
@@ -1290,6 +1296,23 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
         .map(|f| f["unsupported_area_mm2"].as_f64().unwrap())
         .sum();
     assert!((area - expect).abs() < 1.0, "{area}");
+    // With support material (the default) the part, one feature standing on the boss's top,
+    // gets columns from the plate under the overhangs: planned, nothing left unsupported.
+    let held = s.path("held");
+    let o = plan(
+        "plate_boss_boss.step",
+        &["--base-face", "521", "-o", held.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(held.join("plan.json")).unwrap()).unwrap();
+    let mut support = 0.0;
+    for f in report["features"].as_array().unwrap() {
+        assert_eq!(f["unsupported_area_mm2"], 0.0);
+        support += f["support_volume_mm3"].as_f64().unwrap();
+    }
+    // Sparse columns under the unsupported area, up to the plate's underside 15 mm high.
+    assert!(support > 0.0 && support < expect * 15.0, "{support}");
     // --orient auto stands it on the plate's bottom face, every feature held up.
     let auto = s.path("auto");
     let o = plan(
