@@ -1249,7 +1249,11 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
     let off = ["--set", "support_material=off"];
     let o = plan(
         "plate_boss_boss.step",
-        &[&off[..], &["--base-face", "521", "-o", out.to_str().unwrap()]].concat(),
+        &[
+            &off[..],
+            &["--base-face", "521", "-o", out.to_str().unwrap()],
+        ]
+        .concat(),
     );
     assert_refused(&o, &["overhang limit", "no program written"]);
     assert!(!out.join("program.gcode").exists());

@@ -20,7 +20,7 @@
 //! feature's material at the same height (features are planned one at a time).
 
 use crate::fill::{difference, grow, intersection, union, Region};
-use crate::geom2d::region_area;
+use crate::geom2d::{dist, region_area, Point2};
 use crate::params::{LayerParams, PathMode};
 use crate::region_fill::FillPath;
 use crate::tolerance::HEIGHT_SLACK;
@@ -209,6 +209,33 @@ fn sweep(
     }
 }
 
+/// Support paths keep no two points closer than this many bead widths (but their ends): a
+/// zig-zag's connectors follow the column's outline, the part's section grown by the XY gap,
+/// whose round joins and chorded curves put vertices hundredths of a mm apart, points the
+/// post would merge. Support needs no such detail.
+const STEP_BEADS: f64 = 0.25;
+
+/// `points` without those closer than `step` to the last one kept; the last point stays (in
+/// place of the one kept before it when that one is too close and not the first).
+fn thinned(points: Vec<Point2>, step: f64) -> Vec<Point2> {
+    let Some(&last) = points.last() else {
+        return points;
+    };
+    let mut out: Vec<Point2> = Vec::with_capacity(points.len());
+    for p in points {
+        if out.last().is_none_or(|q| dist(*q, p) >= step) {
+            out.push(p);
+        }
+    }
+    if out.last() != Some(&last) {
+        if out.len() > 1 && out.last().is_some_and(|q| dist(*q, last) < step) {
+            out.pop();
+        }
+        out.push(last);
+    }
+    out
+}
+
 /// Each layer's support paths in its plane: sparse zig-zag lines `width / support_density`
 /// apart at `raster_angle_deg` (one direction on every layer), interface lines `width /
 /// support_interface_density` apart turning 90° every layer, under their roles.
@@ -228,7 +255,8 @@ pub(crate) fn fill_columns(
         crate::fill::fill_layer(r, &lines, layer, width, width / density)
             .paths
             .into_iter()
-            .map(|p| FillPath::uniform(p.points, width, role))
+            .map(|p| FillPath::uniform(thinned(p.points, STEP_BEADS * width), width, role))
+            .filter(|p| p.points.len() >= 2)
             .collect()
     };
     regions
