@@ -13,6 +13,9 @@ use slicer::support::{planar_support, FeatureSupport};
 use slicer::support_material::SupportRegions;
 use std::collections::BTreeMap;
 
+/// Each feature's support material regions by file-wide id (features with support only).
+pub type Columns = BTreeMap<usize, SupportRegions>;
+
 /// What holds up one feature.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Held {
@@ -36,7 +39,7 @@ pub fn planar(
     process: &Process,
     bead_width: f64,
     columns: bool,
-) -> Result<(BTreeMap<usize, Held>, BTreeMap<usize, SupportRegions>), PlanError> {
+) -> Result<(BTreeMap<usize, Held>, Columns), PlanError> {
     let base = process.base();
     let trees = &assembly.trees;
     // How high each solid's base plane stands along the build direction (+Z).

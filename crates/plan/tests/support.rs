@@ -15,7 +15,7 @@ fn fixture(name: &str) -> brep::StepPart {
     brep::read_step(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
-fn options(name: &str) -> Options {
+fn options(name: &str) -> Options<'_> {
     Options {
         source: name.into(),
         stem: "part".into(),
