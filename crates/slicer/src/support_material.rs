@@ -25,6 +25,7 @@ use crate::params::{LayerParams, PathMode};
 use crate::region_fill::FillPath;
 use crate::tolerance::HEIGHT_SLACK;
 use crate::toolpath::Role;
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// Where support is printed in each layer of a feature, in its reference plane's 2-D frame.
@@ -179,10 +180,15 @@ fn sweep(
     tol: f64,
     regions: &mut SupportRegions,
 ) {
+    let n = entering.len();
     let interface_layers = params.support_interface_layers;
+    // Top down, one layer after the other: the columns in each layer (what has not landed),
+    // and those that entered within the interface layers above it.
+    let mut active_at: Vec<Vec<Region>> = vec![vec![]; n];
+    let mut top_at: Vec<Vec<Region>> = vec![vec![]; n];
     let mut active: Vec<Region> = vec![];
     let mut recent: VecDeque<Vec<Region>> = VecDeque::new();
-    for j in (0..entering.len()).rev() {
+    for j in (0..n).rev() {
         let new = &entering[j];
         if interface_layers > 0 {
             recent.push_front(new.clone());
@@ -191,22 +197,91 @@ fn sweep(
         if active.is_empty() && new.is_empty() {
             continue;
         }
-        active = difference(&union(&active, new), &sections[j]);
+        let column = union(&active, new);
+        active = difference(&column, &near(&sections[j], &column, 0.0));
         if active.is_empty() {
             continue;
         }
-        let printed = difference(
-            &active,
-            &grow(&sections[j], params.support_xy_distance, tol),
-        );
-        let top: Vec<Region> = recent
+        top_at[j] = recent
             .iter()
             .filter(|r| !r.is_empty())
             .fold(vec![], |acc, r| union(&acc, r));
-        let interface = intersection(&printed, &top);
-        regions.sparse[j] = difference(&printed, &interface);
+        active_at[j] = active.clone();
+    }
+    // Each layer's printed support (in parallel): the columns less the part's section near
+    // them grown by the XY gap, interface where a column entered within the interface layers.
+    let xy = params.support_xy_distance;
+    let printed: Vec<(Vec<Region>, Vec<Region>)> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let a = &active_at[j];
+            if a.is_empty() {
+                return (vec![], vec![]);
+            }
+            // Only the part's section within reach of the columns is grown: clipped to their
+            // box grown by more than the gap (the clip's own edges, grown, stay outside it).
+            let part = match window(a, xy + 2.0 * tol) {
+                Some(w) => grow(
+                    &intersection(&near(&sections[j], a, xy + tol), &[w]),
+                    xy,
+                    tol,
+                ),
+                None => vec![],
+            };
+            let printed = difference(a, &part);
+            let interface = intersection(&printed, &top_at[j]);
+            (difference(&printed, &interface), interface)
+        })
+        .collect();
+    for (j, (sparse, interface)) in printed.into_iter().enumerate() {
+        regions.sparse[j] = sparse;
         regions.interface[j] = interface;
     }
+}
+
+/// The regions of `section` whose outer ring's box comes within `margin` of the box of
+/// `column`'s outer rings: the only ones a boolean with `column` (or with `column` less the
+/// section grown by up to `margin`) can meet.
+fn near(section: &[Region], column: &[Region], margin: f64) -> Vec<Region> {
+    let Some((lo, hi)) = bounds(column) else {
+        return vec![];
+    };
+    section
+        .iter()
+        .filter(|r| {
+            bounds(std::slice::from_ref(*r)).is_some_and(|(a, b)| {
+                (0..2).all(|k| a[k] <= hi[k] + margin && b[k] >= lo[k] - margin)
+            })
+        })
+        .cloned()
+        .collect()
+}
+
+/// The box of `column`'s outer rings grown by `margin`, as a region.
+fn window(column: &[Region], margin: f64) -> Option<Region> {
+    let (lo, hi) = bounds(column)?;
+    let (x0, y0, x1, y1) = (
+        lo[0] - margin,
+        lo[1] - margin,
+        hi[0] + margin,
+        hi[1] + margin,
+    );
+    Some(Region {
+        outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
+        holes: vec![],
+    })
+}
+
+/// The box of the outer rings of `regions`: lowest and highest corner; `None` for none.
+fn bounds(regions: &[Region]) -> Option<(Point2, Point2)> {
+    let mut pts = regions.iter().flat_map(|r| r.outer.iter());
+    let first = *pts.next()?;
+    Some(pts.fold((first, first), |(lo, hi), p| {
+        (
+            [lo[0].min(p[0]), lo[1].min(p[1])],
+            [hi[0].max(p[0]), hi[1].max(p[1])],
+        )
+    }))
 }
 
 /// Support paths keep no two points closer than this many bead widths (but their ends): a
