@@ -56,6 +56,8 @@ pub struct Row {
     pub e: f64,
     pub thickness: f64,
     pub width: f64,
+    /// Support material's bead (role `support_material` or `support_material_interface`).
+    pub support: bool,
 }
 
 /// The rows of `toolpath.csv`, its header checked (other tools read these columns by place).
@@ -78,6 +80,7 @@ pub fn rows(csv: &str) -> Vec<Row> {
                 e: f(9),
                 thickness: f(10),
                 width: f(11),
+                support: c.get(12).is_some_and(|r| r.starts_with("support_material")),
             }
         })
         .collect()

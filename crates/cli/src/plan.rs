@@ -320,6 +320,13 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
     } else {
         String::new()
     };
+    // Support material (issue 33): laid apart from the part's volume.
+    let support: f64 = plan.features().iter().map(|f| f.support_volume_mm3).sum();
+    let support = if support > 0.0 {
+        format!(", {support:.1} mm^3 of support material")
+    } else {
+        String::new()
+    };
     // Where it went: the folder, or the program file `-o` named.
     let to = outputs.shown();
     // The pedestal, if the part stands on one (issue 31).
@@ -346,7 +353,8 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
             String::new()
         };
     format!(
-        "{}: {} feature(s),{planar}{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}, {warnings} warning(s) -> {to}\n",
+        "{}: {} feature(s),{planar}{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}{support}, {warnings} warning(s) -> {to}
+",
         args.part.display(),
         plan.features().len(),
         plan.toolpath.points.len(),

@@ -173,6 +173,13 @@ fn plan_preview<'a>(plan: &'a plan::Plan, title: &str) -> Preview<'a> {
             ("travel length".into(), format!("{travel:.1} mm")),
             ("extruded volume".into(), format!("{volume:.1} mm³")),
             (
+                "support volume".into(),
+                format!(
+                    "{:.1} mm³",
+                    f.iter().map(|x| x.support_volume_mm3).sum::<f64>()
+                ),
+            ),
+            (
                 "estimated time".into(),
                 plan::estimate::hms(plan.report.estimated_time_s),
             ),

@@ -164,6 +164,7 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
         travel_length_mm: round(f.travel_length, 1e3),
         extruded_volume_mm3: round(f.extruded, 1e3),
         widened_volume_mm3: round(f.widened, 1e3),
+        support_volume_mm3: round(f.support_volume, 1e3),
         below_resolution: f
             .below_resolution
             .map(|b| crate::resolution::BelowResolution {

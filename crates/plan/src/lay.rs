@@ -34,6 +34,9 @@ pub struct LaidFeature {
     pub extruded: f64,
     /// Bead volume added by widening narrow beads, mm³.
     pub widened: f64,
+    /// Bead volume of support material laid with its planar layers (issue 33), mm³: not the
+    /// part's, so not in `extruded` nor in the self-check.
+    pub support_volume: f64,
     /// Thinnest, mean and thickest layer, mm.
     pub thickness: (f64, f64, f64),
     /// The freeform planner's figures (curved features).
@@ -70,7 +73,9 @@ pub fn lay(
 ) -> Result<Laid, PlanError> {
     let base = process.base();
     // What holds up each planar layer, from the features alone (issue 31).
-    let mut held = crate::support::planar(&extracted.assembly, process, machine.bead().width)?;
+    // Support material (issue 33) carries what it can; `held` is what it leaves.
+    let (mut held, columns) =
+        crate::support::planar(&extracted.assembly, process, machine.bead().width, true)?;
     let window = rayon::current_num_threads().max(1);
     let mut plans = vec![];
     let mut cursor: Option<P3> = None;
@@ -83,6 +88,10 @@ pub fn lay(
                 let t = &extracted.assembly.trees[slot.tree];
                 let params = process.params_for(&base, extracted.id(slot))?;
                 let fill = fill_feature(t, extracted.feature(slot), &params, machine.bead())?;
+                let fill = match columns.get(&extracted.id(slot)) {
+                    Some(c) => fill.with_support(c, &params),
+                    None => fill,
+                };
                 Ok((params, fill))
             })
             .collect();
@@ -234,6 +243,7 @@ fn laid_feature(
         travel_length: fig.travel_length,
         extruded,
         widened: 0.0,
+        support_volume: fig.support_filament * machine.bead().filament_area(),
         thickness: fig.thickness,
         freeform: plan.freeform,
         warnings,
@@ -253,7 +263,10 @@ impl LaidFeature {
     fn widen(mut self, points: &mut [PathPoint], machine: &MachineProfile) -> LaidFeature {
         let min_bead = machine.min_bead_width();
         let (mut narrow, mut prints, mut thinnest, mut added) = (0, 0, f64::INFINITY, 0.0);
-        for q in points.iter_mut().filter(|q| q.kind == MoveKind::Print) {
+        for q in points
+            .iter_mut()
+            .filter(|q| q.kind == MoveKind::Print && !q.role.is_support())
+        {
             prints += 1;
             if q.width < min_bead && q.width > 0.0 {
                 narrow += 1;

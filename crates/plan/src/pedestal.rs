@@ -308,6 +308,7 @@ impl Stood {
             travel_length_mm: round(fig.travel_length, 1e3),
             extruded_volume_mm3: round(fig.filament * filament_area, 1e3),
             widened_volume_mm3: 0.0,
+            support_volume_mm3: 0.0,
             below_resolution: None,
             unsupported_area_mm2: 0.0,
             thickness_min_mm: round(fig.thickness.0, 1e6),

@@ -152,6 +152,9 @@ pub struct FeatureReport {
     /// Bead volume added over that by widening beads narrower than the machine's
     /// `min_bead_width` to it, mm³ (the program lays both).
     pub widened_volume_mm3: f64,
+    /// Bead volume of support material laid with its planar layers, mm³ (issue 33; the
+    /// program lays it, the self-check leaves it out); 0 without support.
+    pub support_volume_mm3: f64,
     /// Set when the feature is below the nozzle's resolution (a share of it narrower than
     /// `min_bead_width`): its narrowest width and the nozzle it would need
     /// ([`crate::resolution`]); `null` otherwise.
@@ -164,7 +167,7 @@ pub struct FeatureReport {
     pub thickness_max_mm: f64,
     /// Area of its layers that nothing holds up within the overhang limit
     /// (`overhang_angle_deg`), summed over its layers, mm² rounded to 1e-3; 0 when supported
-    /// (issue 31, [`crate::support`]).
+    /// (issue 31, [`crate::support`]), by the layers below or by support material.
     pub unsupported_area_mm2: f64,
     /// Curved features only.
     #[serde(flatten)]

@@ -52,6 +52,8 @@ pub fn below_resolution(
     for q in points
         .iter()
         .filter(|q| q.kind == MoveKind::Print && q.width > 0.0 && q.e > 0.0)
+        // The part's beads: support material is not the feature.
+        .filter(|q| !q.role.is_support())
     {
         total += q.e;
         if q.width < min_bead {

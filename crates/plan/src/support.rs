@@ -3,12 +3,18 @@
 //! the slicer's ([`slicer::support`]): planar layers from the features alone, before any path
 //! is filled ([`planar`], also what `--orient auto` ranks placements by), curved layers as
 //! they are laid (`FreeformFigures::support`). A feature with unsupported area fails the plan
-//! like the self-check ([`crate::Gate::Unsupported`], one [`line()`] each).
+//! like the self-check ([`crate::Gate::Unsupported`], one [`line()`] each), unless support
+//! material carries it (issue 33, [`slicer::support_material`]): then only what support
+//! cannot stand under (below a feature's first layer) is refused.
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
-use slicer::support::{feature_support, FeatureSupport};
+use slicer::support::{planar_support, FeatureSupport};
+use slicer::support_material::SupportRegions;
 use std::collections::BTreeMap;
+
+/// Each feature's support material regions by file-wide id (features with support only).
+pub type Columns = BTreeMap<usize, SupportRegions>;
 
 /// What holds up one feature.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,11 +31,15 @@ pub struct Held {
 /// `process` and beads `bead_width` wide: no path filled (freeform features are left out;
 /// their curved layers are measured as they are laid). A solid whose base feature lies above
 /// the plate (the lowest base plane, [`PLATE_SLACK`]) rests on the solids built before it.
+/// With `columns`, support material (issue 33; unless `support_material = "off"`) carries
+/// what it can ([`slicer::support::planar_support`]): each [`Held`] gives what is left, and
+/// the second map each feature's support regions (features with support only).
 pub fn planar(
     assembly: &Assembly,
     process: &Process,
     bead_width: f64,
-) -> Result<BTreeMap<usize, Held>, PlanError> {
+    columns: bool,
+) -> Result<(BTreeMap<usize, Held>, Columns), PlanError> {
     let base = process.base();
     let trees = &assembly.trees;
     // How high each solid's base plane stands along the build direction (+Z).
@@ -47,6 +57,7 @@ pub fn planar(
         .copied()
         .fold(f64::INFINITY, f64::min);
     let mut out = BTreeMap::new();
+    let mut regions = BTreeMap::new();
     let mut offset = 0;
     for (ti, t) in trees.iter().enumerate() {
         let lifted = standing[ti].is_some_and(|z| z > plate + PLATE_SLACK);
@@ -60,22 +71,26 @@ pub fn planar(
         for f in &t.features {
             let id = offset + f.id;
             let params = process.params_for(&base, id)?;
-            if let Some(support) = feature_support(t, f, &params, bead_width, &earlier)? {
+            let found = planar_support(t, f, &params, bead_width, &earlier, columns)?;
+            if let Some(p) = found {
                 let angle_deg = params.overhang_angle_deg;
                 let kind = f.kind;
                 out.insert(
                     id,
                     Held {
-                        support,
+                        support: p.left,
                         angle_deg,
                         kind,
                     },
                 );
+                if !p.columns.is_empty() {
+                    regions.insert(id, p.columns);
+                }
             }
         }
         offset += t.features.len();
     }
-    Ok(out)
+    Ok((out, regions))
 }
 
 /// How far (mm) above the lowest solid's base plane another solid's base may stand and still
@@ -83,13 +98,15 @@ pub fn planar(
 pub const PLATE_SLACK: f64 = 1e-3;
 
 /// The unsupported area of `assembly`'s planar layers, mm², summed over its features
-/// ([`planar`]): 0 when every layer is held up. What `--orient auto` ranks by first.
+/// ([`planar`], without support material: a placement that needs less is better): 0 when
+/// every layer is held up. What `--orient auto` ranks by first.
 pub fn planar_area(
     assembly: &Assembly,
     process: &Process,
     bead_width: f64,
 ) -> Result<f64, PlanError> {
-    Ok(planar(assembly, process, bead_width)?
+    Ok(planar(assembly, process, bead_width, false)?
+        .0
         .values()
         .map(|h| h.support.area_mm2)
         .sum())

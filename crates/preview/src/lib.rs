@@ -4,7 +4,8 @@
 //!
 //! - the features' meshes, translucent, one colour each, toggled one by one;
 //! - the tool path as lines, print and travel told apart (travel hidden at first), a range of
-//!   layers over the whole build order, coloured by feature, layer or local layer thickness;
+//!   layers over the whole build order, coloured by feature, layer or local layer thickness,
+//!   support material's beads in a colour of their own (green);
 //! - tool axes as short ticks at a chosen density; orbit (drag), pan (shift-drag or right-drag)
 //!   and zoom (wheel); a legend and the plan's figures beside the view.
 //!
@@ -184,7 +185,12 @@ fn path_json(tp: &ToolPath) -> serde_json::Value {
         thick.push(q.thickness as f32);
         info.push(q.feature as u32);
         info.push(global[i]);
-        info.push(u32::from(q.kind == MoveKind::Print));
+        // 0 travel, 1 the part's bead, 2 support material's.
+        info.push(match q.kind {
+            MoveKind::Print if q.role.is_support() => 2,
+            MoveKind::Print => 1,
+            MoveKind::Travel => 0,
+        });
     }
     serde_json::json!({
         "points": keep.len(),

@@ -36,6 +36,19 @@ pub fn fill_feature<'a>(
 }
 
 impl FeatureFill<'_> {
+    /// Planar layers with support material in `columns` ([`Two5dFill::with_support`]);
+    /// curved layers as they are (support material is for planar layers only).
+    pub fn with_support(
+        self,
+        columns: &crate::support_material::SupportRegions,
+        params: &LayerParams,
+    ) -> Self {
+        match self {
+            FeatureFill::Two5d(f) => FeatureFill::Two5d(f.with_support(columns, params)),
+            other => other,
+        }
+    }
+
     /// The feature's plan, its first travel starting at `entry` (where the nozzle is).
     pub fn lay(self, entry: Option<P3>) -> FeaturePlan {
         match self {

@@ -11,8 +11,11 @@ pub struct FeatureFigures {
     pub print_length: f64,
     /// Travel length, mm.
     pub travel_length: f64,
-    /// Filament fed, mm.
+    /// Filament fed for the part's beads, mm (what the self-check compares with the volume).
     pub filament: f64,
+    /// Filament fed for support material's beads, mm (planar layers, issue 33): not the
+    /// part's; the points carry it like any other.
+    pub support_filament: f64,
     /// Thinnest, mean and thickest layer, mm.
     pub thickness: (f64, f64, f64),
     /// How far (mm) the feature's surface reaches below its tree's build plate (the base

@@ -18,6 +18,7 @@
 //!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`;
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
+//! - [`support_material`]: columns of support under what the overhang limit leaves unheld;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
 //!   re-exported);
@@ -48,6 +49,7 @@ mod region_fill;
 pub mod resolution;
 mod sst;
 pub mod support;
+pub mod support_material;
 mod tolerance;
 mod top_field;
 pub mod transition;

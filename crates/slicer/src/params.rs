@@ -74,6 +74,18 @@ pub enum WallOrientation {
     Sst,
 }
 
+/// Whether planar layers get support material where they overhang (issue 33, the process key
+/// `support_material`): `"auto"` (the default) or `"off"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportMaterial {
+    /// Columns under every overhang of a two5d feature's planar layers that can stand on the
+    /// plate or on the feature's own lower layers ([`crate::support_material`]).
+    Auto,
+    /// No support: an overhang refuses the plan as the support check finds it.
+    Off,
+}
+
 /// Whether the part stands on a printed pedestal (issue 31, the process key `pedestal`): a
 /// prism under its build-plate face that lifts it off the table where the head would meet the
 /// table. Written `"auto"`, `"off"` or a height in mm.
@@ -207,6 +219,21 @@ pub struct LayerParams {
     /// `h·tan(overhang_angle_deg)` of the layer below it (h the layer's thickness), or on
     /// material laid before, or on the plate ([`crate::support`]). Default 50.
     pub overhang_angle_deg: f64,
+    /// Support material under the overhangs of planar layers ([`SupportMaterial`]). Default
+    /// `auto`.
+    pub support_material: SupportMaterial,
+    /// Gap between the top of the support and the surface it holds, mm (≥ 0; rounded to whole
+    /// layers). Default 0.2 (one layer).
+    pub support_contact_distance: f64,
+    /// Gap between the support and the part's section beside it, mm (≥ 0). Default 0.5.
+    pub support_xy_distance: f64,
+    /// Sparse support's bead width over line spacing, in (0, 1]. Default 0.2.
+    pub support_density: f64,
+    /// Denser layers at the top of the support, right under the held surface (0 for none).
+    /// Default 2.
+    pub support_interface_layers: usize,
+    /// Those layers' bead width over line spacing, in (0, 1]. Default 0.7.
+    pub support_interface_density: f64,
     /// The part's pedestal ([`Pedestal`]); the part's, so set in `[defaults]` only. Default
     /// `auto`.
     pub pedestal: Pedestal,
@@ -236,6 +263,12 @@ impl Default for LayerParams {
             min_layer_height: 0.1,
             max_layer_height: 0.3,
             overhang_angle_deg: DEFAULT_OVERHANG_ANGLE_DEG,
+            support_material: SupportMaterial::Auto,
+            support_contact_distance: 0.2,
+            support_xy_distance: 0.5,
+            support_density: 0.2,
+            support_interface_layers: 2,
+            support_interface_density: 0.7,
             pedestal: Pedestal::Auto,
             pedestal_inset: 0.0,
             slicing: Slicing::Auto,
@@ -376,6 +409,22 @@ impl LayerParams {
                 "overhang_angle_deg must be more than 0 and less than {MAX_OVERHANG_ANGLE_DEG} degrees, got {a}"
             ));
         }
+        for (key, d) in [
+            ("support_contact_distance", self.support_contact_distance),
+            ("support_xy_distance", self.support_xy_distance),
+        ] {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(format!("{key} must be 0 mm or more, got {d}"));
+            }
+        }
+        for (key, r) in [
+            ("support_density", self.support_density),
+            ("support_interface_density", self.support_interface_density),
+        ] {
+            if !(r.is_finite() && r > 0.0 && r <= 1.0) {
+                return Err(format!("{key} must be in (0, 1], got {r}"));
+            }
+        }
         if let Pedestal::Height(h) = self.pedestal {
             if !(h.is_finite() && h >= 0.0) {
                 return Err(format!(
@@ -449,6 +498,24 @@ impl LayerParams {
         if let Some(v) = p.overhang_angle_deg {
             out.overhang_angle_deg = v;
         }
+        if let Some(v) = p.support_material {
+            out.support_material = v;
+        }
+        if let Some(v) = p.support_contact_distance {
+            out.support_contact_distance = v;
+        }
+        if let Some(v) = p.support_xy_distance {
+            out.support_xy_distance = v;
+        }
+        if let Some(v) = p.support_density {
+            out.support_density = v;
+        }
+        if let Some(v) = p.support_interface_layers {
+            out.support_interface_layers = v;
+        }
+        if let Some(v) = p.support_interface_density {
+            out.support_interface_density = v;
+        }
         if let Some(v) = p.pedestal {
             out.pedestal = v;
         }
@@ -516,6 +583,24 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::overhang_angle_deg`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub overhang_angle_deg: Option<f64>,
+    /// Overrides [`LayerParams::support_material`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_material: Option<SupportMaterial>,
+    /// Overrides [`LayerParams::support_contact_distance`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_contact_distance: Option<f64>,
+    /// Overrides [`LayerParams::support_xy_distance`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_xy_distance: Option<f64>,
+    /// Overrides [`LayerParams::support_density`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_density: Option<f64>,
+    /// Overrides [`LayerParams::support_interface_layers`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_interface_layers: Option<usize>,
+    /// Overrides [`LayerParams::support_interface_density`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support_interface_density: Option<f64>,
     /// Overrides [`LayerParams::pedestal`] (`[defaults]` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pedestal: Option<Pedestal>,
@@ -678,6 +763,16 @@ mod tests {
         bad(|p| p.filling_ratio = 0.0, "filling_ratio");
         bad(|p| p.filling_ratio = 1.01, "filling_ratio");
         bad(|p| p.raster_angle_deg = f64::NAN, "raster_angle_deg");
+        bad(
+            |p| p.support_contact_distance = -0.1,
+            "support_contact_distance",
+        );
+        bad(|p| p.support_xy_distance = f64::NAN, "support_xy_distance");
+        bad(|p| p.support_density = 0.0, "support_density");
+        bad(
+            |p| p.support_interface_density = 1.5,
+            "support_interface_density",
+        );
         let p = LayerParams {
             filling_ratio: 1.0,
             ..LayerParams::default()

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 pub use crate::error::FeatureError;
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FeatureFigures;
+use crate::support_material::SupportRegions;
 use crate::tolerance::{COLLINEAR, KEY_GRID};
 pub use toolpath::Bead;
 
@@ -474,6 +475,17 @@ fn without_straight_vertices(ring: &[Point2]) -> Vec<Point2> {
 }
 
 impl Two5dFill {
+    /// These layers with support material in `columns` (the feature's
+    /// [`crate::support::planar_support`], one entry a layer): sparse and interface lines
+    /// ([`crate::support_material`]) added to each layer, laid before the part's paths.
+    pub fn with_support(mut self, columns: &SupportRegions, params: &LayerParams) -> Two5dFill {
+        let paths = crate::support_material::fill_columns(columns, params, self.bead.width);
+        for (layer, support) in self.filled.iter_mut().zip(paths) {
+            layer.extend(support);
+        }
+        self
+    }
+
     /// Orders each layer's paths from where the nozzle is (starting at `entry`) and joins them
     /// by travel.
     pub fn lay(self, entry: Option<P3>) -> FeaturePlan {
@@ -491,7 +503,15 @@ impl Two5dFill {
         let mut points: Vec<PathPoint> = vec![];
         for (layer, (paths, &(_, z, dl))) in filled.into_iter().zip(&tops).enumerate() {
             let start = cursor.map(|c| plane.to_2d(&c)).unwrap_or([0.0, 0.0]);
-            let paths = order_greedy(paths, start, |p| &p.points, FillPath::reverse);
+            // Support material first, then the part's paths from where it ended.
+            let (support, part): (Vec<FillPath>, Vec<FillPath>) =
+                paths.into_iter().partition(|p| p.role.is_support());
+            let mut paths = order_greedy(support, start, |p| &p.points, FillPath::reverse);
+            let start = paths
+                .last()
+                .and_then(|p| p.points.last().copied())
+                .unwrap_or(start);
+            paths.extend(order_greedy(part, start, |p| &p.points, FillPath::reverse));
             if paths.is_empty() {
                 continue;
             }
@@ -521,7 +541,10 @@ impl Two5dFill {
                     let width = 0.5 * (path.widths[i] + path.widths[i + 1]);
                     let e = bead.filament_length(width, dl, l);
                     fig.print_length += l;
-                    fig.filament += e;
+                    match path.role.is_support() {
+                        true => fig.support_filament += e,
+                        false => fig.filament += e,
+                    }
                     points.push(PathPoint {
                         feature: id,
                         layer,

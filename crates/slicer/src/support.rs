@@ -17,9 +17,10 @@
 
 use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
-use crate::fill::pieces_outside;
-use crate::geom2d::Region;
-use crate::params::LayerParams;
+use crate::fill::{outside_grown, pieces_outside};
+use crate::geom2d::{region_area, Region};
+use crate::params::{LayerParams, SupportMaterial};
+use crate::support_material::SupportRegions;
 use brep::section::Plane;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
@@ -107,7 +108,7 @@ fn section_regions(mesh: &brep::mesh::Mesh, plane: &Plane) -> Vec<Region> {
 /// plate when `earlier` is empty (nothing to check), else on `earlier`: the features of the
 /// file's other solids built before it, for a solid whose base lies above the plate. `None`
 /// for a freeform feature, whose curved layers are measured as they are laid. Nothing is
-/// filled.
+/// filled, and no support material is counted ([`planar_support`] does).
 pub fn feature_support(
     tree: &FeatureTree,
     f: &Feature,
@@ -115,6 +116,34 @@ pub fn feature_support(
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
 ) -> Result<Option<FeatureSupport>, FeatureError> {
+    Ok(planar_support(tree, f, params, bead_width, earlier, false)?.map(|p| p.left))
+}
+
+/// What holds up a two5d feature's planar layers, with support material ([`planar_support`]).
+#[derive(Debug, Clone, Default)]
+pub struct PlanarSupport {
+    /// The unsupported area the layers below leave (what the support check finds).
+    pub overhang: FeatureSupport,
+    /// What is left of it unsupported after support material; `overhang` when there is none.
+    pub left: FeatureSupport,
+    /// The support material's regions, layer by layer (empty without support).
+    pub columns: SupportRegions,
+}
+
+/// [`feature_support`], and with `columns` (and `support_material` not `off`) the support
+/// material under the unsupported pieces ([`crate::support_material::columns`]): what it
+/// carries is no longer unsupported. Columns stand on the plate only for a base feature on it
+/// (no parent, `earlier` empty); elsewhere on the feature's own lower layers, or at its first
+/// layer on what that layer rests on (its parents' or the earlier solids' sections), never
+/// lower.
+pub fn planar_support(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead_width: f64,
+    earlier: &[(&FeatureTree, &Feature)],
+    columns: bool,
+) -> Result<Option<PlanarSupport>, FeatureError> {
     if f.kind != FeatureKind::Two5d {
         return Ok(None);
     }
@@ -158,27 +187,56 @@ pub fn feature_support(
     let sliver = sliver_area(bead_width);
     let angle = params.overhang_angle_deg;
     let chord = params.tolerance;
-    let areas: Vec<f64> = (0..sections.len())
+    let pieces: Vec<Vec<Region>> = (0..sections.len())
         .into_par_iter()
         .map(|k| {
             let below = match k {
                 0 => match &foundation {
                     Some(r) => r,
-                    None => return 0.0,
+                    None => return vec![],
                 },
                 _ => &sections[k - 1],
             };
-            unsupported_area(&sections[k], below, reach(heights[k], angle), sliver, chord)
+            outside_grown(&sections[k], below, reach(heights[k], angle), chord)
+                .into_iter()
+                .filter(|r| region_area(r) >= sliver)
+                .collect()
         })
         .collect();
-    let mut out = FeatureSupport {
+    let mut overhang = FeatureSupport {
         feature: f.id,
         ..FeatureSupport::default()
     };
-    for (k, a) in areas.into_iter().enumerate() {
-        out.add(k + 1, a);
+    for (k, p) in pieces.iter().enumerate() {
+        overhang.add(k + 1, p.iter().map(region_area).sum());
     }
-    Ok(Some(out))
+    if !columns || params.support_material == SupportMaterial::Off || overhang.area_mm2 <= 0.0 {
+        return Ok(Some(PlanarSupport {
+            overhang,
+            left: overhang,
+            columns: SupportRegions::default(),
+        }));
+    }
+    let c = crate::support_material::columns(
+        &sections,
+        &heights,
+        &pieces,
+        foundation.as_deref(),
+        params,
+        sliver,
+    );
+    let mut left = FeatureSupport {
+        feature: f.id,
+        ..FeatureSupport::default()
+    };
+    for (k, a) in c.left.iter().enumerate() {
+        left.add(k + 1, *a);
+    }
+    Ok(Some(PlanarSupport {
+        overhang,
+        left,
+        columns: c.regions,
+    }))
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! What a bead is for in its layer, as slicers name extrusion roles.
 
-/// The role of the path a point belongs to: its outermost ring, another ring, infill or a gap
-/// fill. G-code posts write it as PrusaSlicer's `;TYPE:` comment ([`Role::prusa_name`]),
+/// The role of the path a point belongs to: its outermost ring, another ring, infill, a gap
+/// fill, or support material under it. G-code posts write it as PrusaSlicer's `;TYPE:` comment ([`Role::prusa_name`]),
 /// `toolpath.csv` as its `role` column ([`Role::as_str`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Role {
@@ -17,20 +17,32 @@ pub enum Role {
     InternalInfill,
     /// Beads as wide as a strip narrower than a ring leaves, or spurs into sharp corners.
     GapFill,
+    /// Sparse lines of support material under an overhang: not the part's.
+    SupportMaterial,
+    /// The denser layers of support material right under the surface it holds.
+    SupportMaterialInterface,
 }
 
 impl Role {
     /// Every role, in the order above.
-    pub const ALL: [Role; 5] = [
+    pub const ALL: [Role; 7] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::SolidInfill,
         Role::InternalInfill,
         Role::GapFill,
+        Role::SupportMaterial,
+        Role::SupportMaterialInterface,
     ];
 
+    /// True for support material's beads ([`Role::SupportMaterial`],
+    /// [`Role::SupportMaterialInterface`]), which are not the part's.
+    pub fn is_support(self) -> bool {
+        matches!(self, Role::SupportMaterial | Role::SupportMaterialInterface)
+    }
+
     /// The role's name in `toolpath.csv`: `external_perimeter`, `perimeter`, `solid_infill`,
-    /// `internal_infill`, `gap_fill`.
+    /// `internal_infill`, `gap_fill`, `support_material`, `support_material_interface`.
     pub fn as_str(self) -> &'static str {
         match self {
             Role::ExternalPerimeter => "external_perimeter",
@@ -38,6 +50,8 @@ impl Role {
             Role::SolidInfill => "solid_infill",
             Role::InternalInfill => "internal_infill",
             Role::GapFill => "gap_fill",
+            Role::SupportMaterial => "support_material",
+            Role::SupportMaterialInterface => "support_material_interface",
         }
     }
 
@@ -48,7 +62,7 @@ impl Role {
 
     /// PrusaSlicer's name of the role, as its `;TYPE:` comment writes it and its G-code viewer
     /// lists it: `External perimeter`, `Perimeter`, `Solid infill`, `Internal infill`,
-    /// `Gap fill`.
+    /// `Gap fill`, `Support material`, `Support material interface`.
     pub fn prusa_name(self) -> &'static str {
         match self {
             Role::ExternalPerimeter => "External perimeter",
@@ -56,6 +70,8 @@ impl Role {
             Role::SolidInfill => "Solid infill",
             Role::InternalInfill => "Internal infill",
             Role::GapFill => "Gap fill",
+            Role::SupportMaterial => "Support material",
+            Role::SupportMaterialInterface => "Support material interface",
         }
     }
 }

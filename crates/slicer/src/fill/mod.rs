@@ -29,6 +29,7 @@
 //! first ring at all, that part is handed back ([`FilledLayer::gaps`]) to be filled with beads
 //! as wide as it is. So contour fills cover the region without laying any of it twice.
 
+mod boolean;
 mod offset;
 mod order;
 mod pattern;
@@ -43,6 +44,7 @@ use pattern::{drop_short_segments, rings, scan_fill, Reach, OPEN_SHARE};
 use region::{bounds, region_shapes, shape_region};
 
 pub use crate::geom2d::{Point2, Region};
+pub(crate) use boolean::{difference, grow, intersection, outside_grown, union};
 pub use offset::thinner_than;
 pub use order::{order_greedy, order_paths};
 pub use region::regions_from_loops;
