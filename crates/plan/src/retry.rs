@@ -1,0 +1,324 @@
+//! Placement found, not assumed (issue 31): when the plan of the part as modelled is refused
+//! for something another placement may avoid ([`placement_may_help`]: unsupported beads, the
+//! head meeting material or the table, even on the tallest pedestal, a tool axis the machine
+//! cannot take, the bed or work envelope, the arm's reach), [`find`] plans the other
+//! placements ([`Candidate`]) in turn and keeps the first whose plan passes every gate.
+//!
+//! **The rule.** The candidates, in the order tried ([`candidates`]):
+//!
+//! 1. when the part as modelled leaves the bed or the work envelope, the part turned about the
+//!    build direction (+Z) by the least turn that fits ([`robot_post::fit::turn_to_fit`] on
+//!    its tool path; a turn changes nothing else, so it comes first);
+//! 2. the part's other planar faces turned down, best first as `--orient auto` ranks them
+//!    ([`crate::place::ranked_faces`]), at most [`MAX_FACES`] of them.
+//!
+//! A candidate that leaves the bed or envelope in its turn is tried once more turned to fit,
+//! right after it. The first candidate that plans wins; the report's `placement` says which
+//! and lists what the ones before it failed on (`tried`, the part as modelled first). When
+//! none plans, the refusal of the part as modelled is returned, with every candidate's
+//! failure ([`PlanError::NoPlacement`]).
+//!
+//! Each candidate is a whole plan, written afresh into the caller's [`Outputs`] (a refused
+//! attempt's files are dropped with it), so only the chosen plan's files are left.
+
+use crate::place::{entry_turned, Placed};
+use crate::report::{PlacementEntry, TriedEntry};
+use crate::{Gate, Options, Plan, PlanError, Process, Progress};
+use brep::StepFile;
+use robot_post::machine::MachineProfile;
+use robot_post::ProgramSink;
+
+/// The most planar faces tried after the part as modelled, best first.
+pub const MAX_FACES: usize = 4;
+
+/// Where plans are written: afresh for each placement tried, so that only the chosen plan's
+/// files are left ([`crate::plan_file_to`]).
+pub trait Outputs {
+    /// A program sink and a `toolpath.csv` writer with nothing in them: whatever an earlier
+    /// call gave is dropped.
+    #[allow(clippy::type_complexity)]
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )>;
+}
+
+impl Outputs for crate::post::Discard {
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )> {
+        Ok((self, None))
+    }
+}
+
+impl Outputs for robot_post::InMemory {
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )> {
+        self.files.clear();
+        Ok((self, None))
+    }
+}
+
+/// One placement [`find`] tries. New kinds are appended here and in [`candidates`], and
+/// planned in [`Candidate::plan`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Candidate {
+    /// The part as modelled (−Z down), turned about +Z by `turn_deg` (0: as modelled).
+    Modelled {
+        /// Degrees, counter-clockwise seen from above.
+        turn_deg: f64,
+    },
+    /// The part on a planar face: its outward normal turned down, then turned about +Z by
+    /// `turn_deg`.
+    Face {
+        /// STEP `#id` of the largest planar face pointing that way.
+        id: u64,
+        /// The outward normal (file frame).
+        down: [f64; 3],
+        /// Its place in `--orient auto`'s order (1: its choice).
+        rank: usize,
+        /// Degrees, counter-clockwise seen from above.
+        turn_deg: f64,
+    },
+}
+
+impl Candidate {
+    /// The part as modelled.
+    pub const MODELLED: Candidate = Candidate::Modelled { turn_deg: 0.0 };
+
+    /// What stderr and `plan.json` call it.
+    pub fn label(&self) -> String {
+        let turn = |t: f64| {
+            if t == 0.0 {
+                String::new()
+            } else {
+                format!(" turned {t:.1} degrees about +Z")
+            }
+        };
+        match *self {
+            Candidate::Modelled { turn_deg } => format!("the part as modelled{}", turn(turn_deg)),
+            Candidate::Face {
+                id,
+                down,
+                rank,
+                turn_deg,
+            } => format!(
+                "face #{id} (outward normal {:.4} {:.4} {:.4} down, #{rank} by --orient auto){}",
+                // + 0.0: no "-0.0000".
+                down[0] + 0.0,
+                down[1] + 0.0,
+                down[2] + 0.0,
+                turn(turn_deg)
+            ),
+        }
+    }
+
+    /// The turn about +Z.
+    fn turn_deg(&self) -> f64 {
+        match *self {
+            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => turn_deg,
+        }
+    }
+
+    /// This candidate turned further by `deg` about +Z.
+    fn turned(&self, deg: f64) -> Candidate {
+        let mut c = self.clone();
+        match &mut c {
+            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => *turn_deg += deg,
+        }
+        c
+    }
+
+    /// The rotation standing the part so (rows first): plate = rotation × file.
+    pub fn rotation(&self) -> [[f64; 3]; 3] {
+        let base = match *self {
+            Candidate::Modelled { .. } => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            Candidate::Face { down, .. } => brep::turn_down(down),
+        };
+        let (s, c) = self.turn_deg().to_radians().sin_cos();
+        let z = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        [0, 1, 2].map(|r| [0, 1, 2].map(|k| (0..3).map(|j| z[r][j] * base[j][k]).sum()))
+    }
+
+    /// What `plan.json` records of it, with `rule`.
+    fn entry(&self, rule: String) -> PlacementEntry {
+        let (face, down) = match *self {
+            Candidate::Modelled { .. } => (None, [0.0, 0.0, -1.0]),
+            Candidate::Face { id, down, .. } => (Some(id), down),
+        };
+        let mut e = entry_turned(face, down, self.rotation(), rule);
+        e.turn_deg = crate::report::round(self.turn_deg(), 1e9);
+        e
+    }
+
+    /// Its whole plan, written into `sink` and `csv`.
+    pub fn plan(
+        &self,
+        file: &StepFile,
+        process: &Process,
+        machine: &MachineProfile,
+        options: &Options,
+        sink: &mut dyn ProgramSink,
+        csv: Option<&mut (dyn std::io::Write + Send)>,
+    ) -> Result<Plan, PlanError> {
+        let part = if *self == Candidate::MODELLED {
+            file.part()
+        } else {
+            file.rotated(self.rotation())
+        };
+        let placed = Placed {
+            part: part.map_err(crate::place::PlaceError::from)?,
+            assembly: None,
+            entry: None,
+        };
+        crate::plan_placed_into(placed, process, machine, options, sink, csv)
+    }
+}
+
+/// Whether another placement may avoid the failure `e`: unsupported beads, collisions, a
+/// refusal of the machine's post (the bed or envelope, B beyond the limits, a 3-axis printer's
+/// tool axis), points out of reach, the head meeting the table even on the tallest pedestal.
+/// Not the self-check, `strict`'s warnings, a part too big, without features, or a file or
+/// setting in error: no placement changes those.
+pub fn placement_may_help(e: &PlanError) -> bool {
+    use crate::pedestal::PedestalError;
+    match e {
+        PlanError::Refused { gate, .. } => matches!(
+            gate,
+            Gate::Unsupported(_) | Gate::Collisions(_) | Gate::Machine(_) | Gate::Unreachable(_)
+        ),
+        PlanError::Pedestal(p) => matches!(
+            p,
+            PedestalError::TooLow { .. } | PedestalError::NoneClears { .. }
+        ),
+        _ => false,
+    }
+}
+
+/// `c` turned about +Z by the least turn that fits the bed or work envelope, when `c` was
+/// refused by the machine and was not turned yet; `None` when no turn fits or none is needed.
+fn turned_to_fit(c: &Candidate, e: &PlanError, machine: &MachineProfile) -> Option<Candidate> {
+    let PlanError::Refused {
+        gate: Gate::Machine(_),
+        plan,
+    } = e
+    else {
+        return None;
+    };
+    if c.turn_deg() != 0.0 {
+        return None;
+    }
+    let fit = robot_post::fit::turn_to_fit(&plan.toolpath, machine).ok()?;
+    (fit.angle_deg != 0.0).then(|| c.turned(fit.angle_deg))
+}
+
+/// The placements to try after the part as modelled was refused with `failure`, in order
+/// (module docs). Append new kinds at the end.
+pub fn candidates(
+    file: &StepFile,
+    process: &Process,
+    machine: &MachineProfile,
+    failure: &PlanError,
+) -> Result<Vec<Candidate>, PlanError> {
+    let mut out: Vec<Candidate> = turned_to_fit(&Candidate::MODELLED, failure, machine)
+        .into_iter()
+        .collect();
+    let faces = crate::place::ranked_faces(file, process, machine.bead().width)?;
+    out.extend(
+        faces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| !f.as_modelled)
+            .take(MAX_FACES)
+            .map(|(k, f)| Candidate::Face {
+                id: f.id,
+                down: f.down,
+                rank: k + 1,
+                turn_deg: 0.0,
+            }),
+    );
+    Ok(out)
+}
+
+/// Plans the part as modelled and, when it is refused for something another placement may
+/// avoid, the other [`candidates`] in turn; the first that plans is returned, its report's
+/// `placement` saying which and what the ones before it failed on. Every attempt is written
+/// afresh into `out`.
+pub fn find(
+    file: &StepFile,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    out: &mut dyn Outputs,
+) -> Result<Plan, PlanError> {
+    let attempt = |c: &Candidate, out: &mut dyn Outputs| {
+        let (sink, csv) = out.fresh().map_err(PlanError::Csv)?;
+        c.plan(file, process, machine, options, sink, csv)
+    };
+    let mut first = match attempt(&Candidate::MODELLED, out) {
+        Err(e) if placement_may_help(&e) => e,
+        done => return done,
+    };
+    let mut queue = candidates(file, process, machine, &first)?;
+    let mut tried = vec![TriedEntry {
+        candidate: Candidate::MODELLED.label(),
+        failure: first.to_string(),
+    }];
+    let mut k = 0;
+    while k < queue.len() {
+        let c = queue[k].clone();
+        if let Some(f) = options.progress {
+            f(Progress::Trying {
+                index: k + 1,
+                of: queue.len(),
+                candidate: c.label(),
+                after: tried.last().map_or(String::new(), |t| t.failure.clone()),
+            });
+        }
+        match attempt(&c, out) {
+            Ok(mut plan) => {
+                let rule = format!(
+                    "found: the part as modelled was refused ({}); the first placement tried that plans",
+                    tried[0].failure
+                );
+                let mut entry = c.entry(rule);
+                entry.tried = tried;
+                plan.report.placement = Some(entry);
+                return Ok(plan);
+            }
+            Err(e) => {
+                if let Some(t) = turned_to_fit(&c, &e, machine) {
+                    queue.insert(k + 1, t);
+                }
+                tried.push(TriedEntry {
+                    candidate: c.label(),
+                    failure: e.to_string(),
+                });
+            }
+        }
+        k += 1;
+    }
+    if let PlanError::Refused { plan, .. } = &mut first {
+        let mut entry = Candidate::MODELLED.entry(format!(
+            "as modelled: none of the {} other placement(s) tried plans",
+            queue.len()
+        ));
+        entry.tried = tried.clone();
+        plan.report.placement = Some(entry);
+    }
+    // The part as modelled first in the report; the others are listed with the error.
+    tried.remove(0);
+    Err(PlanError::NoPlacement {
+        modelled: Box::new(first),
+        tried,
+    })
+}
