@@ -437,6 +437,11 @@ impl Bar {
                         eprintln!(
                             "features: {path}: as modelled: {after}; trying other placements"
                         );
+                    } else {
+                        eprintln!(
+                            "features: {path}: placement {} of {of} refused: {after}",
+                            index - 1
+                        );
                     }
                     eprintln!("features: {path}: trying placement {index} of {of}: {candidate}")
                 });

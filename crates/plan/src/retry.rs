@@ -322,3 +322,44 @@ pub fn find(
         tried,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Candidate;
+
+    fn apply(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|r| (0..3).map(|k| m[r][k] * v[k]).sum())
+    }
+
+    /// Rounding of the products of a few sines and cosines.
+    const CLOSE: f64 = 1e-6;
+
+    #[test]
+    fn a_candidates_rotation_turns_its_face_down_then_about_z() {
+        // As modelled turned a quarter turn: X goes to Y, Z stays.
+        let m = Candidate::Modelled { turn_deg: 90.0 }.rotation();
+        let x = apply(m, [1.0, 0.0, 0.0]);
+        assert!((x[1] - 1.0).abs() < CLOSE && x[0].abs() < CLOSE && x[2].abs() < CLOSE);
+        // A face whose normal is +X, turned down and then 30 degrees: the normal points down,
+        // and the matrix is a rotation.
+        let s = 0.5f64.sqrt();
+        for down in [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [s, 0.0, -s]] {
+            let c = Candidate::Face {
+                id: 1,
+                down,
+                rank: 1,
+                turn_deg: 30.0,
+            };
+            let m = c.rotation();
+            let d = apply(m, down);
+            assert!(d[0].abs() < CLOSE && d[1].abs() < CLOSE && (d[2] + 1.0).abs() < CLOSE);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let dot: f64 = (0..3).map(|k| m[k][a] * m[k][b]).sum();
+                    let want = if a == b { 1.0 } else { 0.0 };
+                    assert!((dot - want).abs() < CLOSE);
+                }
+            }
+        }
+    }
+}
