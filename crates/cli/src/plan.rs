@@ -131,10 +131,7 @@ impl Refusal<'_> {
                 for t in &tried {
                     say(&format!("placement {} refused: {}", t.candidate, t.failure));
                 }
-                say(&format!(
-                    "no placement plans: the part as modelled and the {} other(s) tried were refused; the refusal as modelled follows",
-                    tried.len()
-                ));
+                say("no placement plans: the part as modelled and every other placement tried (listed above) were refused; the refusal as modelled follows");
                 *modelled
             }
             e => e,

@@ -13,7 +13,7 @@
 //!    ([`crate::place::ranked_faces`]), at most [`MAX_FACES`] of them.
 //!
 //! A candidate that leaves the bed or envelope in its turn is tried once more turned to fit,
-//! right after it. The first candidate that plans wins; the report's `placement` says which
+//! right after it; when no turn fits, that is listed among the failures. The first candidate that plans wins; the report's `placement` says which
 //! and lists what the ones before it failed on (`tried`, the part as modelled first). When
 //! none plans, the refusal of the part as modelled is returned, with every candidate's
 //! failure ([`PlanError::NoPlacement`]).
@@ -204,9 +204,15 @@ pub fn placement_may_help(e: &PlanError) -> bool {
     }
 }
 
-/// `c` turned about +Z by the least turn that fits the bed or work envelope, when `c` was
-/// refused by the machine and was not turned yet; `None` when no turn fits or none is needed.
-fn turned_to_fit(c: &Candidate, e: &PlanError, machine: &MachineProfile) -> Option<Candidate> {
+/// What a turn about +Z does for `c`, refused with `e`: `None` when `e` is no refusal by the
+/// machine, `c` is turned already, or it fits unturned (the refusal is not the bed or
+/// envelope); else `c` turned by the least turn that fits the bed or work envelope
+/// ([`robot_post::fit::turn_to_fit`] on its tool path), or why none does.
+fn turned_to_fit(
+    c: &Candidate,
+    e: &PlanError,
+    machine: &MachineProfile,
+) -> Option<Result<Candidate, TriedEntry>> {
     let PlanError::Refused {
         gate: Gate::Machine(_),
         plan,
@@ -217,36 +223,37 @@ fn turned_to_fit(c: &Candidate, e: &PlanError, machine: &MachineProfile) -> Opti
     if c.turn_deg() != 0.0 {
         return None;
     }
-    let fit = robot_post::fit::turn_to_fit(&plan.toolpath, machine).ok()?;
-    (fit.angle_deg != 0.0).then(|| c.turned(fit.angle_deg))
+    match robot_post::fit::turn_to_fit(&plan.toolpath, machine) {
+        Ok(fit) => (fit.angle_deg != 0.0).then(|| Ok(c.turned(fit.angle_deg))),
+        Err(e @ robot_post::fit::FitError::NoTurn { .. }) => Some(Err(TriedEntry {
+            candidate: format!("{} turned about +Z", c.label()),
+            failure: e.to_string(),
+        })),
+        Err(_) => None,
+    }
 }
 
-/// The placements to try after the part as modelled was refused with `failure`, in order
-/// (module docs). Append new kinds at the end.
+/// The placements to try after the part as modelled was refused, in order (module docs):
+/// the other planar faces, best first, at most [`MAX_FACES`]. A turn to fit is tried after
+/// any candidate that leaves the bed or envelope ([`find`]). Append new kinds at the end.
 pub fn candidates(
     file: &StepFile,
     process: &Process,
     machine: &MachineProfile,
-    failure: &PlanError,
 ) -> Result<Vec<Candidate>, PlanError> {
-    let mut out: Vec<Candidate> = turned_to_fit(&Candidate::MODELLED, failure, machine)
-        .into_iter()
-        .collect();
     let faces = crate::place::ranked_faces(file, process, machine.bead().width)?;
-    out.extend(
-        faces
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| !f.as_modelled)
-            .take(MAX_FACES)
-            .map(|(k, f)| Candidate::Face {
-                id: f.id,
-                down: f.down,
-                rank: k + 1,
-                turn_deg: 0.0,
-            }),
-    );
-    Ok(out)
+    Ok(faces
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| !f.as_modelled)
+        .take(MAX_FACES)
+        .map(|(k, f)| Candidate::Face {
+            id: f.id,
+            down: f.down,
+            rank: k + 1,
+            turn_deg: 0.0,
+        })
+        .collect())
 }
 
 /// Plans the part as modelled and, when it is refused for something another placement may
@@ -268,11 +275,19 @@ pub fn find(
         Err(e) if placement_may_help(&e) => e,
         done => return done,
     };
-    let mut queue = candidates(file, process, machine, &first)?;
     let mut tried = vec![TriedEntry {
         candidate: Candidate::MODELLED.label(),
         failure: first.to_string(),
     }];
+    let mut queue = vec![];
+    match turned_to_fit(&Candidate::MODELLED, &first, machine) {
+        Some(Ok(t)) => queue.push(t),
+        Some(Err(none)) => tried.push(none),
+        None => {}
+    }
+    queue.extend(candidates(file, process, machine)?);
+    // The previous attempt's failure.
+    let mut last = first.to_string();
     let mut k = 0;
     while k < queue.len() {
         let c = queue[k].clone();
@@ -281,7 +296,7 @@ pub fn find(
                 index: k + 1,
                 of: queue.len(),
                 candidate: c.label(),
-                after: tried.last().map_or(String::new(), |t| t.failure.clone()),
+                after: last.clone(),
             });
         }
         match attempt(&c, out) {
@@ -296,13 +311,17 @@ pub fn find(
                 return Ok(plan);
             }
             Err(e) => {
-                if let Some(t) = turned_to_fit(&c, &e, machine) {
-                    queue.insert(k + 1, t);
-                }
+                let turn = turned_to_fit(&c, &e, machine);
+                last = e.to_string();
                 tried.push(TriedEntry {
                     candidate: c.label(),
                     failure: e.to_string(),
                 });
+                match turn {
+                    Some(Ok(t)) => queue.insert(k + 1, t),
+                    Some(Err(none)) => tried.push(none),
+                    None => {}
+                }
             }
         }
         k += 1;
