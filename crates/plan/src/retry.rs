@@ -205,13 +205,14 @@ pub fn placement_may_help(e: &PlanError) -> bool {
 }
 
 /// What a turn about +Z does for `c`, refused with `e`: `None` when `e` is no refusal by the
-/// machine, `c` is turned already, or it fits unturned (the refusal is not the bed or
-/// envelope); else `c` turned by the least turn that fits the bed or work envelope
+/// machine, `c` is turned already, its plan has unsupported layers or collisions (which a
+/// turn keeps), or it fits unturned (the refusal is not the bed or envelope); else `c` turned by the least turn that fits the bed or work envelope
 /// ([`robot_post::fit::turn_to_fit`] on its tool path), or why none does.
 fn turned_to_fit(
     c: &Candidate,
     e: &PlanError,
     machine: &MachineProfile,
+    options: &Options,
 ) -> Option<Result<Candidate, TriedEntry>> {
     let PlanError::Refused {
         gate: Gate::Machine(_),
@@ -220,7 +221,14 @@ fn turned_to_fit(
     else {
         return None;
     };
-    if c.turn_deg() != 0.0 {
+    // A turn changes nothing but where the part lies on the machine: it cannot help a plan
+    // whose layers are unsupported or whose head collides (the machine's refusal, reported
+    // first, hides those).
+    let held = plan.features().iter().all(|f| {
+        (options.keep_going || f.unsupported_area_mm2 == 0.0)
+            && (options.allow_collisions || f.collision.collisions == 0)
+    });
+    if c.turn_deg() != 0.0 || !held {
         return None;
     }
     match robot_post::fit::turn_to_fit(&plan.toolpath, machine) {
@@ -280,7 +288,7 @@ pub fn find(
         failure: first.to_string(),
     }];
     let mut queue = vec![];
-    match turned_to_fit(&Candidate::MODELLED, &first, machine) {
+    match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
         Some(Ok(t)) => queue.push(t),
         Some(Err(none)) => tried.push(none),
         None => {}
@@ -311,7 +319,7 @@ pub fn find(
                 return Ok(plan);
             }
             Err(e) => {
-                let turn = turned_to_fit(&c, &e, machine);
+                let turn = turned_to_fit(&c, &e, machine, options);
                 last = e.to_string();
                 tried.push(TriedEntry {
                     candidate: c.label(),
