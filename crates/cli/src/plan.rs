@@ -257,6 +257,10 @@ fn tell_placement(plan: &Plan, path: &Path, bar: &Bar) {
         .as_ref()
         .filter(|p| !p.tried.is_empty())
     {
+        if !plan.report.complete {
+            // A refusal as modelled, every other placement refused too: listed already.
+            return;
+        }
         let on = match p.base_face {
             Some(id) => format!(
                 "on face #{id} (outward normal {:.4} {:.4} {:.4} turned down)",

@@ -170,10 +170,9 @@ impl Candidate {
         sink: &mut dyn ProgramSink,
         csv: Option<&mut (dyn std::io::Write + Send)>,
     ) -> Result<Plan, PlanError> {
-        let part = if *self == Candidate::MODELLED {
-            file.part()
-        } else {
-            file.rotated(self.rotation())
+        let part = match *self {
+            Candidate::Modelled { turn_deg: 0.0 } => file.part(),
+            Candidate::Modelled { .. } | Candidate::Face { .. } => file.rotated(self.rotation()),
         };
         let placed = Placed {
             part: part.map_err(crate::place::PlaceError::from)?,
