@@ -121,6 +121,19 @@ fn a_part_modelled_upside_down_plans_on_its_plate_face() {
                 && l.contains("after the part as modelled failed")),
         "{err}"
     );
+    // Turned back onto its plate, it is the part as modelled in the fixture: the same moves.
+    let orig = s.path("orig");
+    let o = plan_at(&fixture("plate_boss_boss.step"), "marlin", &orig, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let moves = |dir: &Path| -> Vec<String> {
+        std::fs::read_to_string(dir.join("program.gcode"))
+            .expect("program")
+            .lines()
+            .filter(|l| !l.starts_with(';'))
+            .map(str::to_string)
+            .collect()
+    };
+    assert!(moves(&out) == moves(&orig), "the programs' moves differ");
     // --orient modelled keeps it as modelled: refused, naming the remedy.
     let o = plan_at(&part, "marlin", &s.path("kept"), &["--orient", "modelled"]);
     let err = stderr(&o);
