@@ -295,12 +295,18 @@ fn plate_boss_boss_plan_summary() {
 
 #[test]
 fn tilted_axes_on_a_3_axis_printer_and_unknown_machines_are_refused_with_one_line() {
+    // As modelled (`--orient modelled`): without it the other placements are tried and
+    // listed too (tests/placement.rs).
     for (name, extra, needle) in [
-        ("impeller", vec![], "feature 1 has tool axis"),
+        (
+            "impeller",
+            vec!["--orient", "modelled"],
+            "feature 1 has tool axis",
+        ),
         ("box", vec!["--machine", "prusa"], "unknown machine `prusa`"),
         (
             "capsule",
-            vec!["--machine", "delta5"],
+            vec!["--machine", "delta5", "--orient", "modelled"],
             "outside the B limits",
         ),
     ] {

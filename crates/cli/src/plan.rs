@@ -3,7 +3,7 @@
 
 use crate::mesh::write_atomic;
 use crate::outputs::Outputs;
-use crate::staged::Staged;
+use crate::staged::{Fresh, Staged};
 use crate::{emit, Failure, PlanArgs};
 use plan::{Gate, Options, Placement, Plan, PlanError, Progress, Stage};
 use std::io::Write as _;
@@ -39,20 +39,11 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         progress: Some(&progress),
     };
     // The program goes to its files as the post makes it, under temporary names until every
-    // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise.
-    let mut staged = Staged::new(&outputs);
-    let mut csv = staged
-        .open("toolpath.csv")
-        .map_err(|e| Failure::new(&outputs.dir, format!("cannot write toolpath.csv: {e}")))?;
-    let result = plan::plan_file_into(
-        &file,
-        &process,
-        &machine,
-        &options,
-        &mut staged,
-        Some(&mut csv),
-    );
-    drop(csv);
+    // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise. Each
+    // placement tried starts afresh.
+    let mut fresh = Fresh::new(&outputs);
+    let result = plan::plan_file_to(&file, &process, &machine, &options, &mut fresh);
+    let staged = fresh.last();
     bar.0.inc(1);
     bar.0.set_prefix("writing");
     bar.0.set_message("outputs");
@@ -63,7 +54,8 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         earlier: &earlier,
         bar: &bar,
     };
-    let plan = result.map_err(|e| refusal.fail(e, path, process_file))?;
+    let plan = result.map_err(|e| refusal.fail(e, path, process_file, options.placement))?;
+    let staged = staged.ok_or_else(|| Failure::new(&outputs.dir, "no program was staged"))?;
     tell_placement(&plan, path, &bar);
     let warnings = print_warnings(&plan, path, &bar);
     let summary = write_plan(plan, &outputs, staged, &earlier, args, warnings)?;
@@ -83,12 +75,24 @@ fn sources(args: &PlanArgs) -> plan::settings::Sources {
     }
 }
 
-/// How the part is to stand, by `--base-face` and `--orient`.
+/// How the part is to stand, by `--base-face` and `--orient`; without either, as modelled or
+/// the first other placement that plans ([`Placement::Find`]).
 fn placement(args: &PlanArgs) -> Placement {
     match (args.base_face, args.orient.as_deref()) {
         (Some(id), _) => Placement::BaseFace(id),
         (None, Some("auto")) => Placement::Auto,
-        _ => Placement::AsModelled,
+        (None, Some(_)) => Placement::AsModelled,
+        (None, None) => Placement::Find,
+    }
+}
+
+/// The remedy of a refusal another placement may avoid, for a placement the user chose.
+fn placement_remedy(placement: Placement) -> &'static str {
+    match placement {
+        Placement::BaseFace(_) => "; another placement may plan: try --orient auto, or leave out --base-face to try the part as modelled, turned about +Z and the best planar faces",
+        Placement::Auto => "; another placement may plan: leave out --orient to try the part as modelled, turned about +Z and the best planar faces",
+        Placement::AsModelled => "; another placement may plan: leave out --orient modelled to try the part turned about +Z and on the best planar faces",
+        Placement::Find => "",
     }
 }
 
@@ -104,16 +108,38 @@ impl Refusal<'_> {
     /// The line of a plan not made, or refused: a refusal's lines first (one per feature, or
     /// the warnings `--strict` refuses), and its `plan.json` and `preview.html` written to show
     /// why (no program).
-    fn fail(&self, e: PlanError, path: &Path, process_file: &Path) -> Failure {
+    fn fail(
+        &self,
+        e: PlanError,
+        path: &Path,
+        process_file: &Path,
+        placement: Placement,
+    ) -> Failure {
         let bar = self.bar;
         let say = |line: &str| {
             bar.0
                 .suspend(|| eprintln!("features: {}: {line}", path.display()))
         };
+        let remedy = if plan::retry::placement_may_help(&e) {
+            placement_remedy(placement)
+        } else {
+            ""
+        };
+        // Every other placement refused too: each with its failure, then the part as modelled.
+        let e = match e {
+            PlanError::NoPlacement { modelled, tried } => {
+                for t in &tried {
+                    say(&format!("placement {} refused: {}", t.candidate, t.failure));
+                }
+                say("no placement plans: the part as modelled and every other placement tried (listed above) were refused; the refusal as modelled follows");
+                *modelled
+            }
+            e => e,
+        };
         let (gate, plan) = match e {
             PlanError::Process(e) => return Failure::new(process_file, e),
             PlanError::Refused { gate, plan } => (gate, plan),
-            e => return Failure::new(path, e),
+            e => return Failure::new(path, format!("{e}{remedy}")),
         };
         let (cause, allow) = match &gate {
             Gate::SelfCheck(problems) => {
@@ -162,7 +188,7 @@ impl Refusal<'_> {
             Ok(names) => format!("no program written; {} show why", names.join(" and ")),
             Err(f) => format!("nothing written ({}: {})", f.path, f.cause),
         };
-        Failure::new(path, format!("{cause}: {written}{allow}"))
+        Failure::new(path, format!("{cause}: {written}{allow}{remedy}"))
     }
 }
 
@@ -225,13 +251,48 @@ fn tell_placement(plan: &Plan, path: &Path, bar: &Bar) {
             )
         });
     }
+    if let Some(p) = plan
+        .report
+        .placement
+        .as_ref()
+        .filter(|p| !p.tried.is_empty())
+    {
+        if !plan.report.complete {
+            // A refusal as modelled, every other placement refused too: listed already.
+            return;
+        }
+        let on = match p.base_face {
+            Some(id) => format!(
+                "on face #{id} (outward normal {:.4} {:.4} {:.4} turned down)",
+                p.down[0], p.down[1], p.down[2]
+            ),
+            None => "as modelled".to_string(),
+        };
+        let turn = if p.turn_deg == 0.0 {
+            String::new()
+        } else {
+            format!(" turned {:.1} degrees about +Z", p.turn_deg)
+        };
+        let first = p.tried.first().map_or("", |t| t.failure.as_str());
+        bar.0.suspend(|| {
+            eprintln!(
+                "features: {}: placed {on}{turn} after the part as modelled failed: {first} ({} placement(s) tried before it)",
+                path.display(),
+                p.tried.len()
+            )
+        });
+        return;
+    }
     if let Some(p) = &plan.report.placement {
         let d = p.down;
+        let Some(face) = p.base_face else {
+            return;
+        };
         bar.0.suspend(|| {
             eprintln!(
                 "features: {}: standing on face #{} (outward normal {:.4} {:.4} {:.4} turned down; {})",
                 path.display(),
-                p.base_face,
+                face,
                 d[0],
                 d[1],
                 d[2],
@@ -364,13 +425,14 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
 /// The run's progress bar over reading the part, each feature, the stages after them
 /// ([`Stage::AFTER_FEATURES`]) and writing the outputs, with the time elapsed (hidden when
 /// stderr is not a terminal); cleared when dropped (the run ended, or failed).
-struct Bar(indicatif::ProgressBar);
+struct Bar(indicatif::ProgressBar, String);
 
 impl Bar {
     fn new(path: &Path) -> Bar {
-        let bar = Bar(crate::progress_bar(
-            "{prefix} {bar:30} {pos}/{len} {msg} [{elapsed}]",
-        ));
+        let bar = Bar(
+            crate::progress_bar("{prefix} {bar:30} {pos}/{len} {msg} [{elapsed}]"),
+            path.display().to_string(),
+        );
         bar.0.set_length(1);
         bar.0.set_prefix("reading");
         bar.0.set_message(path.file_name().map_or_else(
@@ -383,6 +445,28 @@ impl Bar {
     /// Shows where the plan is.
     fn progress(&self, p: Progress) {
         match p {
+            Progress::Trying {
+                index,
+                of,
+                candidate,
+                after,
+            } => {
+                let path = &self.1;
+                self.0.suspend(|| {
+                    if index == 1 {
+                        eprintln!(
+                            "features: {path}: as modelled: {after}; trying other placements"
+                        );
+                    } else {
+                        eprintln!(
+                            "features: {path}: placement {} of {of} refused: {after}",
+                            index - 1
+                        );
+                    }
+                    eprintln!("features: {path}: trying placement {index} of {of}: {candidate}")
+                });
+                self.0.set_position(0);
+            }
             Progress::Start { features } => self
                 .0
                 .set_length(1 + features + Stage::AFTER_FEATURES.len() as u64 + 1),

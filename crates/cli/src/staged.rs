@@ -90,3 +90,44 @@ impl Drop for Staged<'_> {
         }
     }
 }
+
+/// The plan's program and `toolpath.csv`, staged afresh for each placement the plan tries
+/// ([`plan::Outputs`]): a refused attempt's files are dropped (removed) when the next begins,
+/// so only the chosen plan's are left to commit.
+pub(crate) struct Fresh<'a> {
+    outputs: &'a Outputs,
+    staged: Option<Staged<'a>>,
+    csv: Option<std::io::BufWriter<File>>,
+}
+
+impl<'a> Fresh<'a> {
+    /// Nothing staged yet into `outputs`' folder.
+    pub(crate) fn new(outputs: &'a Outputs) -> Fresh<'a> {
+        Fresh {
+            outputs,
+            staged: None,
+            csv: None,
+        }
+    }
+
+    /// The last attempt's staged files, `toolpath.csv` closed; `None` when none began.
+    pub(crate) fn last(mut self) -> Option<Staged<'a>> {
+        self.csv = None;
+        self.staged.take()
+    }
+}
+
+impl plan::Outputs for Fresh<'_> {
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(&mut dyn ProgramSink, Option<&mut (dyn Write + Send)>)> {
+        // The earlier attempt's writer first (its file), then its files.
+        self.csv = None;
+        self.staged = None;
+        let mut staged = Staged::new(self.outputs);
+        let csv = staged.open("toolpath.csv")?;
+        let staged = self.staged.insert(staged);
+        let csv = self.csv.insert(csv);
+        Ok((staged, Some(csv)))
+    }
+}

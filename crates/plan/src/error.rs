@@ -38,6 +38,15 @@ pub enum PlanError {
         /// The bead they need at the least, km.
         bead_km: f64,
     },
+    /// The part as modelled was refused (`modelled`, the refusal reported) and so was every
+    /// other placement tried ([`crate::retry`]): each with what it failed on.
+    #[error("{modelled}")]
+    NoPlacement {
+        /// The refusal of the part as modelled.
+        modelled: Box<PlanError>,
+        /// The other placements tried and their failures, in the order tried.
+        tried: Vec<crate::report::TriedEntry>,
+    },
     /// The plan was made, and a gate refuses it: the plan is here to show why (its report
     /// says `"complete": false`), but no program was written.
     #[error("{gate}")]

@@ -31,6 +31,7 @@ pub mod process;
 pub mod reach;
 pub mod report;
 pub mod resolution;
+pub mod retry;
 pub mod settings;
 pub mod smooth;
 pub mod stage;
@@ -42,6 +43,7 @@ pub use error::{Gate, PlanError};
 pub use place::Placement;
 pub use process::{Process, ProcessError};
 pub use report::{FeatureEntry, FeatureReport, PlanReport, SettingsEntry};
+pub use retry::{Candidate, Outputs};
 pub use stage::Stage;
 pub use warning::{Warning, WarningKind};
 
@@ -58,8 +60,20 @@ use slicer::toolpath::ToolPath;
 pub const MAX_BEAD_KM: f64 = 1000.0;
 
 /// Where a plan is: reported to [`Options::progress`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Progress {
+    /// The part as modelled was refused, and another placement is tried ([`retry`]): a whole
+    /// plan of its own, whose stages are reported next.
+    Trying {
+        /// Its place among the placements tried after the part as modelled (1 first).
+        index: usize,
+        /// How many are queued so far (a turn to fit may be added after a candidate).
+        of: usize,
+        /// The placement ([`Candidate::label`]).
+        candidate: String,
+        /// Why the previous one was refused.
+        after: String,
+    },
     /// Features recognised: this many will be planned.
     Start {
         /// Features in the part.
@@ -172,6 +186,36 @@ pub fn plan_file_into(
     csv: Option<&mut (dyn std::io::Write + Send)>,
 ) -> Result<Plan, PlanError> {
     let placed = place::place(file, options.placement, process, machine.bead().width)?;
+    plan_placed_into(placed, process, machine, options, sink, csv)
+}
+
+/// [`plan_file_into`] writing into `out`: with [`Placement::Find`], the part as modelled and,
+/// when that plan is refused for something another placement may avoid, the other placements
+/// in turn ([`retry::find`]), each written afresh into `out` so that only the chosen plan's
+/// files are left in it; otherwise the one placement asked for.
+pub fn plan_file_to(
+    file: &brep::StepFile,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    out: &mut dyn Outputs,
+) -> Result<Plan, PlanError> {
+    if options.placement == Placement::Find {
+        return retry::find(file, process, machine, options, out);
+    }
+    let (sink, csv) = out.fresh().map_err(PlanError::Csv)?;
+    plan_file_into(file, process, machine, options, sink, csv)
+}
+
+/// [`plan_into`] for a part already stood on the plate.
+pub fn plan_placed_into(
+    placed: place::Placed,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    sink: &mut dyn ProgramSink,
+    csv: Option<&mut (dyn std::io::Write + Send)>,
+) -> Result<Plan, PlanError> {
     process.validate_for_nozzle(machine.nozzle_diameter)?;
     let extracted = match placed.assembly {
         Some(assembly) => extract::arrange(assembly, &placed.part.brep, process, machine)?,

@@ -47,7 +47,7 @@ const NAMED_TRIES: usize = 4;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PedestalError {
     /// Even the machine's tallest pedestal leaves moves hitting the table.
-    #[error("the head meets the table on {moves} move(s) even on a pedestal of the machine's max_pedestal_height {max} mm; a pedestal of {needed} mm clears it (raise machine.max_pedestal_height to it)")]
+    #[error("the head meets the table on {moves} move(s) even on a pedestal of the machine's max_pedestal_height {max} mm; a pedestal of {needed} mm clears it (raise machine.max_pedestal_height to it: --set machine.max_pedestal_height={needed})")]
     TooLow {
         /// The machine's `max_pedestal_height`, mm.
         max: f64,

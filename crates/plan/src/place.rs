@@ -36,6 +36,10 @@ pub enum Placement {
     BaseFace(u64),
     /// On the planar face the rule of `--orient auto` picks.
     Auto,
+    /// As modelled, and when that plan is refused for something another placement may avoid,
+    /// the first other placement that plans ([`crate::retry`], through
+    /// [`crate::plan_file_to`]; [`place`] stands the part as modelled).
+    Find,
 }
 
 /// Why the part could not be stood as asked. Each message is one line.
@@ -84,7 +88,7 @@ pub fn place(
 ) -> Result<Placed, PlaceError> {
     let part = file.part()?;
     match how {
-        Placement::AsModelled => Ok(Placed {
+        Placement::AsModelled | Placement::Find => Ok(Placed {
             part,
             assembly: None,
             entry: None,
@@ -125,24 +129,14 @@ fn auto(
     if candidates.is_empty() {
         return Err(PlaceError::NoPlanarFace);
     }
-    // (some area unsupported, features needing an axis below the horizon, −area, index) for
-    // each candidate, with its unsupported area, the part turned onto it and its features.
+    // The best candidate by its rank key, with its unsupported area, the part turned onto it
+    // and its features.
     let mut best: Option<(RankKey, f64, &Candidate, StepPart, Assembly)> = None;
     for (k, c) in candidates.iter().enumerate() {
-        let turned = file.turned([c.down.x, c.down.y, c.down.z])?;
-        let Ok(assembly) = extract_all(&turned.brep, &ExtractOptions::default()) else {
+        let Some((key, unsupported, turned, assembly)) = measure(file, c, k, process, bead_width)?
+        else {
             continue;
         };
-        let below = assembly
-            .trees
-            .iter()
-            .flat_map(|t| t.features.iter())
-            .filter(|f| f.reference.normal.is_some_and(|n| n[2] < BELOW_HORIZON_Z))
-            .count();
-        // A candidate whose support cannot be measured ranks after every one that can.
-        let unsupported =
-            crate::support::planar_area(&assembly, process, bead_width).unwrap_or(f64::INFINITY);
-        let key = (unsupported > 0.0, below, -c.area, k);
         if best
             .as_ref()
             .is_none_or(|(b, ..)| key.partial_cmp(b) == Some(std::cmp::Ordering::Less))
@@ -166,6 +160,71 @@ fn auto(
     })
 }
 
+/// `c`, the `k`-th candidate, measured: its rank key, its planar area unsupported (infinite
+/// when it cannot be measured), the part turned onto it and its features; `None` when its
+/// features cannot be extracted.
+fn measure(
+    file: &StepFile,
+    c: &Candidate,
+    k: usize,
+    process: &crate::Process,
+    bead_width: f64,
+) -> Result<Option<(RankKey, f64, StepPart, Assembly)>, PlaceError> {
+    let turned = file.turned([c.down.x, c.down.y, c.down.z])?;
+    let Ok(assembly) = extract_all(&turned.brep, &ExtractOptions::default()) else {
+        return Ok(None);
+    };
+    let below = assembly
+        .trees
+        .iter()
+        .flat_map(|t| t.features.iter())
+        .filter(|f| f.reference.normal.is_some_and(|n| n[2] < BELOW_HORIZON_Z))
+        .count();
+    // A candidate whose support cannot be measured ranks after every one that can.
+    let unsupported =
+        crate::support::planar_area(&assembly, process, bead_width).unwrap_or(f64::INFINITY);
+    let key = (unsupported > 0.0, below, -c.area, k);
+    Ok(Some((key, unsupported, turned, assembly)))
+}
+
+/// A planar face the part may stand on, as `--orient auto` ranks them ([`ranked_faces`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RankedFace {
+    /// STEP `#id` of the largest planar face pointing this way.
+    pub id: u64,
+    /// Their outward normal in the file's frame, turned to −Z to stand on them.
+    pub down: [f64; 3],
+    /// Whether the part already stands this way as modelled (its −Z).
+    pub as_modelled: bool,
+}
+
+/// The directions the part's planar faces point outward, best first by the rule of
+/// `--orient auto` (module docs), each with its largest face; those whose features cannot be
+/// extracted are left out.
+pub fn ranked_faces(
+    file: &StepFile,
+    process: &crate::Process,
+    bead_width: f64,
+) -> Result<Vec<RankedFace>, PlaceError> {
+    let part = file.part()?;
+    let candidates = candidates(&part.brep);
+    let mut keyed = vec![];
+    for (k, c) in candidates.iter().enumerate() {
+        if let Some((key, ..)) = measure(file, c, k, process, bead_width)? {
+            keyed.push((key, c));
+        }
+    }
+    keyed.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+    Ok(keyed
+        .into_iter()
+        .map(|(_, c)| RankedFace {
+            id: c.face_id,
+            down: [c.down.x, c.down.y, c.down.z],
+            as_modelled: stands(c.down),
+        })
+        .collect())
+}
+
 /// A candidate's rank, least first: some planar area unsupported, features needing an axis
 /// below the horizon, −planar area down, its index.
 type RankKey = (bool, usize, f64, usize);
@@ -177,13 +236,26 @@ fn stands(down: V3) -> bool {
 
 /// What plan.json records of standing the part on face `face`, whose outward normal `down` is
 /// turned to −Z.
-fn entry(face: u64, down: [f64; 3], rule: String) -> PlacementEntry {
+pub fn entry(face: u64, down: [f64; 3], rule: String) -> PlacementEntry {
+    entry_turned(Some(face), down, brep::turn_down(down), rule)
+}
+
+/// What plan.json records of standing the part by `rotation` (plate = rotation × file): on
+/// face `face` (`None`: as modelled), whose outward normal `down` points down once turned.
+pub fn entry_turned(
+    face: Option<u64>,
+    down: [f64; 3],
+    rotation: [[f64; 3]; 3],
+    rule: String,
+) -> PlacementEntry {
     let r = |x: f64| crate::report::round(x, 1e9);
     PlacementEntry {
         base_face: face,
         down: down.map(r),
-        rotation: brep::turn_down(down).map(|row| row.map(r)),
+        rotation: rotation.map(|row| row.map(r)),
         rule,
+        turn_deg: 0.0,
+        tried: vec![],
     }
 }
 

@@ -258,14 +258,38 @@ impl SettingsEntry {
 /// How the part was turned to stand on the build plate (`--base-face`, `--orient auto`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlacementEntry {
-    /// STEP `#id` of the planar face put on the plate.
-    pub base_face: u64,
+    /// STEP `#id` of the planar face put on the plate; `null`: the part stands as modelled
+    /// (turned about +Z only).
+    pub base_face: Option<u64>,
     /// Its outward normal in the file's frame: the direction turned to −Z.
     pub down: [f64; 3],
     /// The rotation applied about the file's origin (rows first): plate = rotation × file.
     pub rotation: [[f64; 3]; 3],
-    /// Why this face: `base-face` (chosen), or the `auto` rule and its figures.
+    /// Why this face: `base-face` (chosen), the `auto` rule and its figures, or the placement
+    /// found after the part as modelled was refused ([`crate::retry`]).
     pub rule: String,
+    /// The turn about +Z (degrees, counter-clockwise seen from above) after the face was
+    /// turned down, to fit the bed or work envelope; 0 when none.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub turn_deg: f64,
+    /// The placements tried before this one and what each failed on ([`crate::retry`]), the
+    /// part as modelled first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tried: Vec<TriedEntry>,
+}
+
+/// A placement tried and what refused it (`placement.tried` in `plan.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TriedEntry {
+    /// The placement, e.g. `the part as modelled`, `face #342 (outward normal 0 0 1 down)`.
+    pub candidate: String,
+    /// The refusal's line.
+    pub failure: String,
+}
+
+/// Whether `x` is 0 (a field left out of `plan.json`).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// One reason a plan was refused, where it is (`failures` in `plan.json`, on a refused plan).

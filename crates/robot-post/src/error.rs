@@ -66,7 +66,7 @@ pub enum PostError {
     },
     /// A tool axis the `delta5` bed cannot turn to machine +Z (beyond its B limits, or not a
     /// direction).
-    #[error("feature {feature}: tool axis ({i:.6}, {j:.6}, {k:.6}) {reason} of `{name}`")]
+    #[error("feature {feature}: tool axis ({i:.6}, {j:.6}, {k:.6}) {reason} of `{name}`{remedy}")]
     Delta5Axis {
         /// The feature's id.
         feature: usize,
@@ -80,6 +80,9 @@ pub enum PostError {
         name: String,
         /// Why, e.g. `needs B 120.000 or -120.000 degrees, outside the B limits [-90, 90]`.
         reason: String,
+        /// What would take it, after the profile's name (`: a machine with B up to 120
+        /// degrees ...`), or nothing.
+        remedy: String,
     },
     /// A path of a feature turns C further than the `delta5` profile's C limits allow.
     #[error("feature {feature}: C turns through {span:.3} degrees on one path, which does not fit the C limits [{c_min}, {c_max}] of `{name}` (c_continuous = true allows it)")]

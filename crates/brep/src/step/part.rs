@@ -71,6 +71,16 @@ impl StepFile {
             schemas: self.file.schemas(),
         })
     }
+
+    /// The part with every solid turned by `rotation` (a rotation matrix, rows first: plate =
+    /// rotation × file) about the file's origin: [`StepFile::turned`] for any rotation, e.g.
+    /// a face turned down and then a turn about +Z.
+    pub fn rotated(&self, rotation: [[f64; 3]; 3]) -> Result<StepPart, ReadError> {
+        Ok(StepPart {
+            brep: super::read::translate_turned(&self.file, Some(rotation))?,
+            schemas: self.file.schemas(),
+        })
+    }
 }
 
 /// The least rotation (a matrix, rows first) taking the unit vector `n` onto −Z (Rodrigues).

@@ -189,7 +189,7 @@ pub(super) fn plan_poses(
     Ok(poses)
 }
 
-fn axis_error(q: &PathPoint, name: &str, reason: String) -> PostError {
+fn axis_error(q: &PathPoint, name: &str, reason: String, remedy: String) -> PostError {
     PostError::Delta5Axis {
         feature: q.feature,
         i: q.axis[0],
@@ -197,7 +197,18 @@ fn axis_error(q: &PathPoint, name: &str, reason: String) -> PostError {
         k: q.axis[2],
         name: name.to_string(),
         reason,
+        remedy,
     }
+}
+
+/// B limits are named rounded up to a multiple of this (degrees) in a refusal's remedy.
+const B_REMEDY_STEP_DEG: f64 = 5.0;
+
+/// The remedy of a tool axis needing B `need` degrees: a machine whose B limits reach it
+/// (rounded up to [`B_REMEDY_STEP_DEG`], at most 180).
+fn b_remedy(need: f64) -> String {
+    let up = ((need.abs() / B_REMEDY_STEP_DEG).ceil() * B_REMEDY_STEP_DEG).min(180.0);
+    format!(": a machine with B up to {up} degrees (delta5.b_limits_deg) would take it")
 }
 
 fn plan_run(
@@ -210,8 +221,14 @@ fn plan_run(
     let n = run.len();
     let mut axes = Vec::with_capacity(n);
     for q in run {
-        let a = unit(q.axis)
-            .ok_or_else(|| axis_error(q, name, "is not a direction (zero length)".into()))?;
+        let a = unit(q.axis).ok_or_else(|| {
+            axis_error(
+                q,
+                name,
+                "is not a direction (zero length)".into(),
+                String::new(),
+            )
+        })?;
         axes.push(a);
     }
     // Length along the path, for the patch's interpolation.
@@ -234,8 +251,9 @@ fn plan_run(
                     fixed(need, 3),
                     fixed(-need, 3),
                     g.b_limits_deg[0],
-                    g.b_limits_deg[1]
+                    g.b_limits_deg[1],
                 ),
+                b_remedy(need),
             )
         })?;
         (b[i], c[i]) = (bi, ci);
@@ -281,8 +299,9 @@ fn plan_run(
                     "needs B {} degrees, outside the B limits [{}, {}]",
                     fixed(b[i], 3),
                     g.b_limits_deg[0],
-                    g.b_limits_deg[1]
+                    g.b_limits_deg[1],
                 ),
+                b_remedy(b[i]),
             ));
         }
     }

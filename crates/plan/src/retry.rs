@@ -1,0 +1,391 @@
+//! Placement found, not assumed (issue 31): when the plan of the part as modelled is refused
+//! for something another placement may avoid ([`placement_may_help`]: unsupported beads, the
+//! head meeting material or the table, even on the tallest pedestal, a tool axis the machine
+//! cannot take, the bed or work envelope, the arm's reach), [`find`] plans the other
+//! placements ([`Candidate`]) in turn and keeps the first whose plan passes every gate.
+//!
+//! **The rule.** The candidates, in the order tried ([`candidates`]):
+//!
+//! 1. when the part as modelled leaves the bed or the work envelope, the part turned about the
+//!    build direction (+Z) by the least turn that fits ([`robot_post::fit::turn_to_fit`] on
+//!    its tool path; a turn changes nothing else, so it comes first);
+//! 2. the part's other planar faces turned down, best first as `--orient auto` ranks them
+//!    ([`crate::place::ranked_faces`]), at most [`MAX_FACES`] of them.
+//!
+//! A candidate that leaves the bed or envelope in its turn is tried once more turned to fit,
+//! right after it; when no turn fits, that is listed among the failures. The first candidate that plans wins; the report's `placement` says which
+//! and lists what the ones before it failed on (`tried`, the part as modelled first). When
+//! none plans, the refusal of the part as modelled is returned, with every candidate's
+//! failure ([`PlanError::NoPlacement`]).
+//!
+//! Each candidate is a whole plan, written afresh into the caller's [`Outputs`] (a refused
+//! attempt's files are dropped with it), so only the chosen plan's files are left.
+
+use crate::place::{entry_turned, Placed};
+use crate::report::{PlacementEntry, TriedEntry};
+use crate::{Gate, Options, Plan, PlanError, Process, Progress};
+use brep::StepFile;
+use robot_post::machine::MachineProfile;
+use robot_post::ProgramSink;
+
+/// The most planar faces tried after the part as modelled, best first.
+pub const MAX_FACES: usize = 4;
+
+/// Where plans are written: afresh for each placement tried, so that only the chosen plan's
+/// files are left ([`crate::plan_file_to`]).
+pub trait Outputs {
+    /// A program sink and a `toolpath.csv` writer with nothing in them: whatever an earlier
+    /// call gave is dropped.
+    #[allow(clippy::type_complexity)]
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )>;
+}
+
+impl Outputs for crate::post::Discard {
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )> {
+        Ok((self, None))
+    }
+}
+
+impl Outputs for robot_post::InMemory {
+    fn fresh(
+        &mut self,
+    ) -> std::io::Result<(
+        &mut dyn ProgramSink,
+        Option<&mut (dyn std::io::Write + Send)>,
+    )> {
+        self.files.clear();
+        Ok((self, None))
+    }
+}
+
+/// One placement [`find`] tries. New kinds are appended here and in [`candidates`], and
+/// planned in [`Candidate::plan`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Candidate {
+    /// The part as modelled (−Z down), turned about +Z by `turn_deg` (0: as modelled).
+    Modelled {
+        /// Degrees, counter-clockwise seen from above.
+        turn_deg: f64,
+    },
+    /// The part on a planar face: its outward normal turned down, then turned about +Z by
+    /// `turn_deg`.
+    Face {
+        /// STEP `#id` of the largest planar face pointing that way.
+        id: u64,
+        /// The outward normal (file frame).
+        down: [f64; 3],
+        /// Its place in `--orient auto`'s order (1: its choice).
+        rank: usize,
+        /// Degrees, counter-clockwise seen from above.
+        turn_deg: f64,
+    },
+}
+
+impl Candidate {
+    /// The part as modelled.
+    pub const MODELLED: Candidate = Candidate::Modelled { turn_deg: 0.0 };
+
+    /// What stderr and `plan.json` call it.
+    pub fn label(&self) -> String {
+        let turn = |t: f64| {
+            if t == 0.0 {
+                String::new()
+            } else {
+                format!(" turned {t:.1} degrees about +Z")
+            }
+        };
+        match *self {
+            Candidate::Modelled { turn_deg } => format!("the part as modelled{}", turn(turn_deg)),
+            Candidate::Face {
+                id,
+                down,
+                rank,
+                turn_deg,
+            } => format!(
+                "face #{id} (outward normal {:.4} {:.4} {:.4} down, #{rank} by --orient auto){}",
+                // + 0.0: no "-0.0000".
+                down[0] + 0.0,
+                down[1] + 0.0,
+                down[2] + 0.0,
+                turn(turn_deg)
+            ),
+        }
+    }
+
+    /// The turn about +Z.
+    fn turn_deg(&self) -> f64 {
+        match *self {
+            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => turn_deg,
+        }
+    }
+
+    /// This candidate turned further by `deg` about +Z.
+    fn turned(&self, deg: f64) -> Candidate {
+        let mut c = self.clone();
+        match &mut c {
+            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => *turn_deg += deg,
+        }
+        c
+    }
+
+    /// The rotation standing the part so (rows first): plate = rotation × file.
+    pub fn rotation(&self) -> [[f64; 3]; 3] {
+        let base = match *self {
+            Candidate::Modelled { .. } => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            Candidate::Face { down, .. } => brep::turn_down(down),
+        };
+        let (s, c) = self.turn_deg().to_radians().sin_cos();
+        let z = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        [0, 1, 2].map(|r| [0, 1, 2].map(|k| (0..3).map(|j| z[r][j] * base[j][k]).sum()))
+    }
+
+    /// What `plan.json` records of it, with `rule`.
+    fn entry(&self, rule: String) -> PlacementEntry {
+        let (face, down) = match *self {
+            Candidate::Modelled { .. } => (None, [0.0, 0.0, -1.0]),
+            Candidate::Face { id, down, .. } => (Some(id), down),
+        };
+        let mut e = entry_turned(face, down, self.rotation(), rule);
+        e.turn_deg = crate::report::round(self.turn_deg(), 1e9);
+        e
+    }
+
+    /// Its whole plan, written into `sink` and `csv`.
+    pub fn plan(
+        &self,
+        file: &StepFile,
+        process: &Process,
+        machine: &MachineProfile,
+        options: &Options,
+        sink: &mut dyn ProgramSink,
+        csv: Option<&mut (dyn std::io::Write + Send)>,
+    ) -> Result<Plan, PlanError> {
+        let part = match *self {
+            Candidate::Modelled { turn_deg: 0.0 } => file.part(),
+            Candidate::Modelled { .. } | Candidate::Face { .. } => file.rotated(self.rotation()),
+        };
+        let placed = Placed {
+            part: part.map_err(crate::place::PlaceError::from)?,
+            assembly: None,
+            entry: None,
+        };
+        crate::plan_placed_into(placed, process, machine, options, sink, csv)
+    }
+}
+
+/// Whether another placement may avoid the failure `e`: unsupported beads, collisions, a
+/// refusal of the machine's post (the bed or envelope, B beyond the limits, a 3-axis printer's
+/// tool axis), points out of reach, the head meeting the table even on the tallest pedestal.
+/// Not the self-check, `strict`'s warnings, a part too big, without features, or a file or
+/// setting in error: no placement changes those.
+pub fn placement_may_help(e: &PlanError) -> bool {
+    use crate::pedestal::PedestalError;
+    match e {
+        PlanError::Refused { gate, .. } => matches!(
+            gate,
+            Gate::Unsupported(_) | Gate::Collisions(_) | Gate::Machine(_) | Gate::Unreachable(_)
+        ),
+        PlanError::Pedestal(p) => matches!(
+            p,
+            PedestalError::TooLow { .. } | PedestalError::NoneClears { .. }
+        ),
+        _ => false,
+    }
+}
+
+/// What a turn about +Z does for `c`, refused with `e`: `None` when `e` is no refusal by the
+/// machine, `c` is turned already, its plan has unsupported layers or collisions (which a
+/// turn keeps), or it fits unturned (the refusal is not the bed or envelope); else `c` turned by the least turn that fits the bed or work envelope
+/// ([`robot_post::fit::turn_to_fit`] on its tool path), or why none does.
+fn turned_to_fit(
+    c: &Candidate,
+    e: &PlanError,
+    machine: &MachineProfile,
+    options: &Options,
+) -> Option<Result<Candidate, TriedEntry>> {
+    let PlanError::Refused {
+        gate: Gate::Machine(_),
+        plan,
+    } = e
+    else {
+        return None;
+    };
+    // A turn changes nothing but where the part lies on the machine: it cannot help a plan
+    // whose layers are unsupported or whose head collides (the machine's refusal, reported
+    // first, hides those).
+    let held = plan.features().iter().all(|f| {
+        (options.keep_going || f.unsupported_area_mm2 == 0.0)
+            && (options.allow_collisions || f.collision.collisions == 0)
+    });
+    if c.turn_deg() != 0.0 || !held {
+        return None;
+    }
+    match robot_post::fit::turn_to_fit(&plan.toolpath, machine) {
+        Ok(fit) => (fit.angle_deg != 0.0).then(|| Ok(c.turned(fit.angle_deg))),
+        Err(e @ robot_post::fit::FitError::NoTurn { .. }) => Some(Err(TriedEntry {
+            candidate: format!("{} turned about +Z", c.label()),
+            failure: e.to_string(),
+        })),
+        Err(_) => None,
+    }
+}
+
+/// The placements to try after the part as modelled was refused, in order (module docs):
+/// the other planar faces, best first, at most [`MAX_FACES`]. A turn to fit is tried after
+/// any candidate that leaves the bed or envelope ([`find`]). Append new kinds at the end.
+pub fn candidates(
+    file: &StepFile,
+    process: &Process,
+    machine: &MachineProfile,
+) -> Result<Vec<Candidate>, PlanError> {
+    let faces = crate::place::ranked_faces(file, process, machine.bead().width)?;
+    Ok(faces
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| !f.as_modelled)
+        .take(MAX_FACES)
+        .map(|(k, f)| Candidate::Face {
+            id: f.id,
+            down: f.down,
+            rank: k + 1,
+            turn_deg: 0.0,
+        })
+        .collect())
+}
+
+/// Plans the part as modelled and, when it is refused for something another placement may
+/// avoid, the other [`candidates`] in turn; the first that plans is returned, its report's
+/// `placement` saying which and what the ones before it failed on. Every attempt is written
+/// afresh into `out`.
+pub fn find(
+    file: &StepFile,
+    process: &Process,
+    machine: &MachineProfile,
+    options: &Options,
+    out: &mut dyn Outputs,
+) -> Result<Plan, PlanError> {
+    let attempt = |c: &Candidate, out: &mut dyn Outputs| {
+        let (sink, csv) = out.fresh().map_err(PlanError::Csv)?;
+        c.plan(file, process, machine, options, sink, csv)
+    };
+    let mut first = match attempt(&Candidate::MODELLED, out) {
+        Err(e) if placement_may_help(&e) => e,
+        done => return done,
+    };
+    let mut tried = vec![TriedEntry {
+        candidate: Candidate::MODELLED.label(),
+        failure: first.to_string(),
+    }];
+    let mut queue = vec![];
+    match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
+        Some(Ok(t)) => queue.push(t),
+        Some(Err(none)) => tried.push(none),
+        None => {}
+    }
+    queue.extend(candidates(file, process, machine)?);
+    // The previous attempt's failure.
+    let mut last = first.to_string();
+    let mut k = 0;
+    while k < queue.len() {
+        let c = queue[k].clone();
+        if let Some(f) = options.progress {
+            f(Progress::Trying {
+                index: k + 1,
+                of: queue.len(),
+                candidate: c.label(),
+                after: last.clone(),
+            });
+        }
+        match attempt(&c, out) {
+            Ok(mut plan) => {
+                let rule = format!(
+                    "found: the part as modelled was refused ({}); the first placement tried that plans",
+                    tried[0].failure
+                );
+                let mut entry = c.entry(rule);
+                entry.tried = tried;
+                plan.report.placement = Some(entry);
+                return Ok(plan);
+            }
+            Err(e) => {
+                let turn = turned_to_fit(&c, &e, machine, options);
+                last = e.to_string();
+                tried.push(TriedEntry {
+                    candidate: c.label(),
+                    failure: e.to_string(),
+                });
+                match turn {
+                    Some(Ok(t)) => queue.insert(k + 1, t),
+                    Some(Err(none)) => tried.push(none),
+                    None => {}
+                }
+            }
+        }
+        k += 1;
+    }
+    if let PlanError::Refused { plan, .. } = &mut first {
+        let mut entry = Candidate::MODELLED.entry(format!(
+            "as modelled: none of the {} other placement(s) tried plans",
+            queue.len()
+        ));
+        entry.tried = tried.clone();
+        plan.report.placement = Some(entry);
+    }
+    // The part as modelled first in the report; the others are listed with the error.
+    tried.remove(0);
+    Err(PlanError::NoPlacement {
+        modelled: Box::new(first),
+        tried,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Candidate;
+
+    fn apply(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|r| (0..3).map(|k| m[r][k] * v[k]).sum())
+    }
+
+    /// Rounding of the products of a few sines and cosines.
+    const CLOSE: f64 = 1e-6;
+
+    #[test]
+    fn a_candidates_rotation_turns_its_face_down_then_about_z() {
+        // As modelled turned a quarter turn: X goes to Y, Z stays.
+        let m = Candidate::Modelled { turn_deg: 90.0 }.rotation();
+        let x = apply(m, [1.0, 0.0, 0.0]);
+        assert!((x[1] - 1.0).abs() < CLOSE && x[0].abs() < CLOSE && x[2].abs() < CLOSE);
+        // A face whose normal is +X, turned down and then 30 degrees: the normal points down,
+        // and the matrix is a rotation.
+        let s = 0.5f64.sqrt();
+        for down in [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [s, 0.0, -s]] {
+            let c = Candidate::Face {
+                id: 1,
+                down,
+                rank: 1,
+                turn_deg: 30.0,
+            };
+            let m = c.rotation();
+            let d = apply(m, down);
+            assert!(d[0].abs() < CLOSE && d[1].abs() < CLOSE && (d[2] + 1.0).abs() < CLOSE);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let dot: f64 = (0..3).map(|k| m[k][a] * m[k][b]).sum();
+                    let want = if a == b { 1.0 } else { 0.0 };
+                    assert!((dot - want).abs() < CLOSE);
+                }
+            }
+        }
+    }
+}
