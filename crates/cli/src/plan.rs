@@ -261,11 +261,15 @@ fn tell_placement(plan: &Plan, path: &Path, bar: &Bar) {
             // A refusal as modelled, every other placement refused too: listed already.
             return;
         }
+        let kind = plan.report.settings.machine["kind"].as_str().unwrap_or("");
         let on = match p.base_face {
             Some(id) => format!(
                 "on face #{id} (outward normal {:.4} {:.4} {:.4} turned down)",
                 p.down[0], p.down[1], p.down[2]
             ),
+            None if plan.report.slicing == "planar" && !plus_z_only(kind) => {
+                "as modelled, sliced whole in planar layers along +Z,".to_string()
+            }
             None => "as modelled".to_string(),
         };
         let turn = if p.turn_deg == 0.0 {
@@ -402,17 +406,20 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
             ))
         })
         .unwrap_or_default();
-    // Planar slicing `auto` chose (issue 33): the features' own directions were not +Z.
+    // Planar slicing `auto` chose (issue 33): on a machine printing only along +Z, because the
+    // features' own directions were not +Z; on the others, because the feature-by-feature
+    // plans were refused (the placement line before this one says why).
     let chosen = plan.report.settings.process["defaults"]["slicing"].as_str() == Some("auto");
-    let planar =
-        if chosen && plan.report.slicing == "planar" {
-            format!(
-            " sliced whole in planar layers along +Z (slicing auto: `{}` prints only along +Z),",
-            plan.report.settings.machine["kind"].as_str().unwrap_or("the machine")
-        )
-        } else {
-            String::new()
-        };
+    let kind = plan.report.settings.machine["kind"]
+        .as_str()
+        .unwrap_or("the machine");
+    let planar = match (chosen && plan.report.slicing == "planar", plus_z_only(kind)) {
+        (false, _) => String::new(),
+        (true, true) => format!(
+            " sliced whole in planar layers along +Z (slicing auto: `{kind}` prints only along +Z),"
+        ),
+        (true, false) => " sliced whole in planar layers along +Z (slicing auto: the feature-by-feature plan was refused),".to_string(),
+    };
     format!(
         "{}: {} feature(s),{planar}{pedestal} {} points, {print:.1} mm printed, {vol:.1} mm^3 extruded{widened}{support}, {warnings} warning(s) -> {to}
 ",
@@ -491,4 +498,9 @@ impl Drop for Bar {
     fn drop(&mut self) {
         self.0.finish_and_clear();
     }
+}
+
+/// Whether the machine of kind `kind` (as `plan.json` names it) prints only along +Z.
+fn plus_z_only(kind: &str) -> bool {
+    robot_post::MachineKind::from_name(kind).is_some_and(|k| k.plus_z_only())
 }

@@ -10,7 +10,14 @@
 //!    build direction (+Z) by the least turn that fits ([`robot_post::fit::turn_to_fit`] on
 //!    its tool path; a turn changes nothing else, so it comes first);
 //! 2. the part's other planar faces turned down, best first as `--orient auto` ranks them
-//!    ([`crate::place::ranked_faces`]), at most [`MAX_FACES`] of them.
+//!    ([`crate::place::ranked_faces`]), at most [`MAX_FACES`] of them;
+//! 3. last, when the process leaves `slicing` at `auto` and the part was planned feature by
+//!    feature, the part as modelled sliced whole in planar layers along +Z
+//!    ([`Candidate::Planar`], [`crate::extract::planar_assembly`]), as a planar slicer prints
+//!    it, with support material under what overhangs: no tilt, so no axis beyond the machine's
+//!    limits and no head below its layers. It is also the one candidate tried after a failed
+//!    self-check ([`planar_may_help`]): small split-off features (pins, contacts) that their
+//!    own layers cannot hold are laid with the part around them.
 //!
 //! A candidate that leaves the bed or envelope in its turn is tried once more turned to fit,
 //! right after it; when no turn fits, that is listed among the failures. The first candidate that plans wins; the report's `placement` says which
@@ -77,6 +84,12 @@ pub enum Candidate {
         /// Degrees, counter-clockwise seen from above.
         turn_deg: f64,
     },
+    /// The part as modelled, each solid sliced whole in planar layers along +Z (the process
+    /// key `slicing = "planar"`), turned about +Z by `turn_deg`.
+    Planar {
+        /// Degrees, counter-clockwise seen from above.
+        turn_deg: f64,
+    },
     /// The part on a planar face: its outward normal turned down, then turned about +Z by
     /// `turn_deg`.
     Face {
@@ -106,6 +119,10 @@ impl Candidate {
         };
         match *self {
             Candidate::Modelled { turn_deg } => format!("the part as modelled{}", turn(turn_deg)),
+            Candidate::Planar { turn_deg } => format!(
+                "the part as modelled, sliced whole in planar layers along +Z{}",
+                turn(turn_deg)
+            ),
             Candidate::Face {
                 id,
                 down,
@@ -125,7 +142,9 @@ impl Candidate {
     /// The turn about +Z.
     fn turn_deg(&self) -> f64 {
         match *self {
-            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => turn_deg,
+            Candidate::Modelled { turn_deg }
+            | Candidate::Planar { turn_deg }
+            | Candidate::Face { turn_deg, .. } => turn_deg,
         }
     }
 
@@ -133,7 +152,9 @@ impl Candidate {
     fn turned(&self, deg: f64) -> Candidate {
         let mut c = self.clone();
         match &mut c {
-            Candidate::Modelled { turn_deg } | Candidate::Face { turn_deg, .. } => *turn_deg += deg,
+            Candidate::Modelled { turn_deg }
+            | Candidate::Planar { turn_deg }
+            | Candidate::Face { turn_deg, .. } => *turn_deg += deg,
         }
         c
     }
@@ -141,7 +162,9 @@ impl Candidate {
     /// The rotation standing the part so (rows first): plate = rotation × file.
     pub fn rotation(&self) -> [[f64; 3]; 3] {
         let base = match *self {
-            Candidate::Modelled { .. } => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            Candidate::Modelled { .. } | Candidate::Planar { .. } => {
+                [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+            }
             Candidate::Face { down, .. } => brep::turn_down(down),
         };
         let (s, c) = self.turn_deg().to_radians().sin_cos();
@@ -152,7 +175,7 @@ impl Candidate {
     /// What `plan.json` records of it, with `rule`.
     fn entry(&self, rule: String) -> PlacementEntry {
         let (face, down) = match *self {
-            Candidate::Modelled { .. } => (None, [0.0, 0.0, -1.0]),
+            Candidate::Modelled { .. } | Candidate::Planar { .. } => (None, [0.0, 0.0, -1.0]),
             Candidate::Face { id, down, .. } => (Some(id), down),
         };
         let mut e = entry_turned(face, down, self.rotation(), rule);
@@ -171,12 +194,21 @@ impl Candidate {
         csv: Option<&mut (dyn std::io::Write + Send)>,
     ) -> Result<Plan, PlanError> {
         let part = match *self {
-            Candidate::Modelled { turn_deg: 0.0 } => file.part(),
-            Candidate::Modelled { .. } | Candidate::Face { .. } => file.rotated(self.rotation()),
+            Candidate::Modelled { turn_deg: 0.0 } | Candidate::Planar { turn_deg: 0.0 } => {
+                file.part()
+            }
+            Candidate::Modelled { .. } | Candidate::Planar { .. } | Candidate::Face { .. } => {
+                file.rotated(self.rotation())
+            }
+        };
+        let part = part.map_err(crate::place::PlaceError::from)?;
+        let assembly = match self {
+            Candidate::Planar { .. } => Some(crate::extract::planar_assembly(&part.brep)?),
+            Candidate::Modelled { .. } | Candidate::Face { .. } => None,
         };
         let placed = Placed {
-            part: part.map_err(crate::place::PlaceError::from)?,
-            assembly: None,
+            part,
+            assembly,
             entry: None,
         };
         crate::plan_placed_into(placed, process, machine, options, sink, csv)
@@ -200,6 +232,24 @@ pub fn placement_may_help(e: &PlanError) -> bool {
             PedestalError::TooLow { .. } | PedestalError::NoneClears { .. }
         ),
         _ => false,
+    }
+}
+
+/// Whether the part sliced whole in planar layers ([`Candidate::Planar`]) may avoid the
+/// failure `e` of the part planned feature by feature: what [`placement_may_help`] lists, and
+/// a failed self-check (features their own layers cannot hold). Only while the process leaves
+/// `slicing` at `auto` and the failed plan was not planar already.
+pub fn planar_may_help(e: &PlanError, process: &Process) -> bool {
+    if process.base().slicing != slicer::params::Slicing::Auto {
+        return false;
+    }
+    match e {
+        PlanError::Refused { plan, .. } if plan.report.slicing == "planar" => false,
+        PlanError::Refused {
+            gate: Gate::SelfCheck(_),
+            ..
+        } => true,
+        _ => placement_may_help(e),
     }
 }
 
@@ -279,7 +329,7 @@ pub fn find(
         c.plan(file, process, machine, options, sink, csv)
     };
     let mut first = match attempt(&Candidate::MODELLED, out) {
-        Err(e) if placement_may_help(&e) => e,
+        Err(e) if placement_may_help(&e) || planar_may_help(&e, process) => e,
         done => return done,
     };
     let mut tried = vec![TriedEntry {
@@ -287,12 +337,17 @@ pub fn find(
         failure: first.to_string(),
     }];
     let mut queue = vec![];
-    match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
-        Some(Ok(t)) => queue.push(t),
-        Some(Err(none)) => tried.push(none),
-        None => {}
+    if placement_may_help(&first) {
+        match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
+            Some(Ok(t)) => queue.push(t),
+            Some(Err(none)) => tried.push(none),
+            None => {}
+        }
+        queue.extend(candidates(file, process, machine)?);
     }
-    queue.extend(candidates(file, process, machine)?);
+    if planar_may_help(&first, process) {
+        queue.push(Candidate::Planar { turn_deg: 0.0 });
+    }
     // The previous attempt's failure.
     let mut last = first.to_string();
     let mut k = 0;
