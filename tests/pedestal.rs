@@ -42,12 +42,15 @@ impl Drop for Out {
     }
 }
 
+/// Plans `part` on delta5 as modelled (`--orient modelled`: the pedestal under the part as it
+/// stands; other placements and the planar slicing, tried by default after a refusal, are
+/// tests/placement.rs's).
 fn plan(part: &Path, dir: &Path, extra: &[&str]) -> Output {
     let _ = std::fs::remove_dir_all(dir);
     Command::new(BIN)
         .arg("plan")
         .arg(part)
-        .args(["--machine", "delta5", "-o"])
+        .args(["--machine", "delta5", "--orient", "modelled", "-o"])
         .arg(dir)
         .args(extra)
         .output()

@@ -198,11 +198,15 @@ fn unreachable_robot_points_stop_the_plan_unless_allowed() {
     let out = s.path("cap");
     let o = plan(
         "capsule.step",
-        // The cone boss collides too (issue 18); that is not what this test is about.
+        // The cone boss collides too (issue 18); that is not what this test is about. As
+        // modelled: by default the other placements are tried, and the capsule turned over
+        // plans (tests/placement.rs).
         &[
             "--machine",
             "kuka",
             "--allow-collisions",
+            "--orient",
+            "modelled",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -223,6 +227,8 @@ fn unreachable_robot_points_stop_the_plan_unless_allowed() {
             "kuka",
             "--allow-unreachable",
             "--allow-collisions",
+            "--orient",
+            "modelled",
             "-o",
             out.to_str().unwrap(),
         ],
@@ -762,13 +768,23 @@ fn plan_file(part: &Path, args: &[&str]) -> Output {
 fn a_part_modelled_on_its_side_stands_on_the_face_chosen_or_picked() {
     let part = leg_fork();
     let s = Scratch::new("orient");
-    // As modelled, it reaches below the build plate and half of it is not printed: the
-    // self-check refuses the plan (--keep-going writes it, with the warning).
-    let o = plan_file(&part, &["-o", s.path("as").to_str().unwrap()]);
+    // As modelled, feature by feature, it reaches below the build plate and half of it is not
+    // printed: the self-check refuses the plan (--keep-going writes it, with the warning).
+    // (Without --orient modelled, the part sliced whole in planar layers is tried next.)
+    let o = plan_file(
+        &part,
+        &["--orient", "modelled", "-o", s.path("as").to_str().unwrap()],
+    );
     assert_refused(&o, &["self-check"]);
     let o = plan_file(
         &part,
-        &["--keep-going", "-o", s.path("as").to_str().unwrap()],
+        &[
+            "--orient",
+            "modelled",
+            "--keep-going",
+            "-o",
+            s.path("as").to_str().unwrap(),
+        ],
     );
     assert!(
         stderr(&o).contains("below the build plate"),

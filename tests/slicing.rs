@@ -159,6 +159,10 @@ fn features_slicing_on_marlin_keeps_the_axis_refusal() {
             "marlin",
             "--set",
             "slicing=features",
+            // As modelled: by default the other placements are tried, and on the face whose
+            // normal leans 30 degrees every feature grows along +Z.
+            "--orient",
+            "modelled",
             "-o",
             out.to_str().expect("utf-8"),
         ],

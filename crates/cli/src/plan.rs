@@ -146,8 +146,9 @@ impl Refusal<'_> {
                 problems.iter().for_each(|p| say(&p.to_string()));
                 (
                     format!(
-                        "the plan fails its self-check for {} feature(s) (listed above)",
-                        problems.len()
+                        "the plan fails its self-check for {} feature(s) (listed above){}",
+                        problems.len(),
+                        resolution_remedy(&plan, problems)
                     ),
                     " (--keep-going writes it anyway)",
                 )
@@ -503,4 +504,30 @@ impl Drop for Bar {
 /// Whether the machine of kind `kind` (as `plan.json` names it) prints only along +Z.
 fn plus_z_only(kind: &str) -> bool {
     robot_post::MachineKind::from_name(kind).is_some_and(|k| k.plus_z_only())
+}
+
+/// What would print the features a self-check failed on, when they are below the nozzle's
+/// resolution (issue 31, items 4 and 5): the finest nozzle those measured narrower than
+/// `min_bead_width` need, or, for features with no layer at all, that they are smaller than
+/// one layer of beads. Empty when neither.
+fn resolution_remedy(plan: &Plan, problems: &[slicer::verify::PlanProblem]) -> String {
+    let report = |id: usize| plan.features().iter().find(|f| f.feature.id == id);
+    let nozzle = problems
+        .iter()
+        .filter_map(|p| report(p.id())?.below_resolution)
+        .map(|b| b.nozzle_needed_mm)
+        .fold(f64::INFINITY, f64::min);
+    let unlaid = problems
+        .iter()
+        .filter(|p| matches!(p, slicer::verify::PlanProblem::NoLayers { .. }))
+        .count();
+    match (nozzle.is_finite(), unlaid) {
+        (true, _) => format!(
+            "; below the nozzle's resolution: a nozzle of {nozzle:.2} mm or finer would lay them"
+        ),
+        (false, n) if n > 0 => format!(
+            "; {n} of them smaller than one layer of beads: below the nozzle's resolution (a finer nozzle and thinner layers would lay them)"
+        ),
+        _ => String::new(),
+    }
 }

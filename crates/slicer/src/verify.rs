@@ -40,6 +40,15 @@ pub enum PlanProblem {
     },
 }
 
+impl PlanProblem {
+    /// The id of the feature it is about.
+    pub fn id(&self) -> usize {
+        match self {
+            PlanProblem::NoLayers { id, .. } | PlanProblem::Volume { id, .. } => *id,
+        }
+    }
+}
+
 /// What the plan did with one feature.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlannedFeature {
