@@ -4,6 +4,7 @@
 //! surface and order them by what grows on what.
 
 use crate::aag::{self, Convexity};
+use crate::measure::{measure, vol_of, MeasureError, Measured};
 use crate::split;
 use brep::math::V3;
 use brep::mesh::{loop_roles, mesh_faces, LoopRole, MeshError};
@@ -36,6 +37,9 @@ pub enum ExtractError {
     /// Nothing in the file encloses a volume.
     #[error("{0}")]
     Empty(String),
+    /// A solid could not be measured (no shell, or a face that does not mesh).
+    #[error(transparent)]
+    Measure(#[from] MeasureError),
 }
 
 /// Two kinds of AM feature (paper: `two5D_AM_feature`, `freeform_AM_feature`).
@@ -205,39 +209,22 @@ pub fn extract(
     let mut b = part.solid_alone(solid);
     let solid = SolidId(0);
     let mut warnings = vec![];
-    let shells = b.solids[solid.idx()].shells.clone();
-    let outer: Vec<FaceId> = b.shells[shells[0].idx()].faces.clone();
-    let voids: Vec<Vec<FaceId>> = shells[1..]
-        .iter()
-        .map(|s| b.shells[s.idx()].faces.clone())
-        .collect();
-
     // The part as read, meshed once: figures, per-face shares of the volume, adjacency and
     // convexity.
-    let mut all_faces = outer.clone();
-    for v in &voids {
-        all_faces.extend(v.iter().copied());
-    }
-    let rough = brep::solid::rough_bbox(&b, solid);
-    let diag = rough.diagonal().max(1e-3);
-    let mopts = analysis_options(diag);
-    let mesh = mesh_faces(&b, &all_faces, &mopts)?;
-    let origin = if rough.is_empty() {
-        brep::math::P3::origin()
-    } else {
-        nalgebra::center(&rough.min, &rough.max)
-    };
-    let mut shares: HashMap<FaceId, (f64, f64)> = brep::mass::face_shares(&b, &mesh, &origin)
-        .into_iter()
-        .map(|(f, v, a)| (f, (v, a)))
-        .collect();
-    let part_volume =
-        vol_of(&shares, &outer).abs() - voids.iter().map(|v| vol_of(&shares, v).abs()).sum::<f64>();
-    let part_area: f64 = all_faces
-        .iter()
-        .map(|f| shares.get(f).map_or(0.0, |s| s.1))
-        .sum();
-    let genus = brep::validate::check_shell(&b, shells[0]).genus;
+    let Measured {
+        outer_shell: _,
+        outer,
+        voids,
+        all_faces,
+        diag,
+        mopts,
+        mesh,
+        origin,
+        mut shares,
+        part_volume,
+        part_area,
+        genus,
+    } = measure(&b, solid)?;
     let graph = aag::build(&b, &outer, &mesh, opts.smooth_angle_deg);
 
     // Candidate roots: closed chains of concave edges (a boss's root circle, a blade's root
@@ -327,13 +314,6 @@ pub fn extract(
         roots,
         warnings,
     })
-}
-
-/// The volume (mm³) the faces' shares enclose, signed by their orientation.
-fn vol_of(shares: &HashMap<FaceId, (f64, f64)>, fs: &[FaceId]) -> f64 {
-    fs.iter()
-        .map(|f| shares.get(f).map_or(0.0, |s| s.0))
-        .sum::<f64>()
 }
 
 /// Feature `k` made of draft `d`: its shell added to the B-rep, the voids it holds, its

@@ -9,6 +9,7 @@ pub mod aag;
 pub mod assembly;
 pub mod check;
 pub mod extract;
+pub mod measure;
 pub mod split;
 mod tolerance;
 pub mod whole;

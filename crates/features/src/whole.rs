@@ -4,10 +4,9 @@
 
 use crate::assembly::{assemble, Assembly};
 use crate::extract::{ExtractError, Feature, FeatureKind, FeatureTree, Reference};
-use brep::mesh::mesh_faces;
+use crate::measure::{measure, Measured};
 use brep::solid::analysis_options;
-use brep::topology::{Brep, FaceId, SolidId};
-use std::collections::HashMap;
+use brep::topology::{Brep, SolidId};
 
 /// The `subtype` of a solid planned whole.
 pub const WHOLE_PART: &str = "whole_part";
@@ -37,46 +36,18 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
     let b = part.solid_alone(solid);
     let solid = SolidId(0);
     let mut warnings = vec![];
-    let shells = b.solids[solid.idx()].shells.clone();
-    let Some(&outer_shell) = shells.first() else {
-        return Err(ExtractError::Empty(format!(
-            "solid #{} has no shell",
-            b.solids[solid.idx()].step_id
-        )));
-    };
-    let outer: Vec<FaceId> = b.shells[outer_shell.idx()].faces.clone();
-    let voids: Vec<Vec<FaceId>> = shells[1..]
-        .iter()
-        .map(|s| b.shells[s.idx()].faces.clone())
-        .collect();
-    let mut all_faces = outer.clone();
-    for v in &voids {
-        all_faces.extend(v.iter().copied());
-    }
-    let rough = brep::solid::rough_bbox(&b, solid);
-    let diag = rough.diagonal().max(1e-3);
-    let mesh = mesh_faces(&b, &all_faces, &analysis_options(diag))?;
-    let origin = if rough.is_empty() {
-        brep::math::P3::origin()
-    } else {
-        nalgebra::center(&rough.min, &rough.max)
-    };
-    let shares: HashMap<FaceId, (f64, f64)> = brep::mass::face_shares(&b, &mesh, &origin)
-        .into_iter()
-        .map(|(f, v, a)| (f, (v, a)))
-        .collect();
-    let vol_of = |fs: &[FaceId]| {
-        fs.iter()
-            .map(|f| shares.get(f).map_or(0.0, |s| s.0))
-            .sum::<f64>()
-            .abs()
-    };
-    let part_volume = vol_of(&outer) - voids.iter().map(|v| vol_of(v)).sum::<f64>();
-    let part_area: f64 = all_faces
-        .iter()
-        .map(|f| shares.get(f).map_or(0.0, |s| s.1))
-        .sum();
-    let genus = brep::validate::check_shell(&b, outer_shell).genus;
+    let Measured {
+        outer_shell,
+        outer,
+        voids,
+        all_faces,
+        diag,
+        mesh,
+        part_volume,
+        part_area,
+        genus,
+        ..
+    } = measure(&b, solid)?;
     // The same check the recognised features get, at the same (coarser) mesh.
     let problems =
         crate::check::check_solid(&b, &outer, &voids, &analysis_options(diag * 4.0)).problems;
