@@ -1,6 +1,6 @@
 //! A solid as read, measured once: its shells' faces, the analysis mesh of them all, each
 //! face's share of the enclosed volume and area, the volume and the outer shell's genus. What
-//! feature extraction ([`crate::extract`]) and the whole-part feature ([`crate::whole`]) both
+//! feature extraction ([`crate::extract()`]) and the whole-part feature ([`crate::whole`]) both
 //! start from.
 
 use brep::mesh::{mesh_faces, MeshError};
