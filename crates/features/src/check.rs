@@ -70,6 +70,25 @@ impl SolidCheck {
     }
 }
 
+/// How many problems a warning lists before it says `...` ([`listed`]).
+pub const LISTED_PROBLEMS: usize = 4;
+
+/// `problems` as a warning lists them: the first [`LISTED_PROBLEMS`] joined by `; `, then
+/// `; ...` when there are more.
+pub fn listed(problems: &[SolidProblem]) -> String {
+    let list: Vec<String> = problems
+        .iter()
+        .take(LISTED_PROBLEMS)
+        .map(|p| p.to_string())
+        .collect();
+    let more = if problems.len() > LISTED_PROBLEMS {
+        "; ..."
+    } else {
+        ""
+    };
+    format!("{}{more}", list.join("; "))
+}
+
 /// Topology alone: edge uses and loop connection over `faces` (outer and void shells together).
 ///
 /// Some writers (OpenCASCADE for certain reversed faces) write a face's loops against its

@@ -348,11 +348,9 @@ fn make_feature(
     let problems = crate::check::check_solid(b, &d.faces, &fvoids, check_opts).problems;
     let closed = problems.is_empty();
     if !closed {
-        let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();
         warnings.push(format!(
-            "feature {k} is not a valid solid: {}{}",
-            list.join("; "),
-            if problems.len() > 4 { "; ..." } else { "" }
+            "feature {k} is not a valid solid: {}",
+            crate::check::listed(&problems)
         ));
     }
     let (parents, reference) = match &d.host {

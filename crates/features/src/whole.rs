@@ -53,11 +53,9 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
         crate::check::check_solid(&b, &outer, &voids, &analysis_options(diag * 4.0)).problems;
     let closed = problems.is_empty();
     if !closed {
-        let list: Vec<String> = problems.iter().take(4).map(|p| p.to_string()).collect();
         warnings.push(format!(
-            "the solid is not a valid solid: {}{}",
-            list.join("; "),
-            if problems.len() > 4 { "; ..." } else { "" }
+            "the solid is not a valid solid: {}",
+            crate::check::listed(&problems)
         ));
     }
     if !voids.is_empty() {

@@ -203,3 +203,22 @@ pub(crate) fn on_boundary(p: Point2, poly: &[Point2], eps: f64) -> bool {
     let n = poly.len();
     (0..n).any(|i| seg_dist(p, poly[i], poly[(i + 1) % n]) <= eps)
 }
+
+/// Shapes the unit tests of the region operations build from.
+#[cfg(test)]
+pub(crate) mod shapes {
+    use super::{region_area, Region};
+
+    /// The rectangle `[x0, x1] × [y0, y1]`, counter-clockwise, without holes.
+    pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
+        Region {
+            outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
+            holes: vec![],
+        }
+    }
+
+    /// The area of `r`, summed.
+    pub(crate) fn area(r: &[Region]) -> f64 {
+        r.iter().map(region_area).sum()
+    }
+}

@@ -242,16 +242,10 @@ pub fn planar_support(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom2d::shapes::rect;
 
     const W: f64 = 0.4;
     const TOL: f64 = 0.05;
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
-        Region {
-            outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
-            holes: vec![],
-        }
-    }
 
     fn disc(r: f64) -> Region {
         let n = 256;

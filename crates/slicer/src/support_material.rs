@@ -355,17 +355,7 @@ pub(crate) fn fill_columns(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
-        Region {
-            outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
-            holes: vec![],
-        }
-    }
-
-    fn area(r: &[Region]) -> f64 {
-        r.iter().map(region_area).sum()
-    }
+    use crate::geom2d::shapes::{area, rect};
 
     /// A bridge: two posts 10 × 10 (x 0–10 and 30–40) for layers 0..10, a slab 40 × 10 on
     /// them for layers 10..15; the slab's first layer is unsupported between the posts.

@@ -65,18 +65,7 @@ pub(crate) fn outside_grown(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom2d::region_area;
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
-        Region {
-            outer: vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
-            holes: vec![],
-        }
-    }
-
-    fn area(r: &[Region]) -> f64 {
-        r.iter().map(region_area).sum()
-    }
+    use crate::geom2d::shapes::{area, rect};
 
     #[test]
     fn booleans_of_two_squares() {
