@@ -205,8 +205,9 @@ fn planar_slicing_on_delta5_lays_every_point_along_plus_z() {
 }
 
 #[test]
-fn planar_slicing_plans_one_feature_per_solid_with_its_volume() {
-    // Two boxes of 4000 and 3000 mm^3 (fixtures/two_solids.json).
+fn planar_slicing_plans_separate_solids_together_in_one_feature() {
+    // Two boxes of 4000 and 3000 mm^3 (fixtures/two_solids.json): 20x20x10 at the origin and
+    // 10x10x30 at x=40, sliced in the same layers as one feature.
     let s = Scratch::new("solids");
     let out = s.path("t");
     let o = plan(
@@ -223,28 +224,51 @@ fn planar_slicing_plans_one_feature_per_solid_with_its_volume() {
         &std::fs::read_to_string(fixture("two_solids.json")).expect("two_solids.json"),
     )
     .expect("JSON");
-    let mut expected: Vec<f64> = meta["volumes_mm3"]
+    let expected: f64 = meta["volumes_mm3"]
         .as_array()
         .expect("volumes")
         .iter()
         .filter_map(Value::as_f64)
-        .collect();
+        .sum();
     let report = read_json(&out.join("plan.json"));
     let features = report["features"].as_array().expect("features");
-    assert_eq!(features.len(), expected.len());
-    let mut planned: Vec<f64> = features
-        .iter()
-        .map(|f| {
-            assert_eq!(f["subtype"], "whole_part");
-            laid_its_volume(f);
-            f["volume_mm3"].as_f64().expect("volume")
-        })
-        .collect();
-    planned.sort_by(f64::total_cmp);
-    expected.sort_by(f64::total_cmp);
-    for (p, e) in planned.iter().zip(&expected) {
-        assert!((p - e).abs() <= SAME_VOLUME * e, "{p} mm^3 for {e} mm^3");
+    assert_eq!(features.len(), 1);
+    let f = &features[0];
+    assert_eq!(f["subtype"], "whole_part");
+    laid_its_volume(f);
+    let planned = f["volume_mm3"].as_f64().expect("volume");
+    assert!(
+        (planned - expected).abs() <= SAME_VOLUME * expected,
+        "{planned} mm^3 for {expected} mm^3"
+    );
+    // Both boxes in each layer up to the low box's top: the layers of the tall box below
+    // z = 10 are laid between those of the low one, not after its last.
+    let text = std::fs::read_to_string(out.join("toolpath.csv")).expect("toolpath.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect("column");
+    let (x, z) = (col("x"), col("z"));
+    let mut order: Vec<(f64, f64)> = vec![];
+    for line in lines {
+        let v: Vec<&str> = line.split(',').collect();
+        let (Ok(px), Ok(pz)) = (v[x].parse::<f64>(), v[z].parse::<f64>()) else {
+            continue;
+        };
+        order.push((px, pz));
     }
+    let last_low = order
+        .iter()
+        .rposition(|p| p.0 <= 20.0)
+        .expect("low box laid");
+    let first_tall = order
+        .iter()
+        .position(|p| p.0 >= 40.0)
+        .expect("tall box laid");
+    assert!(
+        first_tall < last_low,
+        "the tall box starts at row {first_tall}, after the low box's last row {last_low}"
+    );
+    assert!(order.iter().any(|p| p.0 >= 40.0 && p.1 >= 29.0));
 }
 
 #[test]

@@ -73,6 +73,19 @@ pub(crate) fn assemble(
     brep: &Brep,
     tree_of: impl Fn(&Brep, SolidId) -> Result<FeatureTree, ExtractError>,
 ) -> Result<Assembly, ExtractError> {
+    let (trees, warnings) = solid_trees(brep, tree_of)?;
+    Ok(relate(
+        trees.into_iter().map(|(_, t)| t).collect(),
+        warnings,
+    ))
+}
+
+/// Each solid of `brep` that encloses a volume with the tree `tree_of` made of it, lowest
+/// first; a warning for each solid skipped as empty. An error when none encloses a volume.
+pub(crate) fn solid_trees(
+    brep: &Brep,
+    tree_of: impl Fn(&Brep, SolidId) -> Result<FeatureTree, ExtractError>,
+) -> Result<(Vec<(SolidId, FeatureTree)>, Vec<String>), ExtractError> {
     let mut trees = vec![];
     let mut warnings = vec![];
     let mut empty = vec![];
@@ -81,7 +94,7 @@ pub(crate) fn assemble(
         if t.part_volume < EMPTY_VOLUME {
             empty.push(t);
         } else {
-            trees.push(t);
+            trees.push((s, t));
         }
     }
     if trees.is_empty() {
@@ -102,41 +115,69 @@ pub(crate) fn assemble(
             t.part_area
         ));
     }
-    let boxes: Vec<Aabb> = trees.iter().map(|t| t.mesh.bbox()).collect();
-    let mut order: Vec<usize> = (0..trees.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].min.z.total_cmp(&boxes[b].min.z));
-    let mut slots: Vec<Option<FeatureTree>> = trees.into_iter().map(Some).collect();
-    let trees: Vec<FeatureTree> = order.iter().filter_map(|&k| slots[k].take()).collect();
-    let boxes: Vec<Aabb> = order.iter().map(|&k| boxes[k]).collect();
+    trees.sort_by(|(_, a), (_, b)| a.mesh.bbox().min.z.total_cmp(&b.mesh.bbox().min.z));
+    Ok((trees, warnings))
+}
 
-    if trees.len() > 1 {
-        let solids: Vec<Solid> = trees
-            .iter()
-            .zip(&boxes)
-            .map(|(t, b)| Solid::new(t, *b))
-            .collect();
-        // Solids that overlap one built before them stand on it.
-        let mut supported = vec![false; solids.len()];
-        for i in 0..solids.len() {
-            for j in i + 1..solids.len() {
-                let v = overlap_volume(&solids[i], &solids[j]);
-                let smaller = solids[i].volume.min(solids[j].volume);
-                if v > OVERLAP_SHARE * smaller {
-                    supported[j] = true;
-                    warnings.push(format!(
-                        "{} and {} overlap by about {v:.0} mm^3 ({:.0} % of the smaller): each \
-                         is planned whole, so that material would be laid twice; unite them in \
-                         CAD",
-                        solid_name(&trees[i]),
-                        solid_name(&trees[j]),
-                        100.0 * v / smaller
-                    ));
-                }
+/// Two solids (indices into the trees, lowest first) that share more than [`OVERLAP_SHARE`]
+/// of the smaller one's volume.
+pub(crate) struct Overlap {
+    /// The lower solid.
+    pub first: usize,
+    /// The solid that overlaps it.
+    pub second: usize,
+    /// The volume they share, mm³.
+    pub volume: f64,
+    /// The smaller solid's volume, mm³.
+    pub smaller: f64,
+}
+
+/// The pairs of `trees` (lowest first) that overlap.
+pub(crate) fn overlaps(trees: &[FeatureTree]) -> Vec<Overlap> {
+    let solids: Vec<Solid> = trees.iter().map(|t| Solid::new(t, t.mesh.bbox())).collect();
+    overlaps_of(&solids)
+}
+
+fn overlaps_of(solids: &[Solid]) -> Vec<Overlap> {
+    let mut out = vec![];
+    for i in 0..solids.len() {
+        for j in i + 1..solids.len() {
+            let volume = overlap_volume(&solids[i], &solids[j]);
+            let smaller = solids[i].volume.min(solids[j].volume);
+            if volume > OVERLAP_SHARE * smaller {
+                out.push(Overlap {
+                    first: i,
+                    second: j,
+                    volume,
+                    smaller,
+                });
             }
         }
-        let plate = boxes[0].min.z;
+    }
+    out
+}
+
+/// `trees` (lowest first) as an assembly, with `warnings` and what the user should know about
+/// how its solids sit together: overlaps, and solids that start in the air.
+pub(crate) fn relate(trees: Vec<FeatureTree>, mut warnings: Vec<String>) -> Assembly {
+    if trees.len() > 1 {
+        let solids: Vec<Solid> = trees.iter().map(|t| Solid::new(t, t.mesh.bbox())).collect();
+        // Solids that overlap one built before them stand on it.
+        let mut supported = vec![false; solids.len()];
+        for o in overlaps_of(&solids) {
+            supported[o.second] = true;
+            warnings.push(format!(
+                "{} and {} overlap by about {:.0} mm^3 ({:.0} % of the smaller): each is planned \
+                 whole, so that material would be laid twice; unite them in CAD",
+                solid_name(&trees[o.first]),
+                solid_name(&trees[o.second]),
+                o.volume,
+                100.0 * o.volume / o.smaller
+            ));
+        }
+        let plate = solids[0].bbox.min.z;
         for j in 1..solids.len() {
-            let lift = boxes[j].min.z - plate;
+            let lift = solids[j].bbox.min.z - plate;
             if lift > PLATE_TOL && !supported[j] && !rests_on_another(&trees[j], &solids, j) {
                 warnings.push(format!(
                     "{} starts {lift:.3} mm above the build plate and rests on no other solid: \
@@ -146,7 +187,7 @@ pub(crate) fn assemble(
             }
         }
     }
-    Ok(Assembly { trees, warnings })
+    Assembly { trees, warnings }
 }
 
 /// A solid's closed analysis mesh and figures.

@@ -1,8 +1,16 @@
-//! The whole part as features: each solid one two5d feature of all its faces, built on the
-//! plate from its lowest point along +Z, as a planar slicer slices it (issue 33, the process
+//! The whole part as features: its solids one two5d feature of all their faces, built on the
+//! plate from the lowest point along +Z, as a planar slicer slices it (issue 33, the process
 //! key `slicing = "planar"`). No loop is split off and no face healed.
+//!
+//! Solids that do not overlap are sliced together, in the same layers, as ONE feature: a
+//! planar slicer lays every body's section of a layer before the next layer, so no body
+//! waits for another to be finished (the head would meet the finished one) and a body that
+//! starts in the air is held up by support from the plate like any overhang. Solids that
+//! overlap by more than half a percent of their volume stay one feature each (as
+//! [`crate::extract_all`] plans them), with the overlap reported: sliced together, the
+//! sections' even-odd regions would leave their common material out.
 
-use crate::assembly::{assemble, Assembly};
+use crate::assembly::{overlaps, relate, solid_name, solid_trees, Assembly};
 use crate::extract::{ExtractError, Feature, FeatureKind, FeatureTree, Reference};
 use crate::measure::{measure, Measured};
 use brep::solid::analysis_options;
@@ -14,10 +22,136 @@ pub const WHOLE_PART: &str = "whole_part";
 /// The build direction of a solid planned whole: +Z.
 pub const PLUS_Z: [f64; 3] = [0.0, 0.0, 1.0];
 
-/// Every solid of `brep` as one feature ([`whole_part_tree`]), ordered and checked together
-/// like [`crate::extract_all`]'s trees (lowest first, overlaps and floating solids reported).
+/// The solids of `brep` as features: all of them one feature ([`solids_together`]) when they
+/// share at most [`TOGETHER_OVERLAP_SHARE`] of their volume, else each one feature ([`whole_part_tree`]), ordered and checked together like
+/// [`crate::extract_all`]'s trees (lowest first, overlaps and floating solids reported).
+/// Solids that enclose no volume are skipped with a warning either way.
 pub fn whole_part_features(brep: &Brep) -> Result<Assembly, ExtractError> {
-    assemble(brep, whole_part_tree)
+    let (solids, mut warnings) = solid_trees(brep, whole_part_tree)?;
+    let (ids, trees): (Vec<SolidId>, Vec<FeatureTree>) = solids.into_iter().unzip();
+    let shared = overlaps(&trees);
+    let common: f64 = shared.iter().map(|o| o.volume).sum();
+    let volume: f64 = trees.iter().map(|t| t.part_volume).sum();
+    if trees.len() > 1 && common <= TOGETHER_OVERLAP_SHARE * volume {
+        if let Some(tree) = solids_together(brep, &ids, &trees)? {
+            warnings.extend(shared.iter().map(|o| {
+                format!(
+                    "{} and {} overlap by about {:.3} mm^3: sliced together, the sections' \
+                     even-odd regions leave that material out",
+                    solid_name(&trees[o.first]),
+                    solid_name(&trees[o.second]),
+                    o.volume
+                )
+            }));
+            return Ok(Assembly {
+                trees: vec![tree],
+                warnings,
+            });
+        }
+    }
+    Ok(relate(trees, warnings))
+}
+
+/// Solids `ids` of `brep` (`trees` made of each by [`whole_part_tree`]) as a tree of ONE
+/// two5d feature: every outer shell's faces with every void shell, on the build plate along
+/// +Z, its volume and area the solids' sums, `closed` when each is a valid solid. `None` when
+/// there is no solid.
+fn solids_together(
+    brep: &Brep,
+    ids: &[SolidId],
+    trees: &[FeatureTree],
+) -> Result<Option<FeatureTree>, ExtractError> {
+    let (mut faces, mut voids) = (vec![], vec![]);
+    for &s in ids {
+        let shells = &brep.solids[s.idx()].shells;
+        if let Some(outer) = shells.first() {
+            faces.extend(brep.shells[outer.idx()].faces.iter().copied());
+        }
+        voids.extend(
+            shells
+                .iter()
+                .skip(1)
+                .map(|v| brep.shells[v.idx()].faces.clone()),
+        );
+    }
+    let Some((&solid, first)) = ids.first().zip(trees.first()) else {
+        return Ok(None);
+    };
+    let shell = brep.solids[solid.idx()].shells[0];
+    let mut all_faces = faces.clone();
+    all_faces.extend(voids.iter().flatten().copied());
+    let mut bbox = first.mesh.bbox();
+    for t in &trees[1..] {
+        let b = t.mesh.bbox();
+        bbox.min = bbox.min.inf(&b.min);
+        bbox.max = bbox.max.sup(&b.max);
+    }
+    let mesh = brep::mesh::mesh_faces(
+        brep,
+        &all_faces,
+        &analysis_options(bbox.diagonal().max(MIN_DIAG)),
+    )
+    .map_err(crate::measure::MeasureError::from)?;
+    let part_volume: f64 = trees.iter().map(|t| t.part_volume).sum();
+    let problems: Vec<_> = trees
+        .iter()
+        .flat_map(|t| t.features[0].problems.iter().cloned())
+        .collect();
+    let warnings = trees
+        .iter()
+        .flat_map(|t| {
+            let name = solid_name(t);
+            t.warnings.iter().map(move |w| format!("{name}: {w}"))
+        })
+        .collect();
+    let feature = Feature {
+        id: 0,
+        kind: FeatureKind::Two5d,
+        subtype: WHOLE_PART.to_string(),
+        reference: plate_reference(),
+        parents: vec![],
+        faces,
+        voids,
+        heal_faces: vec![],
+        shell,
+        volume: part_volume,
+        root_loops: 0,
+        depth: 0,
+        closed: trees.iter().all(|t| t.features[0].closed),
+        problems,
+    };
+    Ok(Some(FeatureTree {
+        brep: brep.clone(),
+        solid,
+        features: vec![feature],
+        build_order: vec![0],
+        depth: 0,
+        part_volume,
+        part_area: trees.iter().map(|t| t.part_area).sum(),
+        part_faces: trees.iter().map(|t| t.part_faces).sum(),
+        genus: None,
+        mesh,
+        roots: vec![],
+        warnings,
+    }))
+}
+
+/// Solids are sliced together ([`solids_together`]) while the material they share is at most
+/// this share of their volume: left out of the sections, it stays well inside the
+/// self-check's ±3 % (twice the share at worst: counted in the volume, laid nowhere).
+const TOGETHER_OVERLAP_SHARE: f64 = 0.005;
+
+/// The smallest box diagonal (mm) an analysis mesh is sized for.
+const MIN_DIAG: f64 = 1e-3;
+
+/// What a whole-part feature is built on: the build plate, along +Z, with no face.
+fn plate_reference() -> Reference {
+    Reference {
+        surface: "build_plate".into(),
+        face: None,
+        step_face: None,
+        normal: Some(PLUS_Z),
+    }
 }
 
 /// Whether every tree of `assembly` is a solid planned whole ([`whole_part_features`]).
@@ -68,12 +202,7 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
         id: 0,
         kind: FeatureKind::Two5d,
         subtype: WHOLE_PART.to_string(),
-        reference: Reference {
-            surface: "build_plate".into(),
-            face: None,
-            step_face: None,
-            normal: Some(PLUS_Z),
-        },
+        reference: plate_reference(),
         parents: vec![],
         faces: outer,
         voids,

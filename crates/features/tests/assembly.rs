@@ -148,3 +148,30 @@ fn shapr3d_impeller_bodies_skip_the_sliver_and_report_each_blade_in_the_hub() {
         a.warnings
     );
 }
+
+/// Planned whole (`slicing = "planar"`), solids that do not overlap are one feature sliced in
+/// the same layers; solids that overlap stay one feature each, the overlap reported.
+#[test]
+fn whole_part_slices_separate_solids_together_and_overlapping_ones_apart() {
+    let two = brep::read_step(fixture("two_solids.step")).expect("reads");
+    let a = features::whole_part_features(&two.brep).expect("whole part");
+    assert_eq!(a.trees.len(), 1);
+    let t = &a.trees[0];
+    assert_eq!(t.features.len(), 1);
+    let f = &t.features[0];
+    assert!(f.closed);
+    // Two boxes of 4000 and 3000 mm^3, 12 faces in all.
+    assert!((f.volume - 7000.0).abs() < 7.0, "{}", f.volume);
+    assert_eq!(f.faces.len(), 12);
+    let b = t.mesh.bbox();
+    assert!(b.min.x.abs() < 1e-6 && (b.max.x - 50.0).abs() < 1e-6 && (b.max.z - 30.0).abs() < 1e-6);
+
+    let stacked = brep::read_step(fixture("stacked_solids.step")).expect("reads");
+    let a = features::whole_part_features(&stacked.brep).expect("whole part");
+    assert_eq!(a.trees.len(), 4);
+    assert!(
+        a.warnings.iter().any(|w| w.contains("overlap")),
+        "{:?}",
+        a.warnings
+    );
+}
