@@ -80,12 +80,15 @@ pub(crate) fn assemble(
     ))
 }
 
+/// A solid of a B-rep and the tree made of it.
+pub(crate) type SolidTree = (SolidId, FeatureTree);
+
 /// Each solid of `brep` that encloses a volume with the tree `tree_of` made of it, lowest
 /// first; a warning for each solid skipped as empty. An error when none encloses a volume.
 pub(crate) fn solid_trees(
     brep: &Brep,
     tree_of: impl Fn(&Brep, SolidId) -> Result<FeatureTree, ExtractError>,
-) -> Result<(Vec<(SolidId, FeatureTree)>, Vec<String>), ExtractError> {
+) -> Result<(Vec<SolidTree>, Vec<String>), ExtractError> {
     let mut trees = vec![];
     let mut warnings = vec![];
     let mut empty = vec![];
