@@ -93,9 +93,26 @@ pub struct P21File {
     pub header: Vec<Record>,
     /// The entities of all DATA sections, in file order.
     pub entities: Vec<Entity>,
+    /// Lines of the HEADER section that hold no record and were skipped (a merge-conflict
+    /// marker, a stray word): the header carries no geometry, so they do not stop the reading.
+    pub header_skipped: Vec<SkippedLine>,
     /// Instance id to position in `entities`, built while parsing.
     pub(super) index: HashMap<u64, usize>,
 }
+
+/// A line of the HEADER section that was skipped ([`P21File::header_skipped`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkippedLine {
+    /// 1-based line number.
+    pub line: u32,
+    /// The line's text, trimmed and cut to [`SKIPPED_TEXT`] characters.
+    pub text: String,
+    /// Why it is not a record.
+    pub cause: String,
+}
+
+/// Characters of a skipped header line kept in [`SkippedLine::text`].
+pub const SKIPPED_TEXT: usize = 60;
 
 impl P21File {
     /// The entity `#id`, if the file defines it. Uses the index built by

@@ -1,7 +1,9 @@
 //! Records, entities and sections, on top of the lexer's tokens.
 
 use super::lexer::{describe, is_kw_char, is_kw_start, upper, Parser};
-use super::model::{Entity, Instance, P21Error, P21File, Param, Record, MAX_DEPTH};
+use super::model::{
+    Entity, Instance, P21Error, P21File, Param, Record, SkippedLine, MAX_DEPTH, SKIPPED_TEXT,
+};
 use std::collections::HashMap;
 
 /// Parse a complete exchange file from raw bytes.
@@ -59,7 +61,7 @@ impl<'a> Parser<'a> {
             return Err(self.unexpected("expected header section"));
         }
         self.expect(b';', "expected ';' after header")?;
-        let header = self.header_records()?;
+        let (header, header_skipped) = self.header_records()?;
 
         // Real files average about 70 bytes per entity; the cap keeps a huge
         // file of mostly whitespace from reserving memory it never uses.
@@ -92,35 +94,75 @@ impl<'a> Parser<'a> {
         Ok(P21File {
             header,
             entities,
+            header_skipped,
             index,
         })
     }
 
-    /// Header records up to and including `ENDSEC;`.
-    fn header_records(&mut self) -> Result<Vec<Record>, P21Error> {
+    /// Header records up to and including `ENDSEC;`, and the lines skipped as no record.
+    ///
+    /// A line that does not parse as a record (a merge-conflict marker such as `<<<<<<< HEAD`,
+    /// a stray word) is skipped from where the record started to the end of its line, and
+    /// listed: the header carries no geometry. The DATA section stays strict; a `DATA`
+    /// keyword or an entity `#id` where a header record belongs is still an error (the
+    /// header's `ENDSEC;` is missing).
+    fn header_records(&mut self) -> Result<(Vec<Record>, Vec<SkippedLine>), P21Error> {
         let mut out = Vec::new();
+        let mut skipped = Vec::new();
         loop {
             self.skip_ws()?;
-            match self.peek() {
+            let (start, line) = (self.pos, self.line);
+            let cause = match self.peek() {
                 None => return Err(self.truncated()),
                 Some(c) if is_kw_start(c) => {
                     let kw = self.keyword()?;
                     if kw.eq_ignore_ascii_case(b"ENDSEC") {
                         self.expect(b';', "expected ';' after endsec")?;
-                        return Ok(out);
+                        return Ok((out, skipped));
                     }
-                    let rec = self.record_body(kw)?;
-                    self.expect(b';', "expected ';' after header record")?;
-                    out.push(rec);
+                    if kw.eq_ignore_ascii_case(b"DATA") {
+                        return Err(self.syntax("expected header record or endsec, found DATA"));
+                    }
+                    let rec = self.record_body(kw).and_then(|rec| {
+                        self.expect(b';', "expected ';' after header record")
+                            .map(|()| rec)
+                    });
+                    match rec {
+                        Ok(rec) => {
+                            out.push(rec);
+                            continue;
+                        }
+                        Err(e @ P21Error::Truncated { .. }) => return Err(e),
+                        Err(P21Error::Syntax { msg, .. }) => msg,
+                        Err(e) => e.to_string(),
+                    }
                 }
-                Some(c) => {
-                    return Err(self.syntax(&format!(
-                        "expected header record or endsec, found {}",
-                        describe(c)
-                    )))
+                Some(b'#') => {
+                    return Err(self.syntax("expected header record or endsec, found '#'"));
                 }
+                Some(c) => format!("expected header record or endsec, found {}", describe(c)),
+            };
+            self.entity = None;
+            self.pos = start;
+            self.line = line;
+            let text = self.rest_of_line();
+            skipped.push(SkippedLine { line, text, cause });
+        }
+    }
+
+    /// The text from `pos` to the end of its line (trimmed, at most [`SKIPPED_TEXT`]
+    /// characters); `pos` moves past the line's end.
+    fn rest_of_line(&mut self) -> String {
+        let start = self.pos;
+        while let Some(c) = self.peek() {
+            self.pos += 1;
+            if c == b'\n' {
+                self.newline();
+                break;
             }
         }
+        let raw = String::from_utf8_lossy(self.slice(start, self.pos));
+        raw.trim().chars().take(SKIPPED_TEXT).collect()
     }
 
     /// `( params )` after a record name `kw` already consumed.

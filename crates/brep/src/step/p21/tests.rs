@@ -611,3 +611,48 @@ fn an_stl_mesh_is_named_as_one() {
     binary.pop();
     assert_eq!(parse(&binary).unwrap_err(), P21Error::NotPart21);
 }
+
+/// A header left with a merge conflict (markers and two FILE_NAME records) is read: the marker
+/// lines are skipped and listed with their line numbers, the records kept.
+#[test]
+fn header_lines_that_are_no_record_are_skipped_and_listed() {
+    let text = "ISO-10303-21;\nHEADER;\n\
+        FILE_DESCRIPTION(('test'),'2;1');\n\
+        <<<<<<< HEAD\n\
+        FILE_NAME('a.step','2024-01-01T00:00:00',(''),(''),'','','');\n\
+        =======\n\
+        FILE_NAME('b.step','2024-01-02T00:00:00',(''),(''),'','','');\n\
+        >>>>>>> other\n\
+        FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\n\
+        STRAY WORDS HERE\n\
+        ENDSEC;\nDATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n";
+    let f = parse(text.as_bytes()).expect("parses");
+    let names: Vec<&str> = f.header.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["FILE_DESCRIPTION", "FILE_NAME", "FILE_NAME", "FILE_SCHEMA"]
+    );
+    let lines: Vec<u32> = f.header_skipped.iter().map(|s| s.line).collect();
+    assert_eq!(lines, [4, 6, 8, 10]);
+    assert_eq!(f.header_skipped[0].text, "<<<<<<< HEAD");
+    assert_eq!(f.header_skipped[3].text, "STRAY WORDS HERE");
+    assert_eq!(f.entities.len(), 1);
+}
+
+/// The DATA section stays strict, and a header that never ends is still an error.
+#[test]
+fn a_header_without_endsec_and_a_broken_entity_are_still_errors() {
+    let no_endsec = "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('t'),'2;1');\n\
+        DATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n";
+    match parse(no_endsec.as_bytes()) {
+        Err(P21Error::Syntax { line, msg }) => {
+            assert_eq!(line, 4);
+            assert!(msg.contains("DATA"), "{msg}");
+        }
+        other => panic!("{other:?}"),
+    }
+    match parse(wrap("<<<<<<< HEAD\n#1=CARTESIAN_POINT('',(0.,0.,0.));").as_bytes()) {
+        Err(P21Error::Syntax { line, .. }) => assert_eq!(line, 8),
+        other => panic!("{other:?}"),
+    }
+}

@@ -91,6 +91,12 @@ pub fn translate_turned(file: &P21File, turn: Option<[[f64; 3]; 3]>) -> R<Brep> 
         ));
     }
     t.brep.units = unit_names;
+    for l in &file.header_skipped {
+        t.brep.warnings.push(format!(
+            "line {}: header line `{}` skipped: {}",
+            l.line, l.text, l.cause
+        ));
+    }
     // Entities of no schema the reader knows (a misspelt name): skipped, but said.
     let unknown: Vec<(u64, &str)> = file
         .entities
