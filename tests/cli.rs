@@ -818,3 +818,50 @@ fn extract_text_tree_shows_the_chain() {
     assert!(text.contains("└─ feature 1"), "{text}");
     assert!(text.contains("   └─ feature 2"), "{text}");
 }
+
+/// A file whose header holds a merge conflict and whose data holds an entity of no schema
+/// (that the solid does not use) is read; `extract` and `plan` both say what the reader
+/// skipped, on stderr or stdout and in their JSON.
+#[test]
+fn the_readers_warnings_reach_extract_and_plan() {
+    let dir = TempDir::new("reader-warnings");
+    let text = std::fs::read_to_string(fixture("box.step")).expect("box.step");
+    let text = text
+        .replacen("HEADER;\n", "HEADER;\n<<<<<<< HEAD\n", 1)
+        .replacen("DATA;\n", "DATA;\n#999999=MISSPELT_ENTITY_NAME('x');\n", 1);
+    assert!(text.contains("<<<<<<<") && text.contains("MISSPELT"));
+    let part = dir.write("conflict.step", text.as_bytes());
+    let said = |all: &str| {
+        all.contains("line 3: header line `<<<<<<< HEAD` skipped")
+            && all.contains("#999999: unknown entity MISSPELT_ENTITY_NAME")
+    };
+
+    let extract = run(&["extract".as_ref(), part.as_os_str()]);
+    assert_eq!(extract.status.code(), Some(0), "{}", stderr(&extract));
+    let shown = format!("{}{}", stdout(&extract), stderr(&extract));
+    assert!(said(&shown), "{shown}");
+    let json = run(&["extract".as_ref(), part.as_os_str(), "--json".as_ref()]);
+    assert_eq!(json.status.code(), Some(0), "{}", stderr(&json));
+    let v: Value = serde_json::from_slice(&json.stdout).expect("json");
+    let warnings = v["warnings"].to_string();
+    assert!(said(&warnings), "{warnings}");
+
+    let out = dir.path("plan");
+    let plan = run(&[
+        "plan".as_ref(),
+        part.as_os_str(),
+        "--machine".as_ref(),
+        "marlin".as_ref(),
+        "--orient".as_ref(),
+        "modelled".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(plan.status.code(), Some(0), "{}", stderr(&plan));
+    assert!(said(&stderr(&plan)), "{}", stderr(&plan));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).expect("plan.json"))
+            .expect("json");
+    let warnings = report["warnings"].to_string();
+    assert!(said(&warnings), "{warnings}");
+}

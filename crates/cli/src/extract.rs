@@ -21,7 +21,16 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     let assembly =
         extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
-    let warnings = assembly.all_warnings();
+    // The reader's warnings (skipped header lines, unknown entities, faces turned round) first.
+    let mut warnings = part.brep.warnings.clone();
+    warnings.extend(assembly.all_warnings());
+    let together: Vec<String> = part
+        .brep
+        .warnings
+        .iter()
+        .chain(&assembly.warnings)
+        .cloned()
+        .collect();
     let mut solids = vec![];
     let mut offset = 0;
     for tree in assembly.trees {
@@ -45,7 +54,7 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
         t.push('\n');
         t
     } else {
-        to_text(&source, &solids, &assembly.warnings)
+        to_text(&source, &solids, &together)
     };
     emit(&text)
 }

@@ -88,7 +88,14 @@ pub fn arrange(
     process: &Process,
     machine: &MachineProfile,
 ) -> Result<Extracted, PlanError> {
-    let (assembly, slicing, warnings) = choose_slicing(assembly, brep, process, machine.kind)?;
+    let (assembly, slicing, chosen) = choose_slicing(assembly, brep, process, machine.kind)?;
+    // The reader's warnings first: what it skipped or mended in the file.
+    let mut warnings: Vec<Warning> = brep
+        .warnings
+        .iter()
+        .map(|w| Warning::part(WarningKind::Reader(w.clone())))
+        .collect();
+    warnings.extend(chosen);
     let trees = &assembly.trees;
     process.validate_feature_ids(trees.iter().map(|t| t.features.len()).sum())?;
     let plates = trees

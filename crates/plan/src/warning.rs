@@ -17,6 +17,9 @@ pub struct Warning {
 pub enum WarningKind {
     /// A feature's planner said this (the slicer's own warnings).
     Planner(String),
+    /// The STEP reader said this of the file (skipped header lines, unknown entities, faces
+    /// turned round, edge ends off their curves).
+    Reader(String),
     /// Extraction said this of the part (overlapping or floating solids, kept loops).
     Extraction(String),
     /// The post said this of the program.
@@ -97,6 +100,7 @@ impl std::fmt::Display for Warning {
         let id = self.feature.unwrap_or_default();
         match &self.kind {
             WarningKind::Planner(t)
+            | WarningKind::Reader(t)
             | WarningKind::Extraction(t)
             | WarningKind::Post(t)
             | WarningKind::Collisions(t)
