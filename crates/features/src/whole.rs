@@ -14,7 +14,7 @@ use crate::assembly::{overlaps, relate, solid_name, solid_trees, Assembly};
 use crate::extract::{ExtractError, Feature, FeatureKind, FeatureTree, Reference};
 use crate::measure::{measure, Measured};
 use brep::solid::analysis_options;
-use brep::topology::{Brep, SolidId};
+use brep::topology::{Brep, FaceId, ShellId, SolidId};
 
 /// The `subtype` of a solid planned whole.
 pub const WHOLE_PART: &str = "whole_part";
@@ -104,22 +104,14 @@ fn solids_together(
             t.warnings.iter().map(move |w| format!("{name}: {w}"))
         })
         .collect();
-    let feature = Feature {
-        id: 0,
-        kind: FeatureKind::Two5d,
-        subtype: WHOLE_PART.to_string(),
-        reference: plate_reference(),
-        parents: vec![],
+    let feature = whole_feature(
         faces,
         voids,
-        heal_faces: vec![],
         shell,
-        volume: part_volume,
-        root_loops: 0,
-        depth: 0,
-        closed: trees.iter().all(|t| t.features[0].closed),
+        part_volume,
+        trees.iter().all(|t| t.features[0].closed),
         problems,
-    };
+    );
     Ok(Some(FeatureTree {
         brep: brep.clone(),
         solid,
@@ -143,6 +135,33 @@ const TOGETHER_OVERLAP_SHARE: f64 = 0.005;
 
 /// The smallest box diagonal (mm) an analysis mesh is sized for.
 const MIN_DIAG: f64 = 1e-3;
+
+/// A whole-part feature (id 0, two5d, on the build plate) of shell faces `faces` with `voids`.
+fn whole_feature(
+    faces: Vec<FaceId>,
+    voids: Vec<Vec<FaceId>>,
+    shell: ShellId,
+    volume: f64,
+    closed: bool,
+    problems: Vec<crate::check::SolidProblem>,
+) -> Feature {
+    Feature {
+        id: 0,
+        kind: FeatureKind::Two5d,
+        subtype: WHOLE_PART.to_string(),
+        reference: plate_reference(),
+        parents: vec![],
+        faces,
+        voids,
+        heal_faces: vec![],
+        shell,
+        volume,
+        root_loops: 0,
+        depth: 0,
+        closed,
+        problems,
+    }
+}
 
 /// What a whole-part feature is built on: the build plate, along +Z, with no face.
 fn plate_reference() -> Reference {
@@ -198,22 +217,7 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
             voids.len()
         ));
     }
-    let feature = Feature {
-        id: 0,
-        kind: FeatureKind::Two5d,
-        subtype: WHOLE_PART.to_string(),
-        reference: plate_reference(),
-        parents: vec![],
-        faces: outer,
-        voids,
-        heal_faces: vec![],
-        shell: outer_shell,
-        volume: part_volume,
-        root_loops: 0,
-        depth: 0,
-        closed,
-        problems,
-    };
+    let feature = whole_feature(outer, voids, outer_shell, part_volume, closed, problems);
     Ok(FeatureTree {
         brep: b,
         solid,
