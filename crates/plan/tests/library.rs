@@ -208,6 +208,7 @@ fn same_in_pieces_of_any_size(plan: &plan::Plan, m: &MachineProfile) {
         source: "part.step",
         stem: "part",
         notes: &notes,
+        ..Job::default()
     };
     let whole = m.post().post(&plan.toolpath, &job).expect("posted");
     assert!(!whole.files.is_empty());
@@ -267,6 +268,7 @@ fn held_text_is_bounded(plan: &plan::Plan, m: &MachineProfile, file: &str) {
         source: "part.step",
         stem: "part",
         notes: &[],
+        ..Job::default()
     };
     let mut sink = Counting::default();
     m.post()
