@@ -126,9 +126,12 @@ pub fn block(m: &MachineProfile, path: &ToolPath, extra: &[(String, String)]) ->
     if let Some(d) = m.filament_density {
         keys.push(("filament_density".into(), n(d)));
     }
+    let sane = |t: &f64| *t > 0.0 && *t <= m.bed_size[2];
     if let Some((first, common)) = layer_heights(path) {
-        keys.push(("first_layer_height".into(), n(first)));
-        keys.push(("layer_height".into(), n(common)));
+        if let (true, true) = (sane(&first), sane(&common)) {
+            keys.push(("first_layer_height".into(), n(first)));
+            keys.push(("layer_height".into(), n(common)));
+        }
     }
     let travel = m.travel_acceleration.or(m.max_acceleration);
     let limits = [

@@ -106,7 +106,11 @@ pub fn marlin_job_to(
     let mut file = Chunked::open(sink, "program.gcode")?;
 
     let mut w = Writer::new(m);
-    let first_layer = config::layer_heights(path).map_or(crate::custom::PURGE_THICKNESS, |h| h.0);
+    // The purge line's height: the first layer's, when a nozzle can lay it.
+    let first_layer = config::layer_heights(path)
+        .map(|h| h.0)
+        .filter(|&t| t > 0.0 && t <= m.nozzle_diameter)
+        .unwrap_or(crate::custom::PURGE_THICKNESS);
     w.header(m, job.source, offset, first_layer);
     insert_notes(&mut w.out, job.notes);
     let machine = |q: &PathPoint| [0, 1, 2].map(|k| ((q.p[k] + offset[k]) * 1e3).round() / 1e3);
