@@ -2,6 +2,7 @@
 //! the header's part offset, and the rows of `toolpath.csv`.
 
 /// The program's `G0`/`G1` moves, as (rapid, `[X, Y, Z, B, C]` after the move, E), modal.
+#[allow(dead_code)]
 pub fn moves(program: &str) -> Vec<(bool, [f64; 5], Option<f64>)> {
     let mut at = [0.0f64; 5];
     let mut out = vec![];

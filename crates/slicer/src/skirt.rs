@@ -66,7 +66,7 @@ fn outlines(regions: &[Region]) -> Vec<Region> {
 /// Brim loops a `bead` apart touching `footprint` outward: as many as fit in `width` mm (one
 /// at least when `width` is above 0), the outermost first.
 fn brim(footprint: &[Region], width: f64, bead: f64, tol: f64) -> Vec<AdhesionLoop> {
-    if !(width > 0.0) || footprint.is_empty() {
+    if width.is_nan() || width <= 0.0 || footprint.is_empty() {
         return vec![];
     }
     let n = ((width / bead).round() as usize).max(1);
