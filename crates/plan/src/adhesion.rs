@@ -9,9 +9,12 @@
 //! with that point's feature and layer (so a program begins no layer of its own for them),
 //! roles `skirt` and `brim`: not the part's, so the self-check, which compares what each
 //! feature's planner laid, never counts them; nor do the features' `points` in `plan.json`.
-//! Other machines get neither (their first layers may lie tilted on a turning table).
+//! Other machines get neither (their first layers may lie tilted on a turning table). Where
+//! they would make the print wider or deeper than the bed, they are left out with a warning
+//! rather than the part refused.
 
 use crate::report::{round, AdhesionEntry};
+use crate::warning::{Warning, WarningKind};
 use collide::Collision;
 use robot_post::machine::{MachineKind, MachineProfile};
 use slicer::geom2d::Point2;
@@ -26,24 +29,36 @@ pub const PLATE_SLACK: f64 = 0.01;
 const VERTICAL: f64 = 1e-6;
 
 /// Adds the skirt and brim `params` asks for to `toolpath` on `machine` (Marlin only), and
-/// moves the path indices of `collisions` past them. `None` when nothing was added.
+/// moves the path indices of `collisions` past them. `Ok(None)` when nothing was asked or
+/// there is no first layer to lay them around; `Err` (a warning of the part) when they would
+/// not fit the bed with the part, and were left out.
 pub fn lay(
     toolpath: &mut ToolPath,
     collisions: &mut [Collision],
     params: &LayerParams,
     machine: &MachineProfile,
-) -> Option<AdhesionEntry> {
+) -> Result<Option<AdhesionEntry>, Warning> {
     if machine.kind != MachineKind::Marlin
         || (params.skirt_loops == 0 && params.brim_width_mm <= 0.0)
     {
-        return None;
+        return Ok(None);
     }
-    let first = FirstLayer::of(toolpath)?;
+    let Some(first) = FirstLayer::of(toolpath) else {
+        return Ok(None);
+    };
     let bead = machine.bead();
     let foot = footprint(&first.rings(toolpath), bead.width, params.tolerance);
     let loops = loops(&foot, params, bead.width);
     if loops.is_empty() {
-        return None;
+        return Ok(None);
+    }
+    // The beads' outer edges, as the post measures the fit.
+    let extent = extent(toolpath, &loops).map(|e| e + bead.width);
+    if extent[0] > machine.bed_size[0] || extent[1] > machine.bed_size[1] {
+        return Err(Warning::part(WarningKind::Planner(format!(
+            "skirt and brim left out: with them the print is {:.1} x {:.1} mm, more than the {:.0} x {:.0} mm bed (lower skirt_distance_mm or brim_width_mm, or set skirt_loops = 0)",
+            extent[0], extent[1], machine.bed_size[0], machine.bed_size[1]
+        ))));
     }
     let at = first.start;
     let anchor = toolpath.points[at];
@@ -78,13 +93,33 @@ pub fn lay(
         c.index += n;
     }
     let count = |role| loops.iter().filter(|l| l.role == role).count();
-    Some(AdhesionEntry {
+    Ok(Some(AdhesionEntry {
         skirt_loops: count(Role::Skirt),
         brim_loops: count(Role::Brim),
         points: n,
         length_mm: round(length, 1e1),
         volume_mm3: round(filament * bead.filament_area(), 1e3),
-    })
+    }))
+}
+
+/// The X and Y extent of the bead centres of `path` and of `loops` together, mm.
+fn extent(path: &ToolPath, loops: &[slicer::skirt::AdhesionLoop]) -> [f64; 2] {
+    let xy = path
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .map(|q| [q.p[0], q.p[1]])
+        .chain(loops.iter().flat_map(|l| l.points.iter().copied()));
+    let (lo, hi) = xy.fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        },
+    );
+    [hi[0] - lo[0], hi[1] - lo[1]]
 }
 
 /// Where the first layer lies in a tool path.
@@ -208,6 +243,77 @@ fn convex_hull(mut points: Vec<Point2>) -> Vec<Point2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A square plate's first layer: its outer ring (an external perimeter) and a line of
+    /// infill, `size` mm across, at the bed's middle.
+    fn plate(size: f64) -> ToolPath {
+        let q = |kind, x: f64, y: f64, role| PathPoint {
+            feature: 0,
+            layer: 0,
+            kind,
+            p: [x, y, 0.2],
+            axis: [0.0, 0.0, 1.0],
+            e: 0.01,
+            thickness: 0.2,
+            width: 0.45,
+            role,
+        };
+        let h = size / 2.0;
+        let ring = [[-h, -h], [h, -h], [h, h], [-h, h], [-h, -h]];
+        let mut points: Vec<PathPoint> = ring
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let kind = if k == 0 {
+                    MoveKind::Travel
+                } else {
+                    MoveKind::Print
+                };
+                q(kind, p[0], p[1], Role::ExternalPerimeter)
+            })
+            .collect();
+        points.push(q(MoveKind::Travel, -1.0, 0.0, Role::SolidInfill));
+        points.push(q(MoveKind::Print, 1.0, 0.0, Role::SolidInfill));
+        ToolPath { points }
+    }
+
+    #[test]
+    fn the_skirt_goes_first_around_the_first_layer_unless_the_bed_is_too_small() {
+        let m = MachineProfile::builtin(MachineKind::Marlin);
+        let params = LayerParams::default();
+        let mut path = plate(20.0);
+        let before = path.points.len();
+        let mut collisions = [];
+        let entry = lay(&mut path, &mut collisions, &params, &m)
+            .expect("fits")
+            .expect("a skirt");
+        assert_eq!((entry.skirt_loops, entry.brim_loops), (1, 0));
+        assert_eq!(path.points.len(), before + entry.points);
+        // The skirt first, on the first layer, 6 mm and half a bead out from the ring's
+        // outer edge (a 20.45 mm square grown by 6.225 mm: the sides and round corners).
+        let skirt = &path.points[..entry.points];
+        assert!(skirt.iter().all(|q| q.role == Role::Skirt && q.p[2] == 0.2));
+        assert_eq!(skirt[0].kind, MoveKind::Travel);
+        let want = 4.0 * 20.0 + 2.0 * std::f64::consts::PI * 6.45;
+        assert!((entry.length_mm - want).abs() < 0.2, "{}", entry.length_mm);
+        assert_eq!(path.points[entry.points].role, Role::ExternalPerimeter);
+        // A plate as wide as the bed leaves no room: left out with a warning.
+        let mut wide = plate(m.bed_size[0] - 1.0);
+        let w = lay(&mut wide, &mut collisions, &params, &m).expect_err("too wide");
+        assert!(w.to_string().contains("skirt and brim left out"), "{w}");
+        assert_eq!(wide.points.len(), before);
+        // None asked, none on another machine.
+        let none = LayerParams {
+            skirt_loops: 0,
+            ..LayerParams::default()
+        };
+        assert_eq!(lay(&mut plate(20.0), &mut collisions, &none, &m), Ok(None));
+        let d5 = MachineProfile::builtin(MachineKind::Delta5);
+        assert_eq!(
+            lay(&mut plate(20.0), &mut collisions, &params, &d5),
+            Ok(None)
+        );
+    }
 
     #[test]
     fn the_hull_of_a_square_and_its_inside() {

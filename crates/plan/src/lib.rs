@@ -263,17 +263,22 @@ fn run(
         &laid.features,
         options,
     )?;
+    let mut warnings = laid.warnings;
     let adhesion = adhesion::lay(
         &mut checked.toolpath,
         &mut checked.avoided.left,
         &process.base(),
         machine,
-    );
+    )
+    .unwrap_or_else(|w| {
+        warnings.push(w);
+        None
+    });
     let stages = assemble::Stages {
         extracted,
         placement,
         features: laid.features,
-        warnings: laid.warnings,
+        warnings,
         checked,
         adhesion,
     };
