@@ -450,8 +450,11 @@ fn check_part(file: &str, run: usize) -> Vec<String> {
         if c.len() < 12 || c[2] != "print" {
             continue;
         }
-        // Support material lies outside the part, under its overhangs.
-        if c.get(12).is_some_and(|r| r.starts_with("support_material")) {
+        // Support material lies outside the part, under its overhangs; skirt and brim
+        // around it.
+        if c.get(12).is_some_and(|r| {
+            r.starts_with("support_material") || matches!(*r, "skirt" | "brim")
+        }) {
             continue;
         }
         let num = |k: usize| c[k].parse::<f64>().unwrap_or(f64::NAN);

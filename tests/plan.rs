@@ -132,8 +132,13 @@ fn extruded_volume_matches_the_part_and_points_are_inside() {
             .collect();
         let rs = rows(&csv);
         let mut outside = 0;
-        // The part's beads (support material lies outside it, under its overhangs).
-        for r in rs.iter().filter(|r| r.print && !r.support).step_by(7) {
+        // The part's beads (support material lies outside it, under its overhangs; the skirt
+        // and brim around it).
+        for r in rs
+            .iter()
+            .filter(|r| r.print && !r.support && !r.adhesion)
+            .step_by(7)
+        {
             let q = brep::math::P3::new(
                 r.p[0] - 0.5 * r.thickness * r.axis[0],
                 r.p[1] - 0.5 * r.thickness * r.axis[1],

@@ -944,7 +944,11 @@ fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
         program.matches(";LAYER_CHANGE\n;Z:").count(),
         layers as usize
     );
-    assert_eq!(program.matches(";HEIGHT:0.200\n").count(), layers as usize);
+    // Each layer's, and the start G-code's (its purge line lies on the first layer).
+    assert_eq!(
+        program.matches(";HEIGHT:0.200\n").count(),
+        layers as usize + 1
+    );
     assert!(program.contains(";WIDTH:0.450\n"));
     // The filament is the sum of the tool path's E; its mass by PLA's density.
     let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
@@ -983,9 +987,10 @@ fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
 
 /// PrusaSlicer's G-code viewer colours moves by the `;TYPE:` above them: every print move of
 /// a Marlin plan of plate_boss_boss lies under one (written again in each layer) naming a role
-/// PrusaSlicer knows; the beads reaching farthest out in X and Y on every layer are the
-/// outermost rings, `External perimeter`; and toolpath.csv's last column, `role`, holds the
-/// same roles (as many print points of each as the program has print moves under it).
+/// PrusaSlicer knows; the part's beads reaching farthest out in X and Y on every layer (the
+/// skirt, `Skirt/Brim`, lies around the first) are the outermost rings, `External
+/// perimeter`; and toolpath.csv's last column, `role`, holds the same roles (as many print
+/// points of each as the program has print moves under it).
 #[test]
 fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
     let s = Scratch::new("types");
@@ -1002,14 +1007,15 @@ fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
         "Solid infill",
         "Internal infill",
         "Gap fill",
+        "Skirt/Brim",
     ];
     let mut role: Option<String> = None;
     let mut layers = 0usize;
     // Per layer: the print moves' (x, y, type).
     let mut moves: Vec<Vec<(f64, f64, String)>> = vec![];
     let mut per_type = std::collections::BTreeMap::<String, usize>::new();
-    // The planned moves: between the profile's start_gcode (its purge line prints, untyped)
-    // and its end_gcode.
+    // The planned moves: between the profile's start_gcode (its purge line prints, under
+    // `Skirt/Brim` too) and its end_gcode.
     for line in program
         .lines()
         .skip_while(|l| *l != "; end of start_gcode")
@@ -1051,6 +1057,7 @@ fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
         let far = |key: &dyn Fn(&(f64, f64, String)) -> f64| {
             layer
                 .iter()
+                .filter(|m| m.2 != "Skirt/Brim")
                 .max_by(|a, b| key(a).total_cmp(&key(b)))
                 .map(|m| m.2.clone())
                 .unwrap()
@@ -1084,6 +1091,7 @@ fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
                 "solid_infill" => "Solid infill",
                 "internal_infill" => "Internal infill",
                 "gap_fill" => "Gap fill",
+                "skirt" | "brim" => "Skirt/Brim",
                 other => panic!("role {other}"),
             };
             *csv_types.entry(name.to_string()).or_default() += 1;

@@ -5,6 +5,8 @@
 
 #[path = "common/cli.rs"]
 mod cli;
+#[path = "common/readback.rs"]
+mod readback;
 
 use cli::{fixture, plan, stderr, Scratch, BIN};
 use std::path::Path;
@@ -70,8 +72,9 @@ fn marlin_start_end_gcode_and_fan_follow_the_profile() {
         "M190 S60 ; wait for the bed",
         "G28 ; home all axes",
         "; G29 ; bed levelling",
-        "G0 X0.000 Y0.000 Z0.3 F7200 ; purge line",
-        "G1 X100 E5.61265 F1200",
+        // The purge line on the first layer's height (0.2 mm), its filament for that.
+        "G0 X0.000 Y0.000 Z0.200 F7200 ; purge line",
+        "G1 X100 E3.74177 F1200",
     ] {
         assert!(start.contains(want), "`{want}` not in:\n{start}");
     }
@@ -498,4 +501,324 @@ fn the_progress_bar_covers_the_whole_run_on_a_terminal_only() {
     // The warnings are whole lines among the bar's redraws.
     assert!(tty.contains("features: "), "{tty:?}");
     assert!(out.join("program.gcode").exists());
+}
+
+/// What PrusaSlicer's G-code viewer calls the kinds of extrusion (its `;TYPE:` names).
+const VIEWER_TYPES: [&str; 15] = [
+    "Perimeter",
+    "External perimeter",
+    "Overhang perimeter",
+    "Internal infill",
+    "Solid infill",
+    "Top solid infill",
+    "Ironing",
+    "Bridge infill",
+    "Gap fill",
+    "Skirt/Brim",
+    "Support material",
+    "Support material interface",
+    "Wipe tower",
+    "Custom",
+    "Mixed",
+];
+
+/// The Marlin program as PrusaSlicer's G-code viewer reads it (issue 33, item 5): every
+/// extruding move under a `;TYPE:` the viewer knows (none "Unknown"), the purge line among
+/// them; the layers the viewer counts (a new one wherever an extrusion's Z changes) are the
+/// program's `;LAYER_CHANGE`s and the plan's layers, the purge line adding none; the bed in
+/// the header and the config block at the end; no comment naming a slicer (the viewer would
+/// take the program for that slicer's). The skirt lies its distance around the first layer.
+#[test]
+fn the_marlin_program_reads_as_a_gcode_viewer_reads_it() {
+    let s = Scratch::new("viewer");
+    let out = s.path("o");
+    let o = plan("plate_boss_boss.step", &["-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let program = read(&out.join("program.gcode"));
+    let report: serde_json::Value =
+        serde_json::from_str(&read(&out.join("plan.json"))).expect("plan.json");
+    let moves = readback::extrusions(&program, 0.1);
+    let unknown: Vec<usize> = moves
+        .iter()
+        .filter(|x| !x.role.as_deref().is_some_and(|r| VIEWER_TYPES.contains(&r)))
+        .map(|x| x.line)
+        .collect();
+    assert!(
+        unknown.is_empty(),
+        "extrusions of no known type at lines {unknown:?}"
+    );
+    let (start, _, _) = sections(&program);
+    let purge = moves.first().expect("extrusions");
+    assert_eq!(purge.role.as_deref(), Some("Skirt/Brim"));
+    assert!(start.lines().any(|l| l.starts_with("G1 X100 E")));
+    let layers: u64 = report["features"]
+        .as_array()
+        .expect("features")
+        .iter()
+        .map(|f| f["layers"].as_u64().expect("layers"))
+        .sum();
+    let zs = readback::viewer_layers(&moves);
+    let changes = program.lines().filter(|l| *l == ";LAYER_CHANGE").count();
+    assert_eq!(
+        (zs.len() as u64, changes as u64),
+        (layers, layers),
+        "{zs:?}"
+    );
+    assert!((zs[0] - 0.2).abs() < 1e-9, "the first layer at {}", zs[0]);
+    // The bed and the settings.
+    assert!(program.contains("\n; bed_shape = 0x0,220x0,220x220,0x220\n"));
+    let block = program
+        .split("; prusaslicer_config = begin\n")
+        .nth(1)
+        .expect("config block");
+    assert!(block.ends_with("; prusaslicer_config = end\n"));
+    for want in [
+        "; bed_shape = 0x0,220x0,220x220,0x220",
+        "; printer_technology = FFF",
+        "; layer_height = 0.2",
+        "; first_layer_height = 0.2",
+        "; nozzle_diameter = 0.4",
+        "; filament_diameter = 1.75",
+        "; extrusion_width = 0.45",
+        "; skirts = 1",
+        "; arc_fitting = disabled",
+    ] {
+        assert!(
+            block.lines().any(|l| l == want),
+            "`{want}` not in:\n{block}"
+        );
+    }
+    for l in program.lines().filter(|l| l.starts_with(';')) {
+        for name in robot_post::marlin::config::VIEWER_PRODUCERS {
+            assert!(!l.contains(name), "{l}");
+        }
+    }
+    // The skirt: one loop of the first layer's beads, 6 mm (and half a bead) out from the
+    // part's first-layer beads, in plan.json and toolpath.csv, under Skirt/Brim.
+    assert_eq!(report["skirt_brim"]["skirt_loops"], 1);
+    assert_eq!(report["skirt_brim"]["brim_loops"], 0);
+    let rows = readback::rows(&read(&out.join("toolpath.csv")));
+    let skirt: Vec<&readback::Row> = rows.iter().filter(|r| r.adhesion).collect();
+    assert_eq!(
+        skirt.len() as u64,
+        report["skirt_brim"]["points"].as_u64().unwrap()
+    );
+    let first: Vec<&readback::Row> = rows
+        .iter()
+        .filter(|r| r.print && !r.adhesion && (r.p[2] - 0.2).abs() < 1e-6)
+        .collect();
+    assert!(first.len() > 100);
+    for q in skirt.iter().step_by(3) {
+        assert!((q.p[2] - 0.2).abs() < 1e-6 && (q.thickness - 0.2).abs() < 1e-6);
+        let d = first
+            .iter()
+            .map(|r| (r.p[0] - q.p[0]).hypot(r.p[1] - q.p[1]))
+            .fold(f64::INFINITY, f64::min);
+        // 6 mm from the beads' edge: 6.45 from the outer beads' centre lines, chords of
+        // 0.05 mm cutting the round corners.
+        assert!((6.35..6.5).contains(&d), "skirt point {:?} {d} mm off", q.p);
+    }
+    let skirt_moves = moves
+        .iter()
+        .filter(|x| x.role.as_deref() == Some("Skirt/Brim"))
+        .count();
+    assert!(skirt_moves > 4);
+}
+
+/// `skirt_loops`, `skirt_distance_mm` and `brim_width_mm` (issue 33): a brim of whole beads
+/// touching the part, the skirt its distance beyond it, none of either at 0; misspelt or out
+/// of range, an error naming the key.
+#[test]
+fn skirt_and_brim_follow_the_process_keys() {
+    let s = Scratch::new("brim");
+    let out = s.path("o");
+    let o = plan(
+        "plate_boss_boss.step",
+        &[
+            "--set",
+            "brim_width_mm=2",
+            "--set",
+            "skirt_loops=2",
+            "--set",
+            "skirt_distance_mm=3",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&read(&out.join("plan.json"))).expect("plan.json");
+    // 2 mm of 0.45 mm beads: 4 loops.
+    assert_eq!(report["skirt_brim"]["skirt_loops"], 2);
+    assert_eq!(report["skirt_brim"]["brim_loops"], 4);
+    // The self-check compares the part's beads only: the plan is complete.
+    assert_eq!(report["complete"], true);
+    let rows = readback::rows(&read(&out.join("toolpath.csv")));
+    let csv = read(&out.join("toolpath.csv"));
+    let roles = |role: &str| csv.lines().filter(|l| l.ends_with(role)).count();
+    assert!(roles(",brim") > 0 && roles(",skirt") > 0);
+    let first: Vec<&readback::Row> = rows
+        .iter()
+        .filter(|r| r.print && !r.adhesion && (r.p[2] - 0.2).abs() < 1e-6)
+        .collect();
+    let nearest = |q: &readback::Row| {
+        first
+            .iter()
+            .map(|r| (r.p[0] - q.p[0]).hypot(r.p[1] - q.p[1]))
+            .fold(f64::INFINITY, f64::min)
+    };
+    // The brim's innermost loop touches the part's outer beads (a bead apart, centre to
+    // centre); the skirt's innermost lies 3 mm beyond the brim's outer edge.
+    let brim = csv
+        .lines()
+        .skip(1)
+        .zip(&rows)
+        .filter(|(l, _)| l.ends_with(",brim"));
+    let d = brim.map(|(_, r)| nearest(r)).fold(f64::INFINITY, f64::min);
+    assert!(
+        (0.4..0.46).contains(&d),
+        "brim {d} mm from the part's beads"
+    );
+    let skirt = csv
+        .lines()
+        .skip(1)
+        .zip(&rows)
+        .filter(|(l, _)| l.ends_with(",skirt"));
+    let d = skirt.map(|(_, r)| nearest(r)).fold(f64::INFINITY, f64::min);
+    assert!(
+        (0.225 + 1.8 + 3.0 + 0.225 - 0.1..5.4).contains(&d),
+        "skirt {d} mm off"
+    );
+
+    let none = s.path("none");
+    let o = plan(
+        "plate_boss_boss.step",
+        &["--set", "skirt_loops=0", "-o", none.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&read(&none.join("plan.json"))).expect("plan.json");
+    assert!(report.get("skirt_brim").is_none());
+    assert!(!read(&none.join("toolpath.csv")).contains(",skirt"));
+
+    for (set, key) in [
+        ("skirt_lops=2", "skirt_loops"),
+        ("brim_width_mm=-1", "brim_width_mm"),
+        ("features.0.skirt_loops=2", "skirt_loops"),
+    ] {
+        let o = plan(
+            "plate_boss_boss.step",
+            &["--set", set, "-o", s.path("never").to_str().unwrap()],
+        );
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(key), "{set}: {err}");
+    }
+}
+
+/// Arc fitting (issue 33, item 6): with `arc_fitting = true` the perimeters of the bosses
+/// become `G2`/`G3`; read back with the arcs interpolated, the program runs along the planned
+/// path within the tolerance both ways (every planned print point near the program's path,
+/// every point of the program's path near the planned one), feeds the same filament, and is
+/// shorter.
+#[test]
+fn arcs_read_back_to_the_planned_path() {
+    let s = Scratch::new("arcs");
+    let (lines, arcs) = (s.path("lines"), s.path("arcs"));
+    for (dir, set) in [(&lines, "arc_fitting=false"), (&arcs, "arc_fitting=true")] {
+        let o = plan(
+            "plate_boss_boss.step",
+            &["--set", set, "-o", dir.to_str().unwrap()],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let program = read(&arcs.join("program.gcode"));
+    let plain = read(&lines.join("program.gcode"));
+    assert!(program.contains("; arc_fitting = emit_center\n"));
+    assert!(
+        program.len() < plain.len(),
+        "{} {}",
+        program.len(),
+        plain.len()
+    );
+    let off = readback::offset(&program);
+    let rows = readback::rows(&read(&arcs.join("toolpath.csv")));
+    let moves = readback::extrusions(&program, 0.02);
+    let (g2, g3) = (
+        program.lines().filter(|l| l.starts_with("G2 ")).count(),
+        program.lines().filter(|l| l.starts_with("G3 ")).count(),
+    );
+    assert!(g2 + g3 > 100, "{g2} G2, {g3} G3");
+    assert!(!plain
+        .lines()
+        .any(|l| l.starts_with("G2 ") || l.starts_with("G3 ")));
+    // The planned print segments and the program's, by layer height (0.001 mm).
+    type Segs = std::collections::HashMap<i64, Vec<[[f64; 2]; 2]>>;
+    let key = |z: f64| (z * 1e3).round() as i64;
+    let mut planned: Segs = Default::default();
+    for w in rows.windows(2).filter(|w| w[1].print) {
+        let m = |r: &readback::Row| [r.p[0] + off[0], r.p[1] + off[1]];
+        planned
+            .entry(key(w[1].p[2] + off[2]))
+            .or_default()
+            .push([m(&w[0]), m(&w[1])]);
+    }
+    let mut written: Segs = Default::default();
+    // The part's and the skirt's moves, after the start G-code (its purge line).
+    let own = program
+        .lines()
+        .position(|l| l == "; end of start_gcode")
+        .expect("end of start_gcode");
+    for x in moves.iter().filter(|x| x.line > own) {
+        for w in x.points.windows(2) {
+            written
+                .entry(key(w[1][2]))
+                .or_default()
+                .push([[w[0][0], w[0][1]], [w[1][0], w[1][1]]]);
+        }
+    }
+    let far = |p: [f64; 2], segs: &[[[f64; 2]; 2]]| {
+        segs.iter()
+            .map(|s| segment_distance(p, s[0], s[1]))
+            .fold(f64::INFINITY, f64::min)
+    };
+    // `tolerance` (0.05 mm) and the text's rounding.
+    let tol = 0.05 + 2e-3;
+    let mut worst: (f64, f64) = (0.0, 0.0);
+    for (z, segs) in &planned {
+        let Some(ours) = written.get(z) else {
+            panic!("no program moves at Z {z} um");
+        };
+        for s in segs.iter().step_by(5) {
+            worst.0 = worst.0.max(far(s[1], ours));
+        }
+        for s in ours.iter().step_by(5) {
+            worst.1 = worst.1.max(far(s[1], segs));
+        }
+    }
+    assert!(worst.0 <= tol && worst.1 <= tol, "{worst:?}");
+    let e = |p: &str| {
+        readback::extrusions(p, 1.0)
+            .iter()
+            .map(|x| x.e)
+            .sum::<f64>()
+    };
+    assert!(
+        (e(&program) - e(&plain)).abs() < 1e-3,
+        "{} {}",
+        e(&program),
+        e(&plain)
+    );
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
 }

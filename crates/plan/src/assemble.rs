@@ -35,8 +35,10 @@ pub struct Stages {
     pub features: Vec<LaidFeature>,
     /// The lay stage's warnings of the part.
     pub warnings: Vec<Warning>,
-    /// The head-check stage's path and collisions.
+    /// The head-check stage's path and collisions (the skirt and brim added to the path).
     pub checked: Checked,
+    /// The skirt and brim laid before the part, if any ([`crate::adhesion`]).
+    pub adhesion: Option<crate::report::AdhesionEntry>,
 }
 
 impl Stages {
@@ -57,6 +59,7 @@ impl Stages {
             features,
             warnings,
             checked,
+            adhesion,
         } = self;
         let program = posted.map(|p| p.program);
         let filament_area = machine.bead().filament_area();
@@ -99,6 +102,7 @@ impl Stages {
             slicing: extracted.slicing.as_str(),
             complete: passed.complete,
             features: reports,
+            skirt_brim: adhesion,
             warnings: texts(&all),
             estimated_time_s: round(est.time_s, 1e1),
             filament_mm: round(est.filament_mm, 1e2),

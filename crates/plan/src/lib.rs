@@ -4,7 +4,7 @@
 //!
 //! read (`brep::StepFile`) → [`place`] → [`extract`] → [`lay`] (fill and lay each feature, in
 //! parallel; then sequence them into one tool path) → [`smooth`] → [`head`] (the print head's
-//! check and avoidance) → [`gates`] (self-check, collisions; refused plans stop here) →
+//! check and avoidance; then the skirt and brim on the first layer, [`adhesion`]) → [`gates`] (self-check, collisions; refused plans stop here) →
 //! [`post`] (the program) → [`gates::after_post`] (reach, `strict`). The report is built once,
 //! from the stages' values, by [`assemble`].
 //!
@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod adhesion;
 pub mod assemble;
 pub mod collisions;
 pub mod error;
@@ -254,7 +255,7 @@ fn run(
     tell(Progress::Stage(Stage::Smooth));
     let smoothed = smooth::smooth(laid.toolpath, process, machine);
     tell(Progress::Stage(Stage::HeadCheck));
-    let checked = head::head_check(
+    let mut checked = head::head_check(
         smoothed,
         &extracted,
         process,
@@ -262,12 +263,24 @@ fn run(
         &laid.features,
         options,
     )?;
+    let mut warnings = laid.warnings;
+    let adhesion = adhesion::lay(
+        &mut checked.toolpath,
+        &mut checked.avoided.left,
+        &process.base(),
+        machine,
+    )
+    .unwrap_or_else(|w| {
+        warnings.push(w);
+        None
+    });
     let stages = assemble::Stages {
         extracted,
         placement,
         features: laid.features,
-        warnings: laid.warnings,
+        warnings,
         checked,
+        adhesion,
     };
     let passed = match gates::before_post(&stages.features, &stages.checked, options) {
         Ok(passed) => passed,
@@ -281,6 +294,7 @@ fn run(
     let program = match post::post(
         &stages.checked.toolpath,
         machine,
+        &process.base(),
         options,
         &notes,
         sink,
@@ -318,6 +332,7 @@ fn refuse(
     let gate = match post::post(
         &stages.checked.toolpath,
         machine,
+        &process.base(),
         options,
         &notes,
         &mut post::Discard,

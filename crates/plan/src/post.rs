@@ -8,6 +8,7 @@ use crate::report::SettingsEntry;
 use crate::{Options, PlanError};
 use robot_post::machine::MachineProfile;
 use robot_post::{Job, Program, ProgramSink};
+use slicer::params::LayerParams;
 use slicer::toolpath::ToolPath;
 
 /// What a program's header is made of: the settings, the estimate of `checked`'s tool path on
@@ -39,21 +40,47 @@ pub fn notes(est: &Estimate, checked: &Checked, settings: &SettingsEntry) -> Vec
     notes
 }
 
-/// Writes `toolpath`'s program for `machine` into `sink`, headed by `notes`, and with `csv`
+/// The process's settings a G-code viewer reads, in PrusaSlicer's names, for the Marlin
+/// program's config block: `perimeters`, `skirts`, `skirt_distance`, `brim_width`,
+/// `arc_fitting` (`emit_center` or `disabled`).
+pub fn viewer_config(base: &LayerParams) -> Vec<(String, String)> {
+    let n = |v: f64| format!("{v}");
+    vec![
+        ("perimeters".into(), base.perimeters.to_string()),
+        ("skirts".into(), base.skirt_loops.to_string()),
+        ("skirt_distance".into(), n(base.skirt_distance_mm)),
+        ("brim_width".into(), n(base.brim_width_mm)),
+        (
+            "arc_fitting".into(),
+            match base.arc_fitting {
+                true => "emit_center",
+                false => "disabled",
+            }
+            .into(),
+        ),
+    ]
+}
+
+/// Writes `toolpath`'s program for `machine` into `sink`, headed by `notes` (its config block
+/// and arc fitting from the process's `base` parameters, [`viewer_config`]), and with `csv`
 /// its `toolpath.csv` ([`ToolPath::write_csv`]) at the same time on another thread (the two
 /// texts are the bulk of a large plan's writing).
 pub fn post(
     toolpath: &ToolPath,
     machine: &MachineProfile,
+    base: &LayerParams,
     options: &Options,
     notes: &[String],
     sink: &mut dyn ProgramSink,
     csv: Option<&mut (dyn std::io::Write + Send)>,
 ) -> Result<Program, PlanError> {
+    let config = viewer_config(base);
     let job = Job {
         source: &options.source,
         stem: &options.stem,
         notes,
+        config: &config,
+        arcs: base.arc_fitting.then_some(base.tolerance),
     };
     let post = machine.post();
     let (program, csv) = match csv {

@@ -83,12 +83,21 @@ impl Process {
                 ("pedestal", patch.pedestal.is_some()),
                 ("pedestal_inset", patch.pedestal_inset.is_some()),
                 ("slicing", patch.slicing.is_some()),
+                ("skirt_loops", patch.skirt_loops.is_some()),
+                ("skirt_distance_mm", patch.skirt_distance_mm.is_some()),
+                ("brim_width_mm", patch.brim_width_mm.is_some()),
+                ("arc_fitting", patch.arc_fitting.is_some()),
             ] {
                 if set {
                     return Err(ProcessError(format!(
                         "process file{}: [features.{id}] {key}: the {what} is the part's, not a feature's: set it in [defaults]",
                         process.at("features", id, key),
-                        what = if key == "slicing" { "slicing" } else { "pedestal" },
+                        what = match key {
+                            "slicing" => "slicing",
+                            "pedestal" | "pedestal_inset" => "pedestal",
+                            "arc_fitting" => "program's arc fitting",
+                            _ => "skirt and brim",
+                        },
                     )));
                 }
             }

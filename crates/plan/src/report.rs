@@ -317,6 +317,22 @@ pub struct MovedEntry {
     pub unreachable_before: usize,
 }
 
+/// The skirt and brim laid on the first layer (issue 33, [`crate::adhesion`]): `plan.json`'s
+/// `skirt_brim`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AdhesionEntry {
+    /// Skirt loops laid (one per island of the first layer that lies apart from the others).
+    pub skirt_loops: usize,
+    /// Brim loops laid.
+    pub brim_loops: usize,
+    /// Their points in the tool path (in no feature's `points`).
+    pub points: usize,
+    /// Their bead length, mm.
+    pub length_mm: f64,
+    /// Their bead volume, mm³ (not the part's: the self-check leaves it out).
+    pub volume_mm3: f64,
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -333,6 +349,9 @@ pub struct PlanReport {
     pub complete: bool,
     /// Every feature, in build order.
     pub features: Vec<FeatureReport>,
+    /// The skirt and brim laid before the part (Marlin; absent when none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skirt_brim: Option<AdhesionEntry>,
     /// Things to know about the plan.
     pub warnings: Vec<String>,
     /// Estimated printing time, s ([`crate::estimate`]: each move at its speed).

@@ -46,12 +46,22 @@ fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
         sorted.sort_unstable();
         sorted.dedup();
         assert_eq!(sorted.len(), ids.len(), "{name}: ids repeat: {ids:?}");
+        // The skirt's points carry the first layer's feature id but are no feature's
+        // (plan.json's skirt_brim counts them).
+        let skirt = p.report.skirt_brim.as_ref().map_or(0, |s| s.points);
+        let adhesion = |q: &&robot_post::PathPoint| {
+            matches!(
+                q.role,
+                robot_post::toolpath::Role::Skirt | robot_post::toolpath::Role::Brim
+            )
+        };
+        assert_eq!(p.toolpath.points.iter().filter(adhesion).count(), skirt);
         for f in p.features() {
             let own = p
                 .toolpath
                 .points
                 .iter()
-                .filter(|q| q.feature == f.feature.id)
+                .filter(|q| q.feature == f.feature.id && !adhesion(q))
                 .count();
             assert_eq!(own, f.points, "{name}: feature {}", f.feature.id);
             assert!(
@@ -68,7 +78,7 @@ fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
             );
         }
         let total: usize = p.features().iter().map(|f| f.points).sum();
-        assert_eq!(total, p.toolpath.points.len(), "{name}");
+        assert_eq!(total + skirt, p.toolpath.points.len(), "{name}");
         // Complete exactly when every layer is held up (the self-check passed above).
         let held = p.features().iter().all(|f| f.unsupported_area_mm2 == 0.0);
         assert_eq!(p.report.complete, held, "{name}");
@@ -208,6 +218,7 @@ fn same_in_pieces_of_any_size(plan: &plan::Plan, m: &MachineProfile) {
         source: "part.step",
         stem: "part",
         notes: &notes,
+        ..Job::default()
     };
     let whole = m.post().post(&plan.toolpath, &job).expect("posted");
     assert!(!whole.files.is_empty());
@@ -267,6 +278,7 @@ fn held_text_is_bounded(plan: &plan::Plan, m: &MachineProfile, file: &str) {
         source: "part.step",
         stem: "part",
         notes: &[],
+        ..Job::default()
     };
     let mut sink = Counting::default();
     m.post()

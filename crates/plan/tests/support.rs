@@ -37,13 +37,14 @@ fn planned(name: &str, process: &Process) -> Result<plan::Plan, PlanError> {
 const XY_GAP: f64 = 0.5;
 const SLACK: f64 = 0.05;
 
-/// Support print points (position), and the part's print points, of a plan.
+/// Support print points (position), and the part's print points, of a plan (the skirt
+/// around the first layer is neither).
 fn split(p: &plan::Plan) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let prints = p
         .toolpath
         .points
         .iter()
-        .filter(|q| q.kind == MoveKind::Print);
+        .filter(|q| q.kind == MoveKind::Print && (q.role.is_support() || q.role.is_part()));
     let (s, part): (Vec<&PathPoint>, Vec<&PathPoint>) = prints.partition(|q| q.role.is_support());
     (
         s.iter().map(|q| q.p).collect(),

@@ -7,7 +7,7 @@
 //! the placeholder, so a misspelt one never reaches the machine as text.
 
 /// The placeholders a profile's start and end G-code may hold, with what each stands for.
-pub const PLACEHOLDERS: [(&str, &str); 15] = [
+pub const PLACEHOLDERS: [(&str, &str); 16] = [
     ("nozzle_temperature", "nozzle_temperature, whole degrees"),
     ("bed_temperature", "bed_temperature, whole degrees"),
     ("bed_x", "bed_size X (mm)"),
@@ -23,10 +23,18 @@ pub const PLACEHOLDERS: [(&str, &str); 15] = [
     ("retraction_length", "retraction_length (mm)"),
     ("retraction_feed", "retraction_speed in mm/min"),
     (
+        "first_layer_z",
+        "machine Z of the first layer's beads (the Marlin post's; 0.3 mm for delta5)",
+    ),
+    (
         "purge_e",
-        "filament (mm) of a 100 mm purge line, bead_width wide and 0.3 mm thick (Eq. 1)",
+        "filament (mm) of a 100 mm purge line, bead_width wide and first_layer_z thick (Eq. 1)",
     ),
 ];
+
+/// The purge line's thickness (mm) where the post does not give the first layer's: the
+/// delta5 post, and [`crate::MachineProfile::start_gcode_text`].
+pub const PURGE_THICKNESS: f64 = 0.3;
 
 /// The Marlin profile's start G-code when a profile leaves `start_gcode` out (the built-in
 /// `profiles/marlin.toml` writes the same).
@@ -37,7 +45,7 @@ G28 ; home all axes
 M190 S{bed_temperature} ; wait for the bed
 M109 S{nozzle_temperature} ; wait for the nozzle
 G92 E0
-G0 X{x_min} Y{y_min} Z0.3 F{travel_feed} ; purge line along the bed's front edge
+G0 X{x_min} Y{y_min} Z{first_layer_z} F{travel_feed} ; purge line along the bed's front edge
 G1 X100 E{purge_e} F{first_layer_feed}
 G0 Z2 F{travel_feed}
 ";

@@ -38,7 +38,7 @@ pub use delta5::{delta5, delta5_to, Delta5Geometry, Delta5Program, KinematicFigu
 pub use error::PostError;
 pub use kuka::{kuka, kuka_to, KrlProgram, KukaCell, KukaFigures};
 pub use machine::{MachineKind, MachineProfile};
-pub use marlin::{marlin, marlin_to};
+pub use marlin::{marlin, marlin_job_to, marlin_to};
 pub use post::{Job, Post, PostFigures, Program};
 pub use sink::{InMemory, ProgramFile, ProgramSink};
 pub use toolpath::{MoveKind, PathPoint, ToolPath};

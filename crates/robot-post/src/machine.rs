@@ -427,13 +427,20 @@ impl MachineProfile {
     /// The start G-code with its placeholders filled in: `start_gcode`, or the kind's default
     /// (none for KUKA).
     pub fn start_gcode_text(&self) -> String {
+        self.start_gcode_text_at(crate::custom::PURGE_THICKNESS)
+    }
+
+    /// [`MachineProfile::start_gcode_text`] for a program whose first layer lies at machine Z
+    /// `first_layer_z` (its beads' thickness): `{first_layer_z}` and `{purge_e}` follow it, so
+    /// a purge line written there lies on the first layer's height.
+    pub fn start_gcode_text_at(&self, first_layer_z: f64) -> String {
         let default = match self.kind {
             MachineKind::Marlin => crate::custom::MARLIN_START,
             MachineKind::Delta5 => crate::custom::DELTA5_START,
             MachineKind::Kuka => "",
         };
         let text = self.start_gcode.as_deref().unwrap_or(default);
-        crate::custom::expand(text, &self.placeholder_values())
+        crate::custom::expand(text, &self.placeholder_values(first_layer_z))
     }
 
     /// The end G-code with its placeholders filled in: `end_gcode`, or the kind's default.
@@ -444,11 +451,15 @@ impl MachineProfile {
             MachineKind::Kuka => "",
         };
         let text = self.end_gcode.as_deref().unwrap_or(default);
-        crate::custom::expand(text, &self.placeholder_values())
+        crate::custom::expand(
+            text,
+            &self.placeholder_values(crate::custom::PURGE_THICKNESS),
+        )
     }
 
-    /// The value of every placeholder of [`crate::custom::PLACEHOLDERS`] for this profile.
-    fn placeholder_values(&self) -> Vec<(&'static str, String)> {
+    /// The value of every placeholder of [`crate::custom::PLACEHOLDERS`] for this profile,
+    /// the first layer at machine Z `first_layer_z`.
+    fn placeholder_values(&self, first_layer_z: f64) -> Vec<(&'static str, String)> {
         use toolpath::fixed;
         let (x0, y0) = if self.bed_origin_centre {
             (-self.bed_size[0] / 2.0, -self.bed_size[1] / 2.0)
@@ -472,9 +483,13 @@ impl MachineProfile {
             ("travel_feed", feed(self.travel_speed)),
             ("retraction_length", fixed(self.retraction_length, 5)),
             ("retraction_feed", feed(self.retraction_speed)),
+            ("first_layer_z", mm(first_layer_z)),
             (
                 "purge_e",
-                fixed(self.filament_length(self.bead_width, 0.3, 100.0), 5),
+                fixed(
+                    self.filament_length(self.bead_width, first_layer_z, 100.0),
+                    5,
+                ),
             ),
         ]
     }
@@ -549,7 +564,9 @@ mod tests {
             start.contains("M104 S210") && start.contains("M190 S60"),
             "{start}"
         );
-        assert!(start.contains("G0 X0.000 Y0.000 Z0.3 F7200"), "{start}");
+        assert!(start.contains("G0 X0.000 Y0.000 Z0.300 F7200"), "{start}");
+        let at = m.start_gcode_text_at(0.2);
+        assert!(at.contains("G0 X0.000 Y0.000 Z0.200 F7200"), "{at}");
         // A misspelt placeholder names the key and the placeholder.
         let bad = MARLIN_TOML.replace("M104 S{nozzle_temperature}", "M104 S{nozle_temperature}");
         let e = MachineProfile::from_toml(&bad).unwrap_err().to_string();

@@ -10,12 +10,13 @@ use crate::delta5::{delta5_to, KinematicFigures};
 use crate::kind::MachineKind;
 use crate::kuka::{kuka_to, KukaFigures};
 use crate::machine::MachineProfile;
-use crate::marlin::marlin_to;
+use crate::marlin::marlin_job_to;
 use crate::PostError;
 use toolpath::ToolPath;
 
-/// What the programs name: the part they are for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What the programs name: the part they are for, and what the plan asks of the program's
+/// text.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Job<'a> {
     /// The source (the STEP file's name), written in every program's header.
     pub source: &'a str,
@@ -24,6 +25,14 @@ pub struct Job<'a> {
     /// Comment lines every program's header carries after the line naming the source (the
     /// planner's version and the settings used), without the comment sign.
     pub notes: &'a [String],
+    /// Settings of the plan a G-code viewer reads, `(key, value)` in PrusaSlicer's names
+    /// (`skirts`, `brim_width`): the Marlin post writes them in its config block with the
+    /// machine's ([`crate::marlin::config`]).
+    pub config: &'a [(String, String)],
+    /// Arc fitting (the process key `arc_fitting`): the tolerance (mm) within which the Marlin
+    /// post writes runs of print moves along a circle as `G2`/`G3`
+    /// ([`crate::marlin::arcs`]); `None`: straight moves only.
+    pub arcs: Option<f64>,
 }
 
 /// A post: writes a machine's program for a tool path.
@@ -101,7 +110,7 @@ impl Post for MarlinPost<'_> {
         job: &Job,
         sink: &mut dyn ProgramSink,
     ) -> Result<Program, PostError> {
-        marlin_to(path, self.0, job.source, job.notes, sink)?;
+        marlin_job_to(path, self.0, job, sink)?;
         Ok(Program::default())
     }
 }
@@ -184,6 +193,7 @@ mod tests {
             source: "part.step",
             stem: "part",
             notes: &notes,
+            ..Job::default()
         };
         for (kind, names) in [
             (MachineKind::Marlin, vec!["program.gcode"]),

@@ -19,6 +19,7 @@
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
 //! - [`support_material`]: columns of support under what the overhang limit leaves unheld;
+//! - [`skirt`]: skirt and brim loops around the first layer's footprint;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
 //!   re-exported);
@@ -47,6 +48,7 @@ pub mod params;
 pub mod planar;
 mod region_fill;
 pub mod resolution;
+pub mod skirt;
 mod sst;
 pub mod support;
 pub mod support_material;

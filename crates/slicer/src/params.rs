@@ -20,6 +20,12 @@ pub const DEFAULT_OVERHANG_ANGLE_DEG: f64 = 50.0;
 /// `overhang_angle_deg` must stay under this: at 90° a layer may reach out without limit.
 pub const MAX_OVERHANG_ANGLE_DEG: f64 = 90.0;
 
+/// Widest brim and farthest skirt (`brim_width_mm`, `skirt_distance_mm`), mm.
+pub const MAX_ADHESION_MM: f64 = 100.0;
+
+/// Most skirt loops (`skirt_loops`).
+pub const MAX_SKIRT_LOOPS: usize = 100;
+
 /// How a planar layer is filled (the paper's `path_mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -239,6 +245,18 @@ pub struct LayerParams {
     pub pedestal: Pedestal,
     /// How far the pedestal's outline lies inside the build-plate face's, mm (≥ 0). Default 0.
     pub pedestal_inset: f64,
+    /// Skirt loops around the first layer (issue 33; Marlin programs), 0 for none; the part's,
+    /// so set in `[defaults]` only. Default 1.
+    pub skirt_loops: usize,
+    /// Gap between the skirt and the first layer's outline (its brim included), mm (≥ 0).
+    /// Default 6.
+    pub skirt_distance_mm: f64,
+    /// Brim: loops on the first layer touching the part's outline outward, this wide, mm (≥ 0,
+    /// 0 for none; Marlin programs). Default 0.
+    pub brim_width_mm: f64,
+    /// Runs of print moves along a circle written as `G2`/`G3` within `tolerance` (Marlin
+    /// programs; issue 33). Default false.
+    pub arc_fitting: bool,
     /// How the part is cut into what is planned ([`Slicing`]); the part's, so set in
     /// `[defaults]` only. Default `auto`.
     pub slicing: Slicing,
@@ -271,6 +289,10 @@ impl Default for LayerParams {
             support_interface_density: 0.7,
             pedestal: Pedestal::Auto,
             pedestal_inset: 0.0,
+            skirt_loops: 1,
+            skirt_distance_mm: 6.0,
+            brim_width_mm: 0.0,
+            arc_fitting: false,
             slicing: Slicing::Auto,
         }
     }
@@ -436,6 +458,20 @@ impl LayerParams {
         if !(inset.is_finite() && inset >= 0.0) {
             return Err(format!("pedestal_inset must be 0 mm or more, got {inset}"));
         }
+        for (key, d) in [
+            ("skirt_distance_mm", self.skirt_distance_mm),
+            ("brim_width_mm", self.brim_width_mm),
+        ] {
+            if !(d.is_finite() && (0.0..=MAX_ADHESION_MM).contains(&d)) {
+                return Err(format!("{key} must be 0 to {MAX_ADHESION_MM} mm, got {d}"));
+            }
+        }
+        if self.skirt_loops > MAX_SKIRT_LOOPS {
+            return Err(format!(
+                "skirt_loops must be 0 to {MAX_SKIRT_LOOPS}, got {}",
+                self.skirt_loops
+            ));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > ZERO_AXIS) {
@@ -522,6 +558,18 @@ impl LayerParams {
         if let Some(v) = p.pedestal_inset {
             out.pedestal_inset = v;
         }
+        if let Some(v) = p.skirt_loops {
+            out.skirt_loops = v;
+        }
+        if let Some(v) = p.skirt_distance_mm {
+            out.skirt_distance_mm = v;
+        }
+        if let Some(v) = p.brim_width_mm {
+            out.brim_width_mm = v;
+        }
+        if let Some(v) = p.arc_fitting {
+            out.arc_fitting = v;
+        }
         if let Some(v) = p.slicing {
             out.slicing = v;
         }
@@ -607,6 +655,18 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::pedestal_inset`] (`[defaults]` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pedestal_inset: Option<f64>,
+    /// Overrides [`LayerParams::skirt_loops`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skirt_loops: Option<usize>,
+    /// Overrides [`LayerParams::skirt_distance_mm`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skirt_distance_mm: Option<f64>,
+    /// Overrides [`LayerParams::brim_width_mm`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub brim_width_mm: Option<f64>,
+    /// Overrides [`LayerParams::arc_fitting`] (`[defaults]` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub arc_fitting: Option<bool>,
     /// Overrides [`LayerParams::slicing`] (`[defaults]` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub slicing: Option<Slicing>,

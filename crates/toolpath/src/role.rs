@@ -21,11 +21,17 @@ pub enum Role {
     SupportMaterial,
     /// The denser layers of support material right under the surface it holds.
     SupportMaterialInterface,
+    /// A loop around the part's first layer, apart from it, that primes the nozzle (issue 33,
+    /// `skirt_loops`): not the part's.
+    Skirt,
+    /// Loops on the first layer touching the part's outline outward, holding it to the plate
+    /// (issue 33, `brim_width_mm`): not the part's.
+    Brim,
 }
 
 impl Role {
     /// Every role, in the order above.
-    pub const ALL: [Role; 7] = [
+    pub const ALL: [Role; 9] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::SolidInfill,
@@ -33,6 +39,8 @@ impl Role {
         Role::GapFill,
         Role::SupportMaterial,
         Role::SupportMaterialInterface,
+        Role::Skirt,
+        Role::Brim,
     ];
 
     /// True for support material's beads ([`Role::SupportMaterial`],
@@ -41,8 +49,15 @@ impl Role {
         matches!(self, Role::SupportMaterial | Role::SupportMaterialInterface)
     }
 
+    /// True for the part's own beads: false for support material, skirt and brim, which the
+    /// self-check does not count as the part's volume.
+    pub fn is_part(self) -> bool {
+        !(self.is_support() || matches!(self, Role::Skirt | Role::Brim))
+    }
+
     /// The role's name in `toolpath.csv`: `external_perimeter`, `perimeter`, `solid_infill`,
-    /// `internal_infill`, `gap_fill`, `support_material`, `support_material_interface`.
+    /// `internal_infill`, `gap_fill`, `support_material`, `support_material_interface`, `skirt`,
+    /// `brim`.
     pub fn as_str(self) -> &'static str {
         match self {
             Role::ExternalPerimeter => "external_perimeter",
@@ -52,6 +67,8 @@ impl Role {
             Role::GapFill => "gap_fill",
             Role::SupportMaterial => "support_material",
             Role::SupportMaterialInterface => "support_material_interface",
+            Role::Skirt => "skirt",
+            Role::Brim => "brim",
         }
     }
 
@@ -62,7 +79,8 @@ impl Role {
 
     /// PrusaSlicer's name of the role, as its `;TYPE:` comment writes it and its G-code viewer
     /// lists it: `External perimeter`, `Perimeter`, `Solid infill`, `Internal infill`,
-    /// `Gap fill`, `Support material`, `Support material interface`.
+    /// `Gap fill`, `Support material`, `Support material interface`, and `Skirt/Brim` for
+    /// both the skirt and the brim (the viewer has one type for them).
     pub fn prusa_name(self) -> &'static str {
         match self {
             Role::ExternalPerimeter => "External perimeter",
@@ -72,6 +90,7 @@ impl Role {
             Role::GapFill => "Gap fill",
             Role::SupportMaterial => "Support material",
             Role::SupportMaterialInterface => "Support material interface",
+            Role::Skirt | Role::Brim => "Skirt/Brim",
         }
     }
 }

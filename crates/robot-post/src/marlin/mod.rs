@@ -12,6 +12,15 @@
 //! E is rounded cumulatively, so the E written adds up to the planned filament; a print move
 //! that goes nowhere once rounded (X, Y and Z as written) is not written, its filament going
 //! with the next move, nor one whose E rounds to 0 over less than 0.01 mm.
+//!
+//! What viewers and printers read (issue 33): the header's `; bed_shape = ` and a config block
+//! at the end ([`config`]); the profile's start G-code under `;TYPE:Skirt/Brim` with its
+//! `{first_layer_z}` at the first layer's height, so that its purge line is neither "Unknown"
+//! nor a layer of its own in a viewer; with [`crate::Job::arcs`], runs of print moves along a
+//! circle as `G2`/`G3` ([`arcs`]).
+
+pub mod arcs;
+pub mod config;
 
 use crate::gcode::{
     comment_text, e_text, mergeable, push_e_text, push_line, Extrusion, Fan, LayerMarks,
@@ -64,6 +73,24 @@ pub fn marlin_to(
     notes: &[String],
     sink: &mut dyn ProgramSink,
 ) -> Result<(), PostError> {
+    let job = crate::Job {
+        source,
+        stem: "",
+        notes,
+        config: &[],
+        arcs: None,
+    };
+    marlin_job_to(path, m, &job, sink)
+}
+
+/// [`marlin_to`] for a [`crate::Job`]: its `config` lines join the program's config block, and
+/// with its `arcs` tolerance runs of print moves along a circle are written as `G2`/`G3`.
+pub fn marlin_job_to(
+    path: &ToolPath,
+    m: &MachineProfile,
+    job: &crate::Job,
+    sink: &mut dyn ProgramSink,
+) -> Result<(), PostError> {
     m.check_for(MachineKind::Marlin)?;
     path.check_finite()?;
     if let Some(q) = path.points.iter().find(|q| !is_plus_z(q.axis)) {
@@ -79,11 +106,42 @@ pub fn marlin_to(
     let mut file = Chunked::open(sink, "program.gcode")?;
 
     let mut w = Writer::new(m);
-    w.header(m, source, offset);
-    insert_notes(&mut w.out, notes);
-    for q in &path.points {
+    // The purge line's height: the first layer's, when a nozzle can lay it.
+    let first_layer = config::layer_heights(path)
+        .map(|h| h.0)
+        .filter(|&t| t > 0.0 && t <= m.nozzle_diameter)
+        .unwrap_or(crate::custom::PURGE_THICKNESS);
+    w.header(m, job.source, offset, first_layer);
+    insert_notes(&mut w.out, job.notes);
+    let machine = |q: &PathPoint| [0, 1, 2].map(|k| ((q.p[k] + offset[k]) * 1e3).round() / 1e3);
+    let mut i = 0;
+    while i < path.points.len() {
+        let q = &path.points[i];
         // Machine coordinates as written (0.001 mm).
-        let t = [0, 1, 2].map(|k| ((q.p[k] + offset[k]) * 1e3).round() / 1e3);
+        let t = machine(q);
+        if let (Some(tol), Some(at), MoveKind::Print) = (job.arcs, w.at, q.kind) {
+            // The first few points first: most runs (lines, corners) end there, cheaply.
+            let start = [at[0], at[1]];
+            let head = arc_run(&path.points[i..], t[2], &machine, arcs::MIN_ARC_POINTS);
+            let arc = arcs::fit(start, &head, tol).and_then(|_| {
+                arcs::fit(
+                    start,
+                    &arc_run(&path.points[i..], t[2], &machine, ARC_RUN),
+                    tol,
+                )
+            });
+            if let Some(arc) = arc {
+                let points = &path.points[i..i + arc.count];
+                for p in points {
+                    w.comments(p, t[2]);
+                }
+                let end = machine(&points[arc.count - 1]);
+                w.arc(end, arc, points);
+                file.pass_on(&mut w.out)?;
+                i += arc.count;
+                continue;
+            }
+        }
         w.comments(q, t[2]);
         match q.kind {
             MoveKind::Travel => w.travel(t),
@@ -95,10 +153,44 @@ pub fn marlin_to(
             }
         }
         file.pass_on(&mut w.out)?;
+        i += 1;
     }
     w.footer(m);
+    w.out.push_str(&config::block(m, path, job.config));
     file.finish(&w.out)
 }
+
+/// Most print points one arc is looked for over.
+const ARC_RUN: usize = 4096;
+
+/// The machine XY of the print points from the first of `points` on that an arc may stand
+/// for: the same feature, layer, role, bead width (within half a micrometre) and machine Z
+/// `z`, at most `most` of them.
+fn arc_run(
+    points: &[PathPoint],
+    z: f64,
+    machine: &dyn Fn(&PathPoint) -> [f64; 3],
+    most: usize,
+) -> Vec<[f64; 2]> {
+    let Some(first) = points.first() else {
+        return vec![];
+    };
+    points
+        .iter()
+        .take(most)
+        .take_while(|q| {
+            q.kind == MoveKind::Print
+                && (q.feature, q.layer, q.role) == (first.feature, first.layer, first.role)
+                && (q.width - first.width).abs() <= WIDTH_STEP
+        })
+        .map(machine)
+        .take_while(|t| t[2] == z)
+        .map(|t| [t[0], t[1]])
+        .collect()
+}
+
+/// Bead widths within this of each other (mm) are one `;WIDTH:`.
+const WIDTH_STEP: f64 = 5e-4;
 
 /// Appends `code X.. Y.. Z..` (the machine position `t`, 0.001 mm) to `out`, straight into
 /// the text: a plan writes millions of these moves.
@@ -166,7 +258,7 @@ impl Writer {
         push_line(&mut self.out, s);
     }
 
-    fn header(&mut self, m: &MachineProfile, source: &str, offset: [f64; 3]) {
+    fn header(&mut self, m: &MachineProfile, source: &str, offset: [f64; 3], first_layer: f64) {
         self.line(&format!(
             "; generated by features from {}",
             comment_text(source)
@@ -178,6 +270,7 @@ impl Writer {
             fixed(offset[1], 3),
             fixed(offset[2], 3)
         ));
+        self.line(&format!("; bed_shape = {}", config::bed_shape(m)));
         self.line(&format!(
             "; nozzle {} mm, filament {} mm, bead {} mm",
             fixed(m.nozzle_diameter, 2),
@@ -196,8 +289,12 @@ impl Writer {
         self.line("G90 ; absolute XYZ");
         self.line("M83 ; relative extrusion: E is each segment's filament length");
         self.motion_limits(m);
+        // The purge line of the start G-code is the skirt's kind of bead, on the first layer.
+        self.line(";TYPE:Skirt/Brim");
+        self.line(&format!(";WIDTH:{}", fixed(m.bead_width, 3)));
+        self.line(&format!(";HEIGHT:{}", fixed(first_layer, 3)));
         self.line("; start_gcode");
-        self.out.push_str(&m.start_gcode_text());
+        self.out.push_str(&m.start_gcode_text_at(first_layer));
         if !self.out.ends_with('\n') {
             self.out.push('\n');
         }
@@ -347,6 +444,45 @@ impl Writer {
         self.extrusion.written(de);
         self.printing = true;
         self.at = Some(t);
+    }
+
+    /// A print arc ending at `end` (machine coordinates) standing for `points`: their
+    /// filament, at their speed.
+    fn arc(&mut self, end: [f64; 3], arc: arcs::Arc, points: &[PathPoint]) {
+        let Some(at) = self.at else { return };
+        let mut de = 0;
+        for q in points {
+            de = self.extrusion.add(q.e);
+        }
+        self.resume();
+        let on_plate = points
+            .first()
+            .is_some_and(|q| end[2] - q.thickness.max(0.0) <= 0.01);
+        self.fan.set(on_plate, &mut self.out);
+        let f = if on_plate {
+            &self.first_layer_f
+        } else {
+            &self.print_f
+        };
+        let out = &mut self.out;
+        out.push_str(if arc.ccw { "G3 X" } else { "G2 X" });
+        push_fixed(out, end[0], 3);
+        out.push_str(" Y");
+        push_fixed(out, end[1], 3);
+        out.push_str(" I");
+        push_fixed(out, arc.centre[0] - at[0], 3);
+        out.push_str(" J");
+        push_fixed(out, arc.centre[1] - at[1], 3);
+        if de != 0 {
+            out.push_str(" E");
+            push_e_text(out, de);
+        }
+        out.push_str(" F");
+        out.push_str(f);
+        out.push('\n');
+        self.extrusion.written(de);
+        self.printing = true;
+        self.at = Some(end);
     }
 
     fn footer(&mut self, m: &MachineProfile) {
