@@ -16,6 +16,10 @@ pub struct FeatureFigures {
     /// Filament fed for support material's beads, mm (planar layers, issue 33): not the
     /// part's; the points carry it like any other.
     pub support_filament: f64,
+    /// Volume of the feature's layers laid as sparse infill (issue 33): each layer's sparse
+    /// area × its thickness, summed, mm³; 0 without sparse infill. Its beads cover
+    /// `infill_density` of it, so the self-check expects that much less there.
+    pub sparse_volume: f64,
     /// Thinnest, mean and thickest layer, mm.
     pub thickness: (f64, f64, f64),
     /// How far (mm) the feature's surface reaches below its tree's build plate (the base
