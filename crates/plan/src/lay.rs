@@ -234,7 +234,7 @@ fn laid_feature(
             volume: f.volume,
             fill: params.filling_ratio,
             sparse: fig.sparse_volume,
-            density: params.infill_density,
+            density: fig.sparse_density(params.infill_density),
             layers: fig.layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,

@@ -339,7 +339,7 @@ impl Stood {
             volume: self.volume,
             fill,
             sparse: self.plan.figures.sparse_volume,
-            density,
+            density: self.plan.figures.sparse_density(density),
             layers: self.plan.figures.layers,
             extruded: self.plan.figures.filament * filament_area,
             tolerance: slicer::verify::VOLUME_TOLERANCE,

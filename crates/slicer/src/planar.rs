@@ -111,8 +111,9 @@ pub fn fill_regions(
 }
 
 /// [`fill_regions`] with sparse infill away from the layer's skin (`sparse`,
-/// [`crate::fill::fill_layer_with`]), and the area laid sparse (mm²). Regions too thin for
-/// rings, and the strips rings leave, stay solid.
+/// [`crate::fill::fill_layer_with`]), and the area laid sparse (mm²) with the share of it its
+/// lines cover (mm², area × the layer's density). Regions too thin for rings, and the strips
+/// rings leave, stay solid.
 pub fn fill_regions_with(
     regions: Vec<Region>,
     params: &LayerParams,
@@ -120,7 +121,7 @@ pub fn fill_regions_with(
     width: f64,
     spacing: f64,
     sparse: Option<SparseLayer>,
-) -> (Vec<FillPath>, f64) {
+) -> (Vec<FillPath>, (f64, f64)) {
     let rings = matches!(
         params.path_mode,
         PathMode::Contour | PathMode::ContourZigzag
@@ -154,7 +155,8 @@ pub fn fill_regions_with(
             Boundary::Beads,
         ));
     }
-    (paths, filled.sparse_area)
+    let laid = filled.sparse_area * filled.sparse_density;
+    (paths, (filled.sparse_area, laid))
 }
 
 /// Plans one two5d feature in planar layers parallel to its reference plane; its first travel
@@ -180,8 +182,9 @@ pub struct Two5dFill {
     tops: Vec<(f64, f64, f64)>,
     /// Each layer's fill paths in its plane.
     filled: Vec<Vec<FillPath>>,
-    /// Each layer's area laid sparse, mm² (all 0 without sparse infill).
-    sparse: Vec<f64>,
+    /// Each layer's area laid sparse and the share of it its lines cover, mm² (all 0 without
+    /// sparse infill).
+    sparse: Vec<(f64, f64)>,
     fig: FeatureFigures,
 }
 
@@ -339,7 +342,7 @@ fn fill_sections(
     params: &LayerParams,
     width: f64,
     spacing: f64,
-) -> (Vec<Vec<FillPath>>, Vec<f64>) {
+) -> (Vec<Vec<FillPath>>, Vec<(f64, f64)>) {
     let n = sections.len();
     let mut sections = sections;
     if params.path_mode == PathMode::Contour {
@@ -355,7 +358,7 @@ fn fill_sections(
         vec![vec![]; n]
     };
     let first = first_of_each_fill(&keys, &skins, params);
-    let mut fills: Vec<Option<(Vec<FillPath>, f64)>> = sections
+    let mut fills: Vec<Option<(Vec<FillPath>, (f64, f64))>> = sections
         .into_par_iter()
         .enumerate()
         .map(|(layer, regions)| {
@@ -629,7 +632,9 @@ impl Two5dFill {
                     print: start + 1..points.len(),
                 });
             }
-            fig.sparse_volume += sparse.get(layer).copied().unwrap_or(0.0) * dl;
+            let (area, laid) = sparse.get(layer).copied().unwrap_or_default();
+            fig.sparse_volume += area * dl;
+            fig.sparse_laid += laid * dl;
             layers.push(Layer {
                 index: layer,
                 thickness: dl,

@@ -34,7 +34,7 @@ pub enum PlanProblem {
         fill: f64,
         /// The volume of its layers laid sparse, mm³ ([`PlannedFeature::sparse`]).
         sparse: f64,
-        /// The sparse infill's density (`infill_density`).
+        /// The sparse infill's density ([`PlannedFeature::density`]).
         density: f64,
         /// What it should put down ([`PlannedFeature::expected`]), mm³.
         expected: f64,
@@ -50,7 +50,7 @@ pub enum PlanProblem {
 fn model(volume: f64, fill: f64, sparse: f64, density: f64) -> String {
     if sparse > 0.0 {
         format!(
-            "(volume {volume:.3} - sparse {sparse:.3}) mm^3 x fill {fill} + {sparse:.3} mm^3 x density {density}"
+            "(volume {volume:.3} - sparse {sparse:.3}) mm^3 x fill {fill} + {sparse:.3} mm^3 x density {density:.4}"
         )
     } else {
         format!("volume {volume:.3} mm^3 x fill {fill}")
@@ -81,7 +81,8 @@ pub struct PlannedFeature {
     /// The volume of its layers laid as sparse infill, mm³ (each layer's sparse area × its
     /// thickness, from the regions the planner filled; 0 without sparse infill).
     pub sparse: f64,
-    /// The sparse infill's `infill_density`: the share of `sparse` its beads cover.
+    /// The share of `sparse` its beads cover: `infill_density`, or the gyroid's mean over the
+    /// feature's sparse layers (its lines are longer at some heights than at others).
     pub density: f64,
     /// Layers planned.
     pub layers: usize,

@@ -294,6 +294,9 @@ pub fn fill_layer_with(
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
         sparse_area,
+        sparse_density: sparse.map_or(params.infill_density, |s| {
+            sparse::layer_density(params, s.z, width)
+        }),
     }
 }
 
@@ -416,6 +419,9 @@ pub struct FilledLayer {
     pub gaps: Vec<Region>,
     /// Area of the regions laid sparse, mm² ([`fill_layer_with`]; 0 without sparse infill).
     pub sparse_area: f64,
+    /// The share of `sparse_area` the sparse lines cover on this layer
+    /// ([`sparse::layer_density`]: `infill_density`, or the gyroid's at the layer's height).
+    pub sparse_density: f64,
 }
 
 /// The part of a bead width by which a free line end stops short of the boundary it runs
