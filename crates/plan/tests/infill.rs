@@ -181,8 +181,7 @@ fn a_step_inside_a_feature_gets_its_skin() {
     let step = (1..layers.len())
         .find(|&k| total(k) < 0.5 * total(k - 1) && k > 3)
         .expect("a step");
-    for k in step - 4..step {
-        let (solid, sparse) = layers[k];
+    for (k, &(solid, sparse)) in layers.iter().enumerate().take(step).skip(step - 4) {
         assert!(
             solid > 0.0 && sparse > 0.0,
             "layer {k} under the step: {solid}, {sparse}"

@@ -358,7 +358,7 @@ fn fill_sections(
         vec![vec![]; n]
     };
     let first = first_of_each_fill(&keys, &skins, params);
-    let mut fills: Vec<Option<(Vec<FillPath>, (f64, f64))>> = sections
+    let mut fills: Vec<Option<LayerFill>> = sections
         .into_par_iter()
         .enumerate()
         .map(|(layer, regions)| {
@@ -391,6 +391,9 @@ fn fill_sections(
         })
         .unzip()
 }
+
+/// A layer's paths, and its area laid sparse with the share of it its lines cover (mm²).
+type LayerFill = (Vec<FillPath>, (f64, f64));
 
 /// For each layer, the first layer whose fill it takes (itself when none before it has the
 /// same section, [`SectionKey`], and parity where the fill alternates). With sparse infill,

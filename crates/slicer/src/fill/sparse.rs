@@ -92,7 +92,7 @@ pub(super) fn pattern_lines(
 /// them (Douglas–Peucker): the gyroid's samples along its straighter stretches.
 fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
     let n = pts.len();
-    if n < 3 || !(tol > 0.0) {
+    if n < 3 || tol.is_nan() || tol <= 0.0 {
         return pts.to_vec();
     }
     let mut keep = vec![false; n];
@@ -227,9 +227,9 @@ fn gyroid_period(width: f64, density: f64) -> f64 {
 /// The share of its area the sparse lines of `params` cover on a layer at height `z` (mm),
 /// for beads `width` wide: `infill_density` for straight lines; for the gyroid, whose lines
 /// are longer where the section's two families of lines meet, `infill_density` × the
-/// section's line length at `z` over its mean ([`stretch_at`], from 1.15 to 1.51 periods a
+/// section's line length at `z` over its mean (`stretch_at`, from 1.15 to 1.51 periods a
 /// period): the density holds over the layers of a period, not on each.
-pub(super) fn layer_density(params: &LayerParams, z: f64, width: f64) -> f64 {
+pub fn layer_density(params: &LayerParams, z: f64, width: f64) -> f64 {
     let d = params.infill_density;
     if params.infill_pattern != InfillPattern::Gyroid || !(d > 0.0 && width > 0.0) {
         return d;
