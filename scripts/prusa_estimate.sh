@@ -8,7 +8,12 @@
 # off), then prints each program's estimate and filament. Needs a release build of
 # `features` ($FEATURES, else target/release/features).
 #
-#   scripts/prusa_estimate.sh [PART.step]
+# Sparse infill (issue 33): DENSITY (0-1, default 1: solid) and PATTERN (rectilinear, grid,
+# triangles or gyroid; default rectilinear) set our infill_density / infill_pattern and
+# PrusaSlicer's --fill-density / --fill-pattern alike, with 4 top and 3 bottom solid layers on
+# both; SLICING (features, planar; default: the process default) is passed to ours.
+#
+#   [DENSITY=0.2 PATTERN=gyroid SLICING=planar] scripts/prusa_estimate.sh [PART.step]
 set -eu
 cd "$(dirname "$0")/.."
 part=${1:-fixtures/plate_boss_boss.step}
@@ -17,11 +22,17 @@ prusa=${PRUSA_SLICER:-prusa-slicer}
 [ -x "$features" ] || cargo build --release -p features-cli
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
-"$features" plan "$part" --machine marlin -o "$scratch/ours" >/dev/null
+density=${DENSITY:-1}
+pattern=${PATTERN:-rectilinear}
+set -- --set "infill_density=$density" --set "infill_pattern=$pattern"
+[ -n "${SLICING:-}" ] && set -- "$@" --set "slicing=$SLICING"
+"$features" plan "$part" --machine marlin "$@" -o "$scratch/ours" >/dev/null
+percent=$(awk -v d="$density" 'BEGIN { printf "%g%%", 100 * d }')
 "$features" mesh "$part" --tolerance 0.01 -o "$scratch/part.stl" >/dev/null
 w=0.45
 "$prusa" --export-gcode --loglevel 1 --gcode-flavor marlin2 \
-    --layer-height 0.2 --first-layer-height 0.2 --fill-density 100% --fill-pattern rectilinear \
+    --layer-height 0.2 --first-layer-height 0.2 --fill-density "$percent" --fill-pattern "$pattern" \
+    --top-solid-layers 4 --bottom-solid-layers 3 \
     --perimeters 2 --perimeter-generator classic --extrusion-width $w \
     --first-layer-extrusion-width $w --perimeter-extrusion-width $w \
     --external-perimeter-extrusion-width $w --infill-extrusion-width $w \

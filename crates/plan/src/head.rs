@@ -83,10 +83,10 @@ pub fn head_check(
         collisions::avoid(p, axes, machine, &entries, limits)
     };
     let stood = pedestal::stand(&ctx, toolpath, planned_axes, avoid)?;
-    let pedestal_planned = stood
-        .pedestal
-        .as_ref()
-        .map(|p| p.planned(machine.bead().filament_area(), params.filling_ratio));
+    let pedestal_planned = stood.pedestal.as_ref().map(|p| {
+        let area = machine.bead().filament_area();
+        p.planned(area, params.filling_ratio, params.infill_density)
+    });
     Ok(Checked {
         pedestal_planned,
         collisions: collisions::entries(&stood.avoided),

@@ -118,7 +118,7 @@ pub fn lay(
             )?;
             let mut laid = laid.widen(&mut plan.points, machine);
             if let Some(b) = &below_resolution {
-                let expected = laid.planned.volume * laid.planned.fill;
+                let expected = laid.planned.expected();
                 laid.planned.tolerance = crate::resolution::tolerance(laid.widened, expected);
                 laid.warnings.push(Warning::feature(
                     id,
@@ -233,6 +233,8 @@ fn laid_feature(
             kind: f.kind.as_str().to_string(),
             volume: f.volume,
             fill: params.filling_ratio,
+            sparse: fig.sparse_volume,
+            density: fig.sparse_density(params.infill_density),
             layers: fig.layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,

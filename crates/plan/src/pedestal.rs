@@ -330,13 +330,16 @@ impl Stood {
     }
 
     /// What the self-check is asked of it: extruded within its tolerance of the prism's volume
-    /// × `fill` (the base feature's `filling_ratio`).
-    pub fn planned(&self, filament_area: f64, fill: f64) -> PlannedFeature {
+    /// × `fill` (the base feature's `filling_ratio`), its sparse layers' volume at `density`
+    /// (the base feature's `infill_density`).
+    pub fn planned(&self, filament_area: f64, fill: f64, density: f64) -> PlannedFeature {
         PlannedFeature {
             id: self.id,
             kind: KIND.to_string(),
             volume: self.volume,
             fill,
+            sparse: self.plan.figures.sparse_volume,
+            density: self.plan.figures.sparse_density(density),
             layers: self.plan.figures.layers,
             extruded: self.plan.figures.filament * filament_area,
             tolerance: slicer::verify::VOLUME_TOLERANCE,

@@ -16,6 +16,13 @@ pub struct FeatureFigures {
     /// Filament fed for support material's beads, mm (planar layers, issue 33): not the
     /// part's; the points carry it like any other.
     pub support_filament: f64,
+    /// Volume of the feature's layers laid as sparse infill (issue 33): each layer's sparse
+    /// area × its thickness, summed, mm³; 0 without sparse infill. Its beads cover
+    /// `sparse_laid` of it, so the self-check expects that much less there.
+    pub sparse_volume: f64,
+    /// The share of `sparse_volume` its lines cover, mm³: each layer's sparse volume × its
+    /// density (`infill_density`, or the gyroid's at the layer's height).
+    pub sparse_laid: f64,
     /// Thinnest, mean and thickest layer, mm.
     pub thickness: (f64, f64, f64),
     /// How far (mm) the feature's surface reaches below its tree's build plate (the base
@@ -28,6 +35,16 @@ pub struct FeatureFigures {
 }
 
 impl FeatureFigures {
+    /// The mean share of the sparse volume its lines cover (`sparse_laid / sparse_volume`):
+    /// `density` (the feature's `infill_density`) when nothing is sparse.
+    pub fn sparse_density(&self, density: f64) -> f64 {
+        if self.sparse_volume > 0.0 {
+            self.sparse_laid / self.sparse_volume
+        } else {
+            density
+        }
+    }
+
     /// Closes feature `id`'s figures: its `points`, and its layers from the thicknesses of the
     /// layers that printed (thinnest, mean, thickest; zeros and a warning when none did).
     pub(crate) fn finish(&mut self, id: usize, points: usize, printed: &[f64]) {

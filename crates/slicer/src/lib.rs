@@ -3,7 +3,8 @@
 //! - [`params`]: a feature's layer parameters (the paper's process keys) with defaults,
 //!   validation, per-feature patches and the layer thicknesses they give;
 //! - [`fill`]: filling one planar layer by path mode (raster, zig-zag, contour,
-//!   contour-zig-zag) and ordering the paths for print;
+//!   contour-zig-zag), with sparse infill in a pattern away from its solid skin
+//!   ([`fill::sparse`]), and ordering the paths for print;
 //! - [`feature_fill`]: a feature's layers filled by its planner before they are laid from where
 //!   the nozzle is (the part of planning that features do in parallel);
 //! - [`feature_plan`]: what a planner returns ([`FeaturePlan`] of [`Layer`]s of paths) and
@@ -15,7 +16,8 @@
 //!   was (both planners);
 //! - private: `chart` (the chart of a reference surface), `fold` (offset folds), `region_fill`
 //!   (one region of a curved or thin planar layer filled with beads of varying width, shared
-//!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`;
+//!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`,
+//!   `skins` (the solid skins of planar layers, from their neighbours' sections);
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
 //! - [`support_material`]: columns of support under what the overhang limit leaves unheld;
@@ -49,6 +51,7 @@ pub mod planar;
 mod region_fill;
 pub mod resolution;
 pub mod skirt;
+mod skins;
 mod sst;
 pub mod support;
 pub mod support_material;
@@ -63,4 +66,4 @@ pub use toolpath::vec3;
 pub use feature_fill::{fill_feature, FeatureFill};
 pub use feature_plan::{sequence, FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
-pub use params::{LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};
+pub use params::{InfillPattern, LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

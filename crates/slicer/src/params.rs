@@ -40,6 +40,24 @@ pub enum PathMode {
     ContourZigzag,
 }
 
+/// The pattern of sparse infill (issue 33, the process key `infill_pattern`), laid where a
+/// planar layer's interior is neither perimeter nor solid skin when `infill_density` < 1
+/// ([`crate::fill::sparse`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InfillPattern {
+    /// Parallel lines at `raster_angle_deg`, turned 90° every other layer (the default).
+    #[default]
+    Rectilinear,
+    /// Lines in both directions on every layer, each direction twice as far apart.
+    Grid,
+    /// Lines in three directions 60° apart on every layer, each three times as far apart,
+    /// crossing in common points (triangles).
+    Triangles,
+    /// The gyroid's section at the layer's height: wave lines that shift from layer to layer.
+    Gyroid,
+}
+
 /// How layer thicknesses are chosen (the paper's `layer_height_pattern`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -179,6 +197,31 @@ impl Slicing {
     }
 }
 
+/// Default `top_solid_layers`.
+pub const DEFAULT_TOP_SOLID_LAYERS: usize = 4;
+/// Default `bottom_solid_layers`.
+pub const DEFAULT_BOTTOM_SOLID_LAYERS: usize = 3;
+/// Default `solid_infill_below_area`, mm² (PrusaSlicer's).
+pub const DEFAULT_SOLID_INFILL_BELOW_AREA: f64 = 70.0;
+
+// The sparse-infill keys at their defaults are left out when the parameters are written (a
+// program's header, plan.json), so a plan without sparse infill reads as it did before them.
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+fn is_rectilinear(p: &InfillPattern) -> bool {
+    *p == InfillPattern::Rectilinear
+}
+fn is_default_top(n: &usize) -> bool {
+    *n == DEFAULT_TOP_SOLID_LAYERS
+}
+fn is_default_bottom(n: &usize) -> bool {
+    *n == DEFAULT_BOTTOM_SOLID_LAYERS
+}
+fn is_default_below_area(a: &f64) -> bool {
+    *a == DEFAULT_SOLID_INFILL_BELOW_AREA
+}
+
 /// Layer and path parameters of one feature.
 ///
 /// Missing keys take their defaults when deserialising (`{}` is [`LayerParams::default`]);
@@ -206,6 +249,28 @@ pub struct LayerParams {
     pub filling_ratio: f64,
     /// Number of perimeters for `contour_zigzag`. Default 2.
     pub perimeters: usize,
+    /// Share of the sparse interior of planar layers that infill lines cover, in (0, 1]: lines
+    /// `bead width / infill_density` apart in the `infill_pattern`, inside the perimeters, away
+    /// from the solid skins. Default 1: no sparse infill, every layer solid (as before issue
+    /// 33). Curved layers stay solid whatever it is.
+    #[serde(skip_serializing_if = "is_one")]
+    pub infill_density: f64,
+    /// Pattern of sparse infill ([`InfillPattern`]). Default `rectilinear`.
+    #[serde(skip_serializing_if = "is_rectilinear")]
+    pub infill_pattern: InfillPattern,
+    /// Layers of solid skin under every top surface of a planar feature (the part of a layer
+    /// that one of the next `top_solid_layers` layers does not cover). Default 4.
+    #[serde(skip_serializing_if = "is_default_top")]
+    pub top_solid_layers: usize,
+    /// Layers of solid skin over every bottom surface (the part of a layer that one of the
+    /// `bottom_solid_layers` layers below does not cover). Default 3.
+    #[serde(skip_serializing_if = "is_default_bottom")]
+    pub bottom_solid_layers: usize,
+    /// A piece of a layer's sparse interior smaller than this (mm²) is laid solid (as
+    /// PrusaSlicer's key of that name): a pattern whose lines lie millimetres apart cannot
+    /// lay its density in it. Default 70.
+    #[serde(skip_serializing_if = "is_default_below_area")]
+    pub solid_infill_below_area: f64,
     /// Direction of raster and zig-zag lines, degrees from +x. Default 45; zig-zag adds 90° on
     /// odd layers.
     pub raster_angle_deg: f64,
@@ -274,6 +339,11 @@ impl Default for LayerParams {
             path_mode: PathMode::ContourZigzag,
             filling_ratio: 1.0,
             perimeters: 2,
+            infill_density: 1.0,
+            infill_pattern: InfillPattern::Rectilinear,
+            top_solid_layers: DEFAULT_TOP_SOLID_LAYERS,
+            bottom_solid_layers: DEFAULT_BOTTOM_SOLID_LAYERS,
+            solid_infill_below_area: DEFAULT_SOLID_INFILL_BELOW_AREA,
             raster_angle_deg: 45.0,
             fixed_tool_axis: None,
             layer_strategy: LayerStrategy::Auto,
@@ -308,6 +378,12 @@ impl LayerParams {
             Some(s) => s,
             None => bead_width / self.filling_ratio,
         }
+    }
+
+    /// True when planar layers get sparse infill: `infill_density` below 1 and a path mode
+    /// with infill lines (every mode but `contour`, whose rings fill the whole layer).
+    pub fn sparse_infill(&self) -> bool {
+        self.infill_density < 1.0 && self.path_mode != PathMode::Contour
     }
 
     /// Spacing for layer number `layer`: with the adaptive pattern and a non-empty
@@ -411,6 +487,16 @@ impl LayerParams {
         if !(r.is_finite() && r > 0.0 && r <= 1.0) {
             return Err(format!("filling_ratio must be in (0, 1], got {r}"));
         }
+        let d = self.infill_density;
+        if !(d.is_finite() && d > 0.0 && d <= 1.0) {
+            return Err(format!("infill_density must be in (0, 1], got {d}"));
+        }
+        let a = self.solid_infill_below_area;
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(format!(
+                "solid_infill_below_area must be 0 mm^2 or more, got {a}"
+            ));
+        }
         if !self.raster_angle_deg.is_finite() {
             return Err(format!(
                 "raster_angle_deg must be a finite number of degrees, got {}",
@@ -513,6 +599,21 @@ impl LayerParams {
         if let Some(v) = p.perimeters {
             out.perimeters = v;
         }
+        if let Some(v) = p.infill_density {
+            out.infill_density = v;
+        }
+        if let Some(v) = p.infill_pattern {
+            out.infill_pattern = v;
+        }
+        if let Some(v) = p.top_solid_layers {
+            out.top_solid_layers = v;
+        }
+        if let Some(v) = p.bottom_solid_layers {
+            out.bottom_solid_layers = v;
+        }
+        if let Some(v) = p.solid_infill_below_area {
+            out.solid_infill_below_area = v;
+        }
         if let Some(v) = p.raster_angle_deg {
             out.raster_angle_deg = v;
         }
@@ -610,6 +711,21 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::perimeters`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub perimeters: Option<usize>,
+    /// Overrides [`LayerParams::infill_density`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub infill_density: Option<f64>,
+    /// Overrides [`LayerParams::infill_pattern`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub infill_pattern: Option<InfillPattern>,
+    /// Overrides [`LayerParams::top_solid_layers`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub top_solid_layers: Option<usize>,
+    /// Overrides [`LayerParams::bottom_solid_layers`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bottom_solid_layers: Option<usize>,
+    /// Overrides [`LayerParams::solid_infill_below_area`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solid_infill_below_area: Option<f64>,
     /// Overrides [`LayerParams::raster_angle_deg`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub raster_angle_deg: Option<f64>,

@@ -7,9 +7,11 @@
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
 use crate::feature_mesh::{feature_mesh, slicing_tolerance};
-use crate::fill::{fill_layer, order_greedy, regions_from_loops, thinner_than, Region};
+use crate::fill::{
+    fill_layer_with, order_greedy, regions_from_loops, thinner_than, Region, SparseLayer,
+};
 use crate::geom2d::Point2;
-use crate::params::{LayerParams, PathMode};
+use crate::params::{InfillPattern, LayerParams, PathMode};
 use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint};
 use brep::math::{P3, V3};
@@ -105,6 +107,21 @@ pub fn fill_regions(
     width: f64,
     spacing: f64,
 ) -> Vec<FillPath> {
+    fill_regions_with(regions, params, layer, width, spacing, None).0
+}
+
+/// [`fill_regions`] with sparse infill away from the layer's skin (`sparse`,
+/// [`crate::fill::fill_layer_with`]), and the area laid sparse (mm²) with the share of it its
+/// lines cover (mm², area × the layer's density). Regions too thin for rings, and the strips
+/// rings leave, stay solid.
+pub fn fill_regions_with(
+    regions: Vec<Region>,
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+    sparse: Option<SparseLayer>,
+) -> (Vec<FillPath>, (f64, f64)) {
     let rings = matches!(
         params.path_mode,
         PathMode::Contour | PathMode::ContourZigzag
@@ -112,7 +129,7 @@ pub fn fill_regions(
     let (thin, thick): (Vec<Region>, Vec<Region>) = regions
         .into_iter()
         .partition(|r| rings && thinner_than(r, thin_depth(params, width, spacing)));
-    let filled = fill_layer(&thick, params, layer, width, spacing);
+    let filled = fill_layer_with(&thick, params, layer, width, spacing, sparse);
     let mut paths: Vec<FillPath> = filled
         .paths
         .into_iter()
@@ -138,7 +155,8 @@ pub fn fill_regions(
             Boundary::Beads,
         ));
     }
-    paths
+    let laid = filled.sparse_area * filled.sparse_density;
+    (paths, (filled.sparse_area, laid))
 }
 
 /// Plans one two5d feature in planar layers parallel to its reference plane; its first travel
@@ -164,6 +182,9 @@ pub struct Two5dFill {
     tops: Vec<(f64, f64, f64)>,
     /// Each layer's fill paths in its plane.
     filled: Vec<Vec<FillPath>>,
+    /// Each layer's area laid sparse and the share of it its lines cover, mm² (all 0 without
+    /// sparse infill).
+    sparse: Vec<(f64, f64)>,
     fig: FeatureFigures,
 }
 
@@ -202,13 +223,15 @@ pub fn fill_two5d(
             section_regions(&mesh, &cut, &cut)
         })
         .collect();
-    let filled = fill_sections(sections, params, bead.width, spacing);
+    let mids: Vec<f64> = tops.iter().map(|t| t.0).collect();
+    let (filled, sparse) = fill_sections(sections, &mids, params, bead.width, spacing);
     Ok(Two5dFill {
         id: f.id,
         plane,
         bead,
         tops,
         filled,
+        sparse,
         fig,
     })
 }
@@ -280,46 +303,117 @@ pub fn fill_prism(
     bead: Bead,
 ) -> Two5dFill {
     let spacing = params.spacing(bead.width);
-    let tops = (0..layers)
+    let tops: Vec<(f64, f64, f64)> = (0..layers)
         .map(|k| {
             let z = k as f64 * height;
             (z + 0.5 * height, z + height, height)
         })
         .collect();
-    let filled = fill_sections(vec![regions.to_vec(); layers], params, bead.width, spacing);
+    let mids: Vec<f64> = tops.iter().map(|t| t.0).collect();
+    let sections = vec![regions.to_vec(); layers];
+    let (filled, sparse) = fill_sections(sections, &mids, params, bead.width, spacing);
     Two5dFill {
         id,
         plane,
         bead,
         tops,
         filled,
+        sparse,
         fig: FeatureFigures::default(),
     }
 }
 
-/// Each layer's paths from its section's regions, filled in parallel. A layer whose section is
-/// the same polygon as an earlier layer's ([`SectionKey`]) of the same parity where the fill
-/// alternates ([`alternates`]: the zig-zag's angle turns every other layer, and nothing else of
-/// a fill depends on the layer) takes a copy of that layer's fill instead of making it again:
-/// the layers of a prism are all one section. Bottom and top layers then get their solid
-/// skins.
+/// Each layer's paths from its section's regions, filled in parallel, and each layer's area
+/// laid sparse (mm²). A layer whose section is the same polygon as an earlier layer's
+/// ([`SectionKey`]) of the same parity where the fill alternates ([`alternates`]: the
+/// zig-zag's angle turns every other layer, and nothing else of a fill depends on the layer)
+/// takes a copy of that layer's fill instead of making it again: the layers of a prism are all
+/// one section.
+///
+/// Without sparse infill (`infill_density` 1, [`LayerParams::sparse_infill`]) the bottom and
+/// top layers then get their solid skins. With it, each layer's skin is found from its
+/// neighbours' sections ([`crate::skins`], at `mids`, each layer's middle height) and laid
+/// solid, the rest of its interior sparse; only layers without skin share a fill, on layers
+/// of the same parity (rectilinear turns every other layer) and never for the gyroid (its
+/// lines change with the height).
 fn fill_sections(
     sections: Vec<Vec<Region>>,
+    mids: &[f64],
     params: &LayerParams,
     width: f64,
     spacing: f64,
-) -> Vec<Vec<FillPath>> {
+) -> (Vec<Vec<FillPath>>, Vec<(f64, f64)>) {
     let n = sections.len();
     let mut sections = sections;
     if params.path_mode == PathMode::Contour {
         sections.par_iter_mut().for_each(canonical_order);
     }
     let keys: Vec<SectionKey> = sections.par_iter().map(|r| SectionKey::new(r)).collect();
-    // The first layer with each section and parity; every layer points at its first.
-    let mut first: Vec<usize> = Vec::with_capacity(n);
+    let sparse = params.sparse_infill();
+    let skins: Vec<Vec<Region>> = if sparse {
+        let same: Vec<bool> = keys.windows(2).map(|k| k[0] == k[1]).collect();
+        let (top, bottom) = (params.top_solid_layers, params.bottom_solid_layers);
+        crate::skins::skins(&sections, &same, top, bottom, width, params.tolerance)
+    } else {
+        vec![vec![]; n]
+    };
+    let first = first_of_each_fill(&keys, &skins, params);
+    let mut fills: Vec<Option<LayerFill>> = sections
+        .into_par_iter()
+        .enumerate()
+        .map(|(layer, regions)| {
+            let at = sparse.then(|| SparseLayer {
+                skin: &skins[layer],
+                z: mids.get(layer).copied().unwrap_or(0.0),
+            });
+            (first[layer] == layer)
+                .then(|| fill_regions_with(regions, params, layer, width, spacing, at))
+        })
+        .collect();
+    // The last layer to take each fill, which moves it instead of copying it.
+    let mut last: Vec<usize> = (0..n).collect();
+    for (layer, &j) in first.iter().enumerate() {
+        last[j] = layer;
+    }
+    (0..n)
+        .map(|layer| {
+            let j = first[layer];
+            let (paths, area) = if last[j] == layer {
+                fills[j].take()
+            } else {
+                fills[j].clone()
+            }
+            .unwrap_or_default();
+            match sparse {
+                true => (paths, area),
+                false => (solid_on_skins(paths, layer, n), area),
+            }
+        })
+        .unzip()
+}
+
+/// A layer's paths, and its area laid sparse with the share of it its lines cover (mm²).
+type LayerFill = (Vec<FillPath>, (f64, f64));
+
+/// For each layer, the first layer whose fill it takes (itself when none before it has the
+/// same section, [`SectionKey`], and parity where the fill alternates). With sparse infill,
+/// a layer with skin, and every gyroid layer, fills itself.
+fn first_of_each_fill(
+    keys: &[SectionKey],
+    skins: &[Vec<Region>],
+    params: &LayerParams,
+) -> Vec<usize> {
+    let sparse = params.sparse_infill();
+    let mut first: Vec<usize> = Vec::with_capacity(keys.len());
     let mut seen: crate::fast_hash::FastMap<(u64, usize), Vec<usize>> = Default::default();
     for (layer, key) in keys.iter().enumerate() {
-        let parity = if alternates(params.path_mode) {
+        let own =
+            sparse && (!skins[layer].is_empty() || params.infill_pattern == InfillPattern::Gyroid);
+        if own {
+            first.push(layer);
+            continue;
+        }
+        let parity = if alternates(params.path_mode) || sparse {
             layer % 2
         } else {
             0
@@ -333,30 +427,7 @@ fn fill_sections(
             }
         }
     }
-    let mut fills: Vec<Option<Vec<FillPath>>> = sections
-        .into_par_iter()
-        .enumerate()
-        .map(|(layer, regions)| {
-            (first[layer] == layer).then(|| fill_regions(regions, params, layer, width, spacing))
-        })
-        .collect();
-    // The last layer to take each fill, which moves it instead of copying it.
-    let mut last: Vec<usize> = (0..n).collect();
-    for (layer, &j) in first.iter().enumerate() {
-        last[j] = layer;
-    }
-    (0..n)
-        .map(|layer| {
-            let j = first[layer];
-            let paths = if last[j] == layer {
-                fills[j].take()
-            } else {
-                fills[j].clone()
-            }
-            .unwrap_or_default();
-            solid_on_skins(paths, layer, n)
-        })
-        .collect()
+    first
 }
 
 /// Puts a section's regions, and each region's holes, in an order of their own (by their
@@ -495,6 +566,7 @@ impl Two5dFill {
             bead,
             tops,
             filled,
+            sparse,
             mut fig,
         } = self;
         let mut cursor = entry;
@@ -563,6 +635,9 @@ impl Two5dFill {
                     print: start + 1..points.len(),
                 });
             }
+            let (area, laid) = sparse.get(layer).copied().unwrap_or_default();
+            fig.sparse_volume += area * dl;
+            fig.sparse_laid += laid * dl;
             layers.push(Layer {
                 index: layer,
                 thickness: dl,
@@ -696,7 +771,7 @@ mod tests {
             path_mode: PathMode::Contour,
             ..LayerParams::default()
         };
-        let filled = fill_sections(vec![a, b.clone(), b], &params, 0.45, 0.45);
+        let (filled, _) = fill_sections(vec![a, b.clone(), b], &[0.0; 3], &params, 0.45, 0.45);
         assert!(!filled[1].is_empty());
         assert_eq!(filled[0], filled[1]);
     }
@@ -713,7 +788,7 @@ mod tests {
             let (width, spacing) = (0.45, 0.4);
             let sections: Vec<Vec<Region>> =
                 (0..6).map(|l| cut_box(0.05 + 0.1 * l as f64)).collect();
-            let shared = fill_sections(sections.clone(), &params, width, spacing);
+            let (shared, _) = fill_sections(sections.clone(), &[0.0; 6], &params, width, spacing);
             let n = sections.len();
             for (layer, regions) in sections.into_iter().enumerate() {
                 let own = solid_on_skins(

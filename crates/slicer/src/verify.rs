@@ -20,7 +20,8 @@ pub enum PlanProblem {
     /// The extruded volume is off by more than the feature's tolerance ([`VOLUME_TOLERANCE`]
     /// unless it is below the nozzle's resolution).
     #[error(
-        "feature {id} ({kind}): {extruded:.3} mm^3 extruded for {expected:.3} mm^3 expected (volume {volume:.3} mm^3 x fill {fill}), {percent:+.2} %"
+        "feature {id} ({kind}): {extruded:.3} mm^3 extruded for {expected:.3} mm^3 expected ({}), {percent:+.2} %",
+        model(*.volume, *.fill, *.sparse, *.density)
     )]
     Volume {
         /// Feature id in the plan.
@@ -31,13 +32,29 @@ pub enum PlanProblem {
         volume: f64,
         /// The fill it was planned with (`filling_ratio`).
         fill: f64,
-        /// Volume × fill, mm³.
+        /// The volume of its layers laid sparse, mm³ ([`PlannedFeature::sparse`]).
+        sparse: f64,
+        /// The sparse infill's density ([`PlannedFeature::density`]).
+        density: f64,
+        /// What it should put down ([`PlannedFeature::expected`]), mm³.
         expected: f64,
         /// What the plan puts down, mm³.
         extruded: f64,
         /// `(extruded − expected) / expected`, in percent.
         percent: f64,
     },
+}
+
+/// How the expected volume is made, for [`PlanProblem::Volume`]'s message: `volume V mm^3 x
+/// fill f`, and with sparse infill `(volume V − sparse S) mm^3 x fill f + S mm^3 x density d`.
+fn model(volume: f64, fill: f64, sparse: f64, density: f64) -> String {
+    if sparse > 0.0 {
+        format!(
+            "(volume {volume:.3} - sparse {sparse:.3}) mm^3 x fill {fill} + {sparse:.3} mm^3 x density {density:.4}"
+        )
+    } else {
+        format!("volume {volume:.3} mm^3 x fill {fill}")
+    }
 }
 
 impl PlanProblem {
@@ -59,8 +76,14 @@ pub struct PlannedFeature {
     /// The feature's solid volume, mm³.
     pub volume: f64,
     /// Its `filling_ratio`: beads `w` wide laid `w / filling_ratio` apart cover that share of
-    /// each layer, perimeters and infill alike, so the plan should put down `volume × fill`.
+    /// each layer, perimeters, skins and solid infill alike.
     pub fill: f64,
+    /// The volume of its layers laid as sparse infill, mm³ (each layer's sparse area × its
+    /// thickness, from the regions the planner filled; 0 without sparse infill).
+    pub sparse: f64,
+    /// The share of `sparse` its beads cover: `infill_density`, or the gyroid's mean over the
+    /// feature's sparse layers (its lines are longer at some heights than at others).
+    pub density: f64,
     /// Layers planned.
     pub layers: usize,
     /// Bead volume put down (Eq. 1 filament length × filament area), mm³.
@@ -71,8 +94,18 @@ pub struct PlannedFeature {
     pub tolerance: f64,
 }
 
+impl PlannedFeature {
+    /// What the plan should put down, mm³: the solid part of the volume (perimeters, skins,
+    /// solid infill) × `fill`, and the sparse part × `density`:
+    /// `(volume − sparse) × fill + sparse × density`. The volume is the solid's own (not the
+    /// layers' areas summed), so a lost layer or feature still shows.
+    pub fn expected(&self) -> f64 {
+        (self.volume - self.sparse) * self.fill + self.sparse * self.density
+    }
+}
+
 /// Checks one feature's plan: at least one layer, and extruded volume within its
-/// `tolerance` (at least [`VOLUME_TOLERANCE`]) of `volume × fill`.
+/// `tolerance` (at least [`VOLUME_TOLERANCE`]) of [`PlannedFeature::expected`].
 pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
     if f.layers == 0 || f.extruded <= 0.0 {
         return Some(PlanProblem::NoLayers {
@@ -81,13 +114,15 @@ pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
             volume: f.volume,
         });
     }
-    let expected = f.volume * f.fill;
+    let expected = f.expected();
     let rel = (f.extruded - expected) / expected.max(crate::tolerance::VOLUME_FLOOR);
     (rel.abs() > f.tolerance.max(VOLUME_TOLERANCE)).then(|| PlanProblem::Volume {
         id: f.id,
         kind: f.kind.clone(),
         volume: f.volume,
         fill: f.fill,
+        sparse: f.sparse,
+        density: f.density,
         expected,
         extruded: f.extruded,
         percent: rel * 100.0,
@@ -109,6 +144,8 @@ mod tests {
             kind: "freeform".into(),
             volume: 100.0,
             fill,
+            sparse: 0.0,
+            density: 1.0,
             layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,
@@ -157,5 +194,21 @@ mod tests {
         assert!(check_planned(&f(10, 80.0, 0.8)).is_none());
         assert!(check_planned(&f(10, 100.0, 0.8)).is_some());
         assert_eq!(check_plan(&[f(10, 80.0, 0.8), f(0, 0.0, 1.0)]).len(), 1);
+    }
+
+    /// Sparse infill: 60 of the 100 mm³ laid at density 0.2 should put down 40 + 12 mm³;
+    /// the solid volume would be far off, and a lost layer's worth still shows.
+    #[test]
+    fn the_sparse_part_is_expected_at_its_density() {
+        let sparse = |extruded| PlannedFeature {
+            sparse: 60.0,
+            density: 0.2,
+            ..f(10, extruded, 1.0)
+        };
+        assert!((sparse(52.0).expected() - 52.0).abs() < 1e-9);
+        assert!(check_planned(&sparse(52.0)).is_none());
+        assert!(check_planned(&sparse(100.0)).is_some());
+        let p = check_planned(&sparse(48.0)).expect("short by a layer");
+        assert!(p.to_string().contains("sparse 60.000"), "{p}");
     }
 }

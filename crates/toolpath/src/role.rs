@@ -10,10 +10,11 @@ pub enum Role {
     ExternalPerimeter,
     /// A ring inside the outermost one.
     Perimeter,
-    /// Infill lines laid edge to edge: where the fill is solid (`filling_ratio` 1), and on a
-    /// feature's bottom and top layers.
+    /// Infill lines laid edge to edge: where the fill is solid (`filling_ratio` 1), on a
+    /// feature's bottom and top layers, and on the solid skins of sparse infill.
     SolidInfill,
-    /// Infill lines laid apart (`filling_ratio` below 1) on the layers between.
+    /// Infill lines laid apart: sparse infill (`infill_density` below 1) away from the skins,
+    /// or every line of a `filling_ratio` below 1 on the layers between.
     InternalInfill,
     /// Beads as wide as a strip narrower than a ring leaves, or spurs into sharp corners.
     GapFill,

@@ -34,6 +34,7 @@ mod offset;
 mod order;
 mod pattern;
 mod region;
+pub mod sparse;
 
 use crate::geom2d::{area2, dist};
 use crate::params::{LayerParams, PathMode};
@@ -48,6 +49,7 @@ pub(crate) use boolean::{difference, grow, intersection, outside_grown, union};
 pub use offset::thinner_than;
 pub use order::{order_greedy, order_paths};
 pub use region::regions_from_loops;
+pub use sparse::SparseLayer;
 
 /// One continuous extrusion path (an open polyline; a closed perimeter repeats its first point
 /// at the end).
@@ -170,6 +172,23 @@ pub fn fill_layer(
     width: f64,
     spacing: f64,
 ) -> FilledLayer {
+    fill_layer_with(regions, params, layer, width, spacing, None)
+}
+
+/// [`fill_layer`], and with `sparse` (and [`LayerParams::sparse_infill`]) the infill lines of
+/// each region laid solid only on the layer's skin ([`SparseLayer::skin`]) and sparse
+/// ([`sparse`]) on the rest of its interior, whose area [`FilledLayer::sparse_area`] gives.
+/// Rings and gaps are as [`fill_layer`] makes them.
+pub fn fill_layer_with(
+    regions: &[Region],
+    params: &LayerParams,
+    layer: usize,
+    width: f64,
+    spacing: f64,
+    sparse: Option<SparseLayer>,
+) -> FilledLayer {
+    let sparse = sparse.filter(|_| params.sparse_infill());
+    let mut sparse_area = 0.0;
     let mut out = Vec::new();
     let mut gaps: Shapes = Vec::new();
     if !(width.is_finite() && width > 0.0 && spacing.is_finite() && spacing > 0.0) {
@@ -224,24 +243,25 @@ pub fn fill_layer(
             tol: tol.min(0.0025 * width),
             print_tol: ring_print_tolerance(tol, width),
         };
-        let lines_from = out.len();
+        let lines = Lines {
+            role: infill,
+            sparse: sparse.as_ref(),
+            params,
+            layer,
+            inset: match params.path_mode {
+                PathMode::ContourZigzag => 0.5 * spacing,
+                _ => 0.5 * width,
+            },
+        };
         match params.path_mode {
             PathMode::Raster => {
                 let area = erode(&base, 0.5 * width, &ctx.join);
-                let reach = Some(Reach { base: &base, width });
-                scan_fill(
-                    &area,
-                    base_angle.to_radians(),
-                    spacing,
-                    false,
-                    reach,
-                    &mut out,
-                );
+                let angle = base_angle.to_radians();
+                sparse_area += lines.lay(&area, &base, angle, false, &ctx, &mut out);
             }
             PathMode::Zigzag => {
                 let area = erode(&base, 0.5 * width, &ctx.join);
-                let reach = Some(Reach { base: &base, width });
-                scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
+                sparse_area += lines.lay(&area, &base, zigzag_angle, true, &ctx, &mut out);
             }
             PathMode::Contour => {
                 rings(&base, &ctx, MAX_RINGS, true, &mut out, &mut gaps);
@@ -259,14 +279,8 @@ pub fn fill_layer(
                 // infill area grown back by half a spacing (not the ring itself eroded, which
                 // would take in the strips left to the gaps).
                 let edge = offset(&area, 0.5 * spacing, &ctx.join, 1.0);
-                let reach = Some(Reach { base: &edge, width });
-                let from = out.len();
-                scan_fill(&area, zigzag_angle, spacing, true, reach, &mut out);
-                set_role(&mut out[from..], infill);
+                sparse_area += lines.lay(&area, &edge, zigzag_angle, true, &ctx, &mut out);
             }
-        }
-        if matches!(params.path_mode, PathMode::Raster | PathMode::Zigzag) {
-            set_role(&mut out[lines_from..], infill);
         }
     }
     for p in &mut out {
@@ -279,6 +293,92 @@ pub fn fill_layer(
     FilledLayer {
         paths: out,
         gaps: gaps.into_iter().filter_map(shape_region).collect(),
+        sparse_area,
+        sparse_density: sparse.map_or(params.infill_density, |s| {
+            sparse::layer_density(params, s.z, width)
+        }),
+    }
+}
+
+/// How one layer's infill lines are laid: solid (the lines of the path mode, role `role`),
+/// or, with `sparse`, solid on the skin and in the infill pattern elsewhere.
+struct Lines<'a> {
+    role: Role,
+    sparse: Option<&'a SparseLayer<'a>>,
+    params: &'a LayerParams,
+    layer: usize,
+    /// How far inside the beads' edge the lines' centres keep: half a bead for raster and
+    /// zig-zag, half a spacing inside the rings of contour-zig-zag.
+    inset: f64,
+}
+
+impl Lines<'_> {
+    /// The infill lines of a region whose lines' centres lie in `area` and whose beads fill
+    /// `edge` (`area` grown by half a spacing): lines at `angle` (chained with `join`),
+    /// appended to `out`. Returns the area (mm²) laid sparse.
+    fn lay(
+        &self,
+        area: &Shapes,
+        edge: &Shapes,
+        angle: f64,
+        join: bool,
+        ctx: &Ctx,
+        out: &mut Vec<Path2>,
+    ) -> f64 {
+        let (width, spacing) = (ctx.width, ctx.spacing);
+        let Some(sparse) = self.sparse else {
+            let from = out.len();
+            scan_fill(
+                area,
+                angle,
+                spacing,
+                join,
+                Some(Reach { base: edge, width }),
+                out,
+            );
+            set_role(&mut out[from..], self.role);
+            return 0.0;
+        };
+        use i_overlay::core::fill_rule::FillRule;
+        use i_overlay::core::overlay_rule::OverlayRule;
+        use i_overlay::float::single::SingleFloatOverlay;
+        let skin: Shapes = sparse.skin.iter().flat_map(region_shapes).collect();
+        let (mut solid, rest) = if skin.is_empty() {
+            (vec![], edge.clone())
+        } else {
+            (
+                edge.overlay(&skin, OverlayRule::Intersect, FillRule::NonZero),
+                edge.overlay(&skin, OverlayRule::Difference, FillRule::NonZero),
+            )
+        };
+        // Pieces too small for the pattern's density are laid solid.
+        let (small, rest): (Shapes, Shapes) = rest.into_iter().partition(|piece| {
+            shapes_area(&vec![piece.clone()]).abs() < self.params.solid_infill_below_area
+        });
+        if !small.is_empty() {
+            solid = if solid.is_empty() {
+                small
+            } else {
+                solid.overlay(&small, OverlayRule::Union, FillRule::NonZero)
+            };
+        }
+        // The skin solid: lines whose centres keep half a line off its edge, run on to it.
+        let solid_area = erode(&solid, self.inset, &ctx.join);
+        let from = out.len();
+        let reach = Some(Reach {
+            base: &solid,
+            width,
+        });
+        scan_fill(&solid_area, angle, spacing, join, reach, out);
+        set_role(&mut out[from..], Role::SolidInfill);
+        out.extend(sparse::pattern_lines(
+            &rest,
+            self.params,
+            self.layer,
+            sparse.z,
+            width,
+        ));
+        shapes_area(&rest).abs()
     }
 }
 
@@ -317,6 +417,11 @@ pub struct FilledLayer {
     /// sides, or the first ring cannot reach): each is to be filled with beads as wide as it
     /// is there (`freeform::fill_flat_region`; `planar::fill_regions` does so).
     pub gaps: Vec<Region>,
+    /// Area of the regions laid sparse, mm² ([`fill_layer_with`]; 0 without sparse infill).
+    pub sparse_area: f64,
+    /// The share of `sparse_area` the sparse lines cover on this layer
+    /// ([`sparse::layer_density`]: `infill_density`, or the gyroid's at the layer's height).
+    pub sparse_density: f64,
 }
 
 /// The part of a bead width by which a free line end stops short of the boundary it runs
