@@ -83,6 +83,9 @@ pub enum PedestalError {
         /// Why not.
         why: NoPedestal,
     },
+    /// The search for the pedestal was given up at [`Context::stop_at`].
+    #[error("given up at the placement time limit")]
+    TimeLimit,
 }
 
 /// Why a part cannot stand on a pedestal.
@@ -371,6 +374,9 @@ pub struct Context<'a> {
     pub id: usize,
     /// Plan on where even the tallest pedestal leaves moves hitting the table (with a warning).
     pub allow_collisions: bool,
+    /// Past this instant the search for the pedestal is given up ([`PedestalError::TimeLimit`],
+    /// [`crate::Options::stop_at`]).
+    pub stop_at: Option<std::time::Instant>,
 }
 
 /// What [`stand`] leaves: the tool path as checked, its collisions left, and the pedestal it
@@ -481,7 +487,8 @@ pub fn stand(
     drop(first);
     // The least pedestal that clears the table, with its check's result.
     let mut best: Option<(Stood, ToolPath, Avoided)> = None;
-    let fits = |n: usize| -> Result<bool, std::convert::Infallible> {
+    let fits = |n: usize| -> Result<bool, PedestalError> {
+        crate::in_time(ctx.stop_at).map_err(|_| PedestalError::TimeLimit)?;
         let stood = build(&o, n);
         let (p, a) = check(&stood);
         let clear = table_hits(&a) == 0;
@@ -490,7 +497,7 @@ pub fn stand(
         }
         Ok(clear)
     };
-    let Ok(found) = least(max, guess, fits);
+    let found = least(max, guess, fits)?;
     if let (Some(_), Some((stood, p, a))) = (found, best) {
         return Ok(Checked {
             path: p,
@@ -508,6 +515,7 @@ pub fn stand(
     let mut n = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
     let mut cleared = false;
     for _ in 0..NAMED_TRIES {
+        crate::in_time(ctx.stop_at).map_err(|_| PedestalError::TimeLimit)?;
         let s = build(&o, n);
         let (q, b) = check(&s);
         if table_hits(&b) == 0 {

@@ -7,14 +7,18 @@
 //! - [`reach`](mod@reach): on `kuka`, the least move of the part on the table (the cell's
 //!   `part_position`) that brings every point into the arm's reach and joint limits
 //!   ([`reach_shift`]).
+//! - [`size`](mod@size): whether the part can fit in any placement at all: the most it may
+//!   measure across ([`largest_across`]).
 //!
-//! Both search with a cheap model of the post's check and confirm their choice with the post
-//! itself, so a placement they return is one the post accepts.
+//! The two searches run with a cheap model of the post's check and confirm their choice with
+//! the post itself, so a placement they return is one the post accepts.
 
 pub mod reach;
+pub mod size;
 pub mod turn;
 
 pub use reach::{reach_shift, unreachable_points, ReachShift};
+pub use size::{across, largest_across};
 pub use turn::{bounding_path, envelope_excess, turn_to_fit, turned, TurnFit};
 
 use crate::sink::ProgramSink;
