@@ -330,7 +330,7 @@ fn turned_to_fit(
     if c.turn_deg() != 0.0 || !held {
         return None;
     }
-    match robot_post::fit::turn_to_fit(&plan.toolpath, machine) {
+    match robot_post::fit::turn_to_fit_until(&plan.toolpath, machine, options.stop_at) {
         Ok(fit) => (fit.angle_deg != 0.0).then(|| Ok(c.turned(fit.angle_deg))),
         Err(e @ robot_post::fit::FitError::NoTurn { .. }) => Some(Err(TriedEntry {
             candidate: format!("{} turned about +Z", c.label()),

@@ -19,7 +19,7 @@ pub mod turn;
 
 pub use reach::{reach_shift, unreachable_points, ReachShift};
 pub use size::{across, largest_across};
-pub use turn::{bounding_path, envelope_excess, turn_to_fit, turned, TurnFit};
+pub use turn::{bounding_path, envelope_excess, turn_to_fit, turn_to_fit_until, turned, TurnFit};
 
 use crate::sink::ProgramSink;
 use crate::PostError;
@@ -41,6 +41,9 @@ pub enum FitError {
         /// By how much it missed (mm).
         excess_mm: f64,
     },
+    /// The search was given up at its time limit ([`turn_to_fit_until`]).
+    #[error("the search for a turn that fits was given up at its time limit")]
+    TimeLimit,
     /// No move of the part on the table brings every point into the arm's reach.
     #[error("no place on the table of `{name}` brings every point into the arm's reach: the best, part_position [{x:.1}, {y:.1}], leaves {unreachable} point(s) out of reach")]
     NoShift {
