@@ -1,8 +1,8 @@
 //! The placement time limit (`plan::Options::placement_time_limit`): a part refused as
-//! modelled for something another placement may avoid (here the box, on a bed smaller than
-//! it) has its other placements tried without a limit, and none with a limit of 0 s: the
-//! refusal then says the search stopped at the limit, lists what it left untried and names
-//! the remedy.
+//! modelled for something another placement may avoid (here the box, on a bed too low for
+//! it, but wide enough that the box's size alone does not rule out every placement) has its
+//! other placements tried without a limit, and none with a limit of 0 s: the refusal then
+//! says the search stopped at the limit, lists what it left untried and names the remedy.
 
 use plan::{Options, Placement, PlanError, Process};
 use robot_post::{InMemory, MachineKind, MachineProfile};
@@ -15,10 +15,11 @@ fn the_box() -> brep::StepFile {
     brep::StepFile::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
-/// A Marlin printer whose bed, 5 mm each way, no face of the box fits.
-fn small_bed() -> MachineProfile {
+/// A Marlin printer whose bed is a metre wide and 1 mm high: no face of the box fits under
+/// it, yet its diagonal is longer than the box.
+fn low_bed() -> MachineProfile {
     let mut m = MachineProfile::builtin(MachineKind::Marlin);
-    m.bed_size = [5.0, 5.0, 5.0];
+    m.bed_size = [1000.0, 1000.0, 1.0];
     m
 }
 
@@ -35,13 +36,13 @@ fn refused(limit: Option<Duration>) -> (usize, Option<plan::retry::Stopped>) {
     match plan::plan_file_to(
         &the_box(),
         &Process::default(),
-        &small_bed(),
+        &low_bed(),
         &options,
         &mut out,
     ) {
         Err(PlanError::NoPlacement { tried, stopped, .. }) => (tried.len(), stopped),
         Err(e) => panic!("refused, but not after trying placements: {e}"),
-        Ok(_) => panic!("the box was planned on a 5 mm bed"),
+        Ok(_) => panic!("the box was planned on a 1 mm high bed"),
     }
 }
 
@@ -68,4 +69,33 @@ fn a_limit_of_zero_stops_after_the_part_as_modelled_naming_the_remedy() {
     assert!(line.contains("time limit of 0 s"), "{line}");
     assert!(line.contains("--placement-time-limit"), "{line}");
     assert!(line.contains("--base-face"), "{line}");
+}
+
+/// No placement fits a bed smaller than the part across (`robot_post::fit::largest_across`):
+/// none is planned, and the refusal says why.
+#[test]
+fn no_placement_is_planned_when_the_part_is_larger_than_any_placement_holds() {
+    let mut m = MachineProfile::builtin(MachineKind::Marlin);
+    m.bed_size = [5.0, 5.0, 5.0];
+    let holds = robot_post::fit::largest_across(&m)
+        .expect("a marlin profile")
+        .expect("a bound");
+    let options = Options {
+        placement: Placement::Find,
+        ..Default::default()
+    };
+    let mut out = InMemory::default();
+    match plan::plan_file_to(&the_box(), &Process::default(), &m, &options, &mut out) {
+        Err(PlanError::NoPlacement { tried, stopped, .. }) => {
+            assert_eq!(stopped, None);
+            assert_eq!(tried.len(), 1, "{tried:?}");
+            assert!(tried[0].failure.contains("none fits"), "{tried:?}");
+            assert!(
+                tried[0].failure.contains(&format!("{holds:.1} mm")),
+                "{tried:?}"
+            );
+        }
+        Err(e) => panic!("refused, but not after looking for placements: {e}"),
+        Ok(_) => panic!("the box was planned on a 5 mm bed"),
+    }
 }
