@@ -141,6 +141,7 @@ impl Refusal<'_> {
                 }
                 match stopped {
                     None => say("no placement plans: the part as modelled and every other placement tried (listed above) were refused; the refusal as modelled follows"),
+                    Some(s) if tried.is_empty() => say(&format!("no placement plans: the part as modelled was refused and no other placement was tried; {s}; the refusal as modelled follows")),
                     Some(s) => say(&format!("no placement plans: the part as modelled and the {} other placement(s) tried (listed above) were refused; {s}; the refusal as modelled follows", tried.len())),
                 }
                 *modelled

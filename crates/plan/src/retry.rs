@@ -421,7 +421,7 @@ impl std::fmt::Display for Stopped {
         };
         write!(
             f,
-            "the search for a placement stopped at its time limit of {} s{untried}: raise the limit (--placement-time-limit SECONDS, inf: none) or choose the placement (--base-face ID, --orient auto)",
+            "the search for a placement stopped at its time limit of {} s{untried}: raise the limit (--placement-time-limit SECONDS, inf: none) or choose the placement (--base-face ID, --orient auto, --set slicing=planar)",
             self.limit_s
         )
     }
@@ -561,6 +561,7 @@ pub fn find(
                 tried[tried.len() - 1].failure
             ),
             None => format!("as modelled: none of the {k} other placement(s) tried plans"),
+            Some(s) if k == 0 => format!("as modelled: no other placement tried; {s}"),
             Some(s) => format!("as modelled: none of the {k} other placement(s) tried plans; {s}"),
         };
         let mut entry = Candidate::MODELLED.entry(rule);

@@ -59,8 +59,9 @@ const DIRECTIONS: [[f64; 3]; 13] = [
     [-1.0, 1.0, 1.0],
 ];
 
-/// A lower bound (mm) of how far apart two of `points` lie: their largest extent along
-/// [`DIRECTIONS`] (0 for no point). Any turn of the points keeps it a lower bound.
+/// A lower bound (mm) of how far apart two of `points` lie: their largest extent along 13
+/// directions, the axes, the face diagonals and the body diagonals (0 for no point). Any turn
+/// of the points keeps it a lower bound.
 pub fn across(points: impl Iterator<Item = [f64; 3]>) -> f64 {
     let mut lo = [f64::INFINITY; 13];
     let mut hi = [f64::NEG_INFINITY; 13];
