@@ -454,9 +454,12 @@ pub fn find(
         Err(e) if placement_may_help(&e) || planar_may_help(&e, process) => e,
         done => return done,
     };
-    // The other placements are given up at the limit.
+    // The other placements are given up at the limit (or the caller's own, if sooner).
     let options = &Options {
-        stop_at,
+        stop_at: match (stop_at, options.stop_at) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        },
         ..options.clone()
     };
     let mut tried = vec![TriedEntry {
