@@ -157,6 +157,12 @@ pub struct PlanArgs {
     /// `modelled`: as the file has it
     #[arg(long, value_name = "auto|modelled", value_parser = ["auto", "modelled"])]
     pub orient: Option<String>,
+    /// Without --base-face or --orient: the most seconds spent finding a placement that plans
+    /// (the plan as modelled included); past it no other placement is tried, the one being
+    /// planned is given up, and the refusal lists what was tried and what was not. `inf`: no
+    /// limit
+    #[arg(long, value_name = "SECONDS", default_value_t = ::plan::retry::DEFAULT_TIME_LIMIT_S, value_parser = seconds)]
+    pub placement_time_limit: f64,
     /// Write the plan even when its self-check fails (a feature with no layer, or extruded
     /// volume more than 3 % from volume x fill) or some layers are unsupported (reaching past
     /// the layer below by more than layer height x tan(overhang_angle_deg)): the failures
@@ -167,6 +173,14 @@ pub struct PlanArgs {
     /// table (plan.json counts the colliding moves per feature): the lines become warnings
     #[arg(long)]
     pub allow_collisions: bool,
+}
+
+/// A time limit in seconds: a number from 0, or `inf`.
+fn seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v >= 0.0 => Ok(v),
+        _ => Err(format!("{s}: seconds from 0, or inf for no limit")),
+    }
 }
 
 /// Arguments of `features extract`.

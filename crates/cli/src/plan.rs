@@ -37,6 +37,10 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         allow_unreachable: args.allow_unreachable,
         strict: args.strict,
         progress: Some(&progress),
+        // `inf`: no limit.
+        placement_time_limit: std::time::Duration::try_from_secs_f64(args.placement_time_limit)
+            .ok(),
+        stop_at: None,
     };
     // The program goes to its files as the post makes it, under temporary names until every
     // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise. Each
@@ -127,11 +131,19 @@ impl Refusal<'_> {
         };
         // Every other placement refused too: each with its failure, then the part as modelled.
         let e = match e {
-            PlanError::NoPlacement { modelled, tried } => {
+            PlanError::NoPlacement {
+                modelled,
+                tried,
+                stopped,
+            } => {
                 for t in &tried {
                     say(&format!("placement {} refused: {}", t.candidate, t.failure));
                 }
-                say("no placement plans: the part as modelled and every other placement tried (listed above) were refused; the refusal as modelled follows");
+                match stopped {
+                    None => say("no placement plans: the part as modelled and every other placement tried (listed above) were refused; the refusal as modelled follows"),
+                    Some(s) if tried.is_empty() => say(&format!("no placement plans: the part as modelled was refused and no other placement was tried; {s}; the refusal as modelled follows")),
+                    Some(s) => say(&format!("no placement plans: the part as modelled and the {} other placement(s) tried (listed above) were refused; {s}; the refusal as modelled follows", tried.len())),
+                }
                 *modelled
             }
             e => e,

@@ -46,7 +46,14 @@ pub enum PlanError {
         modelled: Box<PlanError>,
         /// The other placements tried and their failures, in the order tried.
         tried: Vec<crate::report::TriedEntry>,
+        /// When the search stopped at [`crate::Options::placement_time_limit`]: what it left
+        /// untried. `None`: every placement queued was tried.
+        stopped: Option<crate::retry::Stopped>,
     },
+    /// The plan was given up at [`crate::Options::stop_at`] (the placement time limit of
+    /// [`crate::retry::find`]).
+    #[error("given up at the placement time limit")]
+    TimeLimit,
     /// The plan was made, and a gate refuses it: the plan is here to show why (its report
     /// says `"complete": false`), but no program was written.
     #[error("{gate}")]

@@ -78,11 +78,15 @@ pub fn head_check(
         machine,
         id: trees.iter().map(|t| t.features.len()).sum(),
         allow_collisions: options.allow_collisions,
+        stop_at: options.stop_at,
     };
     let avoid = |p: &mut ToolPath, axes: &[slicer::vec3::V3]| {
         collisions::avoid(p, axes, machine, &entries, limits)
     };
-    let stood = pedestal::stand(&ctx, toolpath, planned_axes, avoid)?;
+    let stood = pedestal::stand(&ctx, toolpath, planned_axes, avoid).map_err(|e| match e {
+        pedestal::PedestalError::TimeLimit => PlanError::TimeLimit,
+        e => PlanError::Pedestal(e),
+    })?;
     let pedestal_planned = stood.pedestal.as_ref().map(|p| {
         let area = machine.bead().filament_area();
         p.planned(area, params.filling_ratio, params.infill_density)

@@ -64,11 +64,13 @@ pub struct Laid {
 
 /// Fills and lays every feature of `extracted` in build order. Features are filled a few at a
 /// time in parallel, as many as there are threads, so memory holds no more than that many
-/// fills; then laid one after the other, each from where the one before ended.
+/// fills; then laid one after the other, each from where the one before ended. Past
+/// `stop_at` no further group of features is begun ([`PlanError::TimeLimit`]).
 pub fn lay(
     extracted: &Extracted,
     process: &Process,
     machine: &MachineProfile,
+    stop_at: Option<std::time::Instant>,
     tell: &dyn Fn(Progress),
 ) -> Result<Laid, PlanError> {
     let base = process.base();
@@ -82,6 +84,7 @@ pub fn lay(
     let mut features = vec![];
     let mut warnings = vec![];
     for chunk in extracted.order.chunks(window) {
+        crate::in_time(stop_at)?;
         let fills: Vec<Result<_, PlanError>> = chunk
             .par_iter()
             .map(|&slot| {

@@ -94,7 +94,7 @@ pub enum Progress {
 }
 
 /// How to plan.
-#[derive(Default)]
+#[derive(Default, Clone)]
 pub struct Options<'a> {
     /// The part's name in the report and the programs (its path as given).
     pub source: String,
@@ -115,6 +115,29 @@ pub struct Options<'a> {
     pub strict: bool,
     /// Told where the plan is.
     pub progress: Option<&'a (dyn Fn(Progress) + Sync)>,
+    /// The most time [`retry::find`] spends on a part, the plan as modelled included: past
+    /// it no other placement is begun, the one being planned is given up, and the refusal
+    /// says so ([`retry::Stopped`]). `None`: no limit.
+    pub placement_time_limit: Option<std::time::Duration>,
+    /// Past this instant the plan is given up ([`PlanError::TimeLimit`]), checked before each
+    /// group of features is laid and before each stage after them: [`retry::find`] sets it
+    /// for the placements after the part as modelled. `None`: never.
+    pub stop_at: Option<std::time::Instant>,
+}
+
+impl Options<'_> {
+    /// [`PlanError::TimeLimit`] once [`Options::stop_at`] has passed.
+    pub fn in_time(&self) -> Result<(), PlanError> {
+        in_time(self.stop_at)
+    }
+}
+
+/// [`PlanError::TimeLimit`] once `stop_at` has passed (`None`: never).
+pub fn in_time(stop_at: Option<std::time::Instant>) -> Result<(), PlanError> {
+    match stop_at {
+        Some(t) if std::time::Instant::now() >= t => Err(PlanError::TimeLimit),
+        _ => Ok(()),
+    }
 }
 
 /// A planned part.
@@ -251,9 +274,11 @@ fn run(
     tell(Progress::Start {
         features: extracted.order.len() as u64,
     });
-    let laid = lay::lay(&extracted, process, machine, &tell)?;
+    let laid = lay::lay(&extracted, process, machine, options.stop_at, &tell)?;
+    options.in_time()?;
     tell(Progress::Stage(Stage::Smooth));
     let smoothed = smooth::smooth(laid.toolpath, process, machine);
+    options.in_time()?;
     tell(Progress::Stage(Stage::HeadCheck));
     let mut checked = head::head_check(
         smoothed,
@@ -282,6 +307,7 @@ fn run(
         checked,
         adhesion,
     };
+    options.in_time()?;
     let passed = match gates::before_post(&stages.features, &stages.checked, options) {
         Ok(passed) => passed,
         Err(gate) => return Err(refuse(gate, stages, process, machine, options)),

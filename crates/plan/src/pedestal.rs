@@ -83,6 +83,9 @@ pub enum PedestalError {
         /// Why not.
         why: NoPedestal,
     },
+    /// The search for the pedestal was given up at [`Context::stop_at`].
+    #[error("given up at the placement time limit")]
+    TimeLimit,
 }
 
 /// Why a part cannot stand on a pedestal.
@@ -374,6 +377,9 @@ pub struct Context<'a> {
     pub id: usize,
     /// Plan on where even the tallest pedestal leaves moves hitting the table (with a warning).
     pub allow_collisions: bool,
+    /// Past this instant the search for the pedestal is given up ([`PedestalError::TimeLimit`],
+    /// [`crate::Options::stop_at`]).
+    pub stop_at: Option<std::time::Instant>,
 }
 
 /// What [`stand`] leaves: the tool path as checked, its collisions left, and the pedestal it
@@ -421,9 +427,10 @@ pub fn stand(
         }
     };
     let check = |stood: &Stood| {
+        crate::in_time(ctx.stop_at).map_err(|_| PedestalError::TimeLimit)?;
         let (mut p, axes) = on_pedestal(&stood.plan, &path, &planned);
         let a = avoid(&mut p, &axes);
-        (p, a)
+        Ok::<_, PedestalError>((p, a))
     };
     match ctx.setting {
         Pedestal::Height(given) if layer_count(given, layer) > 0 => {
@@ -436,7 +443,7 @@ pub fn stand(
             let o = outline(ctx.trees, ctx.params, ctx.params.pedestal_inset)
                 .map_err(|why| PedestalError::Impossible { given, why })?;
             let stood = build(&o, layer_count(given, layer));
-            let (p, avoided) = check(&stood);
+            let (p, avoided) = check(&stood)?;
             return Ok(Checked {
                 path: p,
                 avoided,
@@ -484,16 +491,16 @@ pub fn stand(
     drop(first);
     // The least pedestal that clears the table, with its check's result.
     let mut best: Option<(Stood, ToolPath, Avoided)> = None;
-    let fits = |n: usize| -> Result<bool, std::convert::Infallible> {
+    let fits = |n: usize| -> Result<bool, PedestalError> {
         let stood = build(&o, n);
-        let (p, a) = check(&stood);
+        let (p, a) = check(&stood)?;
         let clear = table_hits(&a) == 0;
         if clear && best.as_ref().is_none_or(|(s, _, _)| n < s.layers) {
             best = Some((stood, p, a));
         }
         Ok(clear)
     };
-    let Ok(found) = least(max, guess, fits);
+    let found = least(max, guess, fits)?;
     if let (Some(_), Some((stood, p, a))) = (found, best) {
         return Ok(Checked {
             path: p,
@@ -506,13 +513,13 @@ pub fn stand(
     // checked (the tilts found change with the height: a move cleared at one height may hit
     // at the next), and raised again from where it still hits, a few times.
     let stood = build(&o, max);
-    let (p, a) = check(&stood);
+    let (p, a) = check(&stood)?;
     let moves = table_hits(&a);
     let mut n = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
     let mut cleared = false;
     for _ in 0..NAMED_TRIES {
         let s = build(&o, n);
-        let (q, b) = check(&s);
+        let (q, b) = check(&s)?;
         if table_hits(&b) == 0 {
             cleared = true;
             break;

@@ -17,13 +17,20 @@
 //!    it, with support material under what overhangs: no tilt, so no axis beyond the machine's
 //!    limits and no head below its layers. It is also the one candidate tried after a failed
 //!    self-check ([`planar_may_help`]): small split-off features (pins, contacts) that their
-//!    own layers cannot hold are laid with the part around them.
+//!    own layers cannot hold are laid with the part around them. Not when the part as
+//!    modelled already is that plan ([`planar_may_help`]).
+//!
+//! None is planned when no placement can fit the machine: the part as modelled measures
+//! across more than any placement holds ([`robot_post::fit::largest_across`]).
 //!
 //! A candidate that leaves the bed or envelope in its turn is tried once more turned to fit,
 //! right after it; when no turn fits, that is listed among the failures. The first candidate that plans wins; the report's `placement` says which
 //! and lists what the ones before it failed on (`tried`, the part as modelled first). When
 //! none plans, the refusal of the part as modelled is returned, with every candidate's
 //! failure ([`PlanError::NoPlacement`]).
+//!
+//! With [`crate::Options::placement_time_limit`] the search stops at the limit, the plan in
+//! progress given up ([`crate::Options::stop_at`]); the refusal says so ([`Stopped`]).
 //!
 //! Each candidate is a whole plan, written afresh into the caller's [`Outputs`] (a refused
 //! attempt's files are dropped with it), so only the chosen plan's files are left.
@@ -37,6 +44,18 @@ use robot_post::ProgramSink;
 
 /// The most planar faces tried after the part as modelled, best first.
 pub const MAX_FACES: usize = 4;
+
+/// The share of what the part as modelled measures across ([`none_fits`]) that another
+/// placement's tool path may measure less (its layers cut the part elsewhere).
+const ACROSS_SLACK_SHARE: f64 = 0.05;
+
+/// ... and as much again, mm.
+const ACROSS_SLACK_MM: f64 = 5.0;
+
+/// The `features plan` default of [`crate::Options::placement_time_limit`], seconds: the
+/// slowest corpus parts refused in every placement stop in time for a 240 s budget
+/// (docs/measurements.md).
+pub const DEFAULT_TIME_LIMIT_S: f64 = 150.0;
 
 /// Where plans are written: afresh for each placement tried, so that only the chosen plan's
 /// files are left ([`crate::plan_file_to`]).
@@ -244,13 +263,44 @@ pub fn planar_may_help(e: &PlanError, process: &Process) -> bool {
         return false;
     }
     match e {
-        PlanError::Refused { plan, .. } if plan.report.slicing == "planar" => false,
+        PlanError::Refused { plan, .. }
+            if plan.report.slicing == "planar" || is_planar_already(plan) =>
+        {
+            false
+        }
         PlanError::Refused {
             gate: Gate::SelfCheck(_),
             ..
         } => true,
         _ => placement_may_help(e),
     }
+}
+
+/// Whether `plan` is what slicing the part whole in planar layers along +Z plans: each solid
+/// one two5d feature (the whole solid: nothing split off) on the build plate, growing along
+/// +Z, nothing of it below the plate (the whole solid's layers start at its lowest point).
+/// Sliced whole, it would be planned and refused the same way.
+fn is_planar_already(plan: &Plan) -> bool {
+    let one_each = plan
+        .assembly
+        .trees
+        .iter()
+        .all(|t| match t.features.as_slice() {
+            [f] => {
+                f.kind == features::FeatureKind::Two5d
+                    && f.parents.is_empty()
+                    && f.reference.surface == "build_plate"
+                    && f.reference
+                        .normal
+                        .is_some_and(|n| n[2] > crate::tolerance::SAME_DIRECTION_DOT)
+            }
+            _ => false,
+        });
+    one_each
+        && !plan
+            .warnings()
+            .iter()
+            .any(|w| w.contains(crate::warning::BELOW_PLATE))
 }
 
 /// What a turn about +Z does for `c`, refused with `e`: `None` when `e` is no refusal by the
@@ -280,7 +330,7 @@ fn turned_to_fit(
     if c.turn_deg() != 0.0 || !held {
         return None;
     }
-    match robot_post::fit::turn_to_fit(&plan.toolpath, machine) {
+    match robot_post::fit::turn_to_fit_until(&plan.toolpath, machine, options.stop_at) {
         Ok(fit) => (fit.angle_deg != 0.0).then(|| Ok(c.turned(fit.angle_deg))),
         Err(e @ robot_post::fit::FitError::NoTurn { .. }) => Some(Err(TriedEntry {
             candidate: format!("{} turned about +Z", c.label()),
@@ -288,6 +338,42 @@ fn turned_to_fit(
         })),
         Err(_) => None,
     }
+}
+
+/// Why no placement can fit the machine, when none can: the part as modelled (`e`'s plan,
+/// its print points but the pedestal's and the support material's) measures across more than
+/// any placement holds ([`robot_post::fit::largest_across`]), by more than another
+/// placement's path may measure less ([`ACROSS_SLACK_SHARE`], [`ACROSS_SLACK_MM`]). Then
+/// every other placement would be refused too, and none is planned.
+fn none_fits(e: &PlanError, machine: &MachineProfile) -> Option<TriedEntry> {
+    let PlanError::Refused { plan, .. } = e else {
+        return None;
+    };
+    let holds = robot_post::fit::largest_across(machine).ok()??;
+    let pedestals: Vec<usize> = plan
+        .features()
+        .iter()
+        .filter(|f| f.pedestal_height_mm.is_some())
+        .map(|f| f.feature.id)
+        .collect();
+    let across = robot_post::fit::across(
+        plan.toolpath
+            .points
+            .iter()
+            .filter(|q| {
+                q.kind == slicer::toolpath::MoveKind::Print
+                    && !q.role.is_support()
+                    && !pedestals.contains(&q.feature)
+            })
+            .map(|q| q.p),
+    );
+    (across * (1.0 - ACROSS_SLACK_SHARE) - ACROSS_SLACK_MM > holds).then(|| TriedEntry {
+        candidate: "every other placement".into(),
+        failure: format!(
+            "none fits: the part measures at least {across:.1} mm across, more than the {holds:.1} mm `{}` holds in any placement",
+            machine.name
+        ),
+    })
 }
 
 /// The placements to try after the part as modelled was refused, in order (module docs):
@@ -313,10 +399,43 @@ pub fn candidates(
         .collect())
 }
 
+/// The placement time limit reached ([`find`], [`crate::Options::placement_time_limit`]):
+/// the search stopped, and these placements were not tried.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stopped {
+    /// The limit, seconds.
+    pub limit_s: f64,
+    /// The placements queued and not tried (or given up part-way), in order
+    /// ([`Candidate::label`]).
+    pub untried: Vec<String>,
+}
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let untried = match self.untried.len() {
+            0 => String::new(),
+            n => format!(
+                ", {n} placement(s) not tried or given up ({})",
+                self.untried.join("; ")
+            ),
+        };
+        write!(
+            f,
+            "the search for a placement stopped at its time limit of {} s{untried}: raise the limit (--placement-time-limit SECONDS, inf: none) or choose the placement (--base-face ID, --orient auto, --set slicing=planar)",
+            self.limit_s
+        )
+    }
+}
+
 /// Plans the part as modelled and, when it is refused for something another placement may
 /// avoid, the other [`candidates`] in turn; the first that plans is returned, its report's
 /// `placement` saying which and what the ones before it failed on. Every attempt is written
 /// afresh into `out`.
+///
+/// With [`crate::Options::placement_time_limit`], the time is counted from the start, the
+/// plan as modelled included: past the limit no other placement is begun and the one being
+/// planned is given up ([`crate::Options::stop_at`]); the refusal lists what was tried and
+/// what was not ([`Stopped`]).
 pub fn find(
     file: &StepFile,
     process: &Process,
@@ -324,35 +443,64 @@ pub fn find(
     options: &Options,
     out: &mut dyn Outputs,
 ) -> Result<Plan, PlanError> {
-    let attempt = |c: &Candidate, out: &mut dyn Outputs| {
+    let stop_at = options
+        .placement_time_limit
+        .and_then(|l| std::time::Instant::now().checked_add(l));
+    let attempt = |c: &Candidate, options: &Options, out: &mut dyn Outputs| {
         let (sink, csv) = out.fresh().map_err(PlanError::Csv)?;
         c.plan(file, process, machine, options, sink, csv)
     };
-    let mut first = match attempt(&Candidate::MODELLED, out) {
+    let mut first = match attempt(&Candidate::MODELLED, options, out) {
         Err(e) if placement_may_help(&e) || planar_may_help(&e, process) => e,
         done => return done,
+    };
+    // The other placements are given up at the limit (or the caller's own, if sooner).
+    let options = &Options {
+        stop_at: match (stop_at, options.stop_at) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        },
+        ..options.clone()
     };
     let mut tried = vec![TriedEntry {
         candidate: Candidate::MODELLED.label(),
         failure: first.to_string(),
     }];
     let mut queue = vec![];
-    if placement_may_help(&first) {
-        match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
-            Some(Ok(t)) => queue.push(t),
-            Some(Err(none)) => tried.push(none),
-            None => {}
+    // Whether the limit came before the other placements were listed.
+    let mut unlisted = false;
+    // No placement fits the machine: none is planned.
+    let too_big = none_fits(&first, machine);
+    let fits_nowhere = too_big.is_some();
+    if let Some(t) = too_big {
+        tried.push(t);
+    } else if placement_may_help(&first) {
+        unlisted = options.in_time().is_err();
+        if !unlisted {
+            match turned_to_fit(&Candidate::MODELLED, &first, machine, options) {
+                Some(Ok(t)) => queue.push(t),
+                Some(Err(none)) => tried.push(none),
+                None => {}
+            }
+            unlisted = options.in_time().is_err();
         }
-        queue.extend(candidates(file, process, machine)?);
+        if !unlisted {
+            queue.extend(candidates(file, process, machine)?);
+        }
     }
-    if planar_may_help(&first, process) {
+    if planar_may_help(&first, process) && !fits_nowhere {
         queue.push(Candidate::Planar { turn_deg: 0.0 });
     }
     // The previous attempt's failure.
     let mut last = first.to_string();
+    let mut stopped = None;
     let mut k = 0;
     while k < queue.len() {
         let c = queue[k].clone();
+        if options.in_time().is_err() {
+            stopped = Some(k);
+            break;
+        }
         if let Some(f) = options.progress {
             f(Progress::Trying {
                 index: k + 1,
@@ -361,7 +509,7 @@ pub fn find(
                 after: last.clone(),
             });
         }
-        match attempt(&c, out) {
+        match attempt(&c, options, out) {
             Ok(mut plan) => {
                 let rule = format!(
                     "found: the part as modelled was refused ({}); the first placement tried that plans",
@@ -371,6 +519,10 @@ pub fn find(
                 entry.tried = tried;
                 plan.report.placement = Some(entry);
                 return Ok(plan);
+            }
+            Err(PlanError::TimeLimit) => {
+                stopped = Some(k);
+                break;
             }
             Err(e) => {
                 let turn = turned_to_fit(&c, &e, machine, options);
@@ -388,11 +540,34 @@ pub fn find(
         }
         k += 1;
     }
+    // Stopped by the limit: at the `k`-th placement queued, or before the faces were listed.
+    let untried = |k: usize| -> Vec<String> {
+        let mut u: Vec<String> = queue[k..].iter().map(Candidate::label).collect();
+        if unlisted {
+            u.insert(0, format!("the planar faces, up to {MAX_FACES}"));
+        }
+        u
+    };
+    let stopped = match (options.placement_time_limit, stopped) {
+        (Some(l), Some(k)) => Some((l, untried(k))),
+        (Some(l), None) if unlisted => Some((l, untried(queue.len()))),
+        _ => None,
+    }
+    .map(|(l, untried)| Stopped {
+        limit_s: crate::report::round(l.as_secs_f64(), 1e3),
+        untried,
+    });
     if let PlanError::Refused { plan, .. } = &mut first {
-        let mut entry = Candidate::MODELLED.entry(format!(
-            "as modelled: none of the {} other placement(s) tried plans",
-            queue.len()
-        ));
+        let rule = match &stopped {
+            None if fits_nowhere => format!(
+                "as modelled: no other placement tried: {}",
+                tried[tried.len() - 1].failure
+            ),
+            None => format!("as modelled: none of the {k} other placement(s) tried plans"),
+            Some(s) if k == 0 => format!("as modelled: no other placement tried; {s}"),
+            Some(s) => format!("as modelled: none of the {k} other placement(s) tried plans; {s}"),
+        };
+        let mut entry = Candidate::MODELLED.entry(rule);
         entry.tried = tried.clone();
         plan.report.placement = Some(entry);
     }
@@ -401,6 +576,7 @@ pub fn find(
     Err(PlanError::NoPlacement {
         modelled: Box::new(first),
         tried,
+        stopped,
     })
 }
 

@@ -3,6 +3,10 @@
 
 use slicer::verify::PlanProblem;
 
+/// How the warning of a feature reaching below the build plate ends
+/// ([`WarningKind::BelowPlate`]).
+pub const BELOW_PLATE: &str = "below the build plate";
+
 /// One thing to know about a plan: of a feature (its file-wide id) or of the whole part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Warning {
@@ -124,7 +128,7 @@ impl std::fmt::Display for Warning {
                 100.0 * added_mm3 / extruded_mm3.max(crate::tolerance::VOLUME_MM3)
             ),
             WarningKind::BelowPlate { depth } => {
-                write!(f, "feature {id} reaches {depth:.3} mm below the build plate")
+                write!(f, "feature {id} reaches {depth:.3} mm {BELOW_PLATE}")
             }
             WarningKind::TiltLimited {
                 axes,

@@ -172,7 +172,7 @@ impl Delta5Geometry {
     }
 
     /// The crossing `Q` of the B and C axes, in machine coordinates.
-    pub(super) fn pivot(&self) -> [f64; 3] {
+    pub(crate) fn pivot(&self) -> [f64; 3] {
         [self.c_axis_xy[0], self.c_axis_xy[1], self.b_axis_z]
     }
 

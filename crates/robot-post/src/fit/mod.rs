@@ -7,15 +7,19 @@
 //! - [`reach`](mod@reach): on `kuka`, the least move of the part on the table (the cell's
 //!   `part_position`) that brings every point into the arm's reach and joint limits
 //!   ([`reach_shift`]).
+//! - [`size`](mod@size): whether the part can fit in any placement at all: the most it may
+//!   measure across ([`largest_across`]).
 //!
-//! Both search with a cheap model of the post's check and confirm their choice with the post
-//! itself, so a placement they return is one the post accepts.
+//! The two searches run with a cheap model of the post's check and confirm their choice with
+//! the post itself, so a placement they return is one the post accepts.
 
 pub mod reach;
+pub mod size;
 pub mod turn;
 
 pub use reach::{reach_shift, unreachable_points, ReachShift};
-pub use turn::{bounding_path, envelope_excess, turn_to_fit, turned, TurnFit};
+pub use size::{across, largest_across};
+pub use turn::{bounding_path, envelope_excess, turn_to_fit, turn_to_fit_until, turned, TurnFit};
 
 use crate::sink::ProgramSink;
 use crate::PostError;
@@ -37,6 +41,9 @@ pub enum FitError {
         /// By how much it missed (mm).
         excess_mm: f64,
     },
+    /// The search was given up at its time limit ([`turn_to_fit_until`]).
+    #[error("the search for a turn that fits was given up at its time limit")]
+    TimeLimit,
     /// No move of the part on the table brings every point into the arm's reach.
     #[error("no place on the table of `{name}` brings every point into the arm's reach: the best, part_position [{x:.1}, {y:.1}], leaves {unreachable} point(s) out of reach")]
     NoShift {

@@ -151,6 +151,17 @@ fn coarse_turns() -> impl Iterator<Item = f64> {
 /// fits; [`FitError::Post`] when the post refuses the path for another reason (a tool axis
 /// beyond the B limits, a non-finite point, a profile of another kind).
 pub fn turn_to_fit(path: &ToolPath, m: &MachineProfile) -> Result<TurnFit, FitError> {
+    turn_to_fit_until(path, m, None)
+}
+
+/// [`turn_to_fit`], given up past `stop_at` ([`FitError::TimeLimit`], checked before each
+/// turn; `None`: never): a long path on `delta5` takes its bed angles afresh at every turn.
+pub fn turn_to_fit_until(
+    path: &ToolPath,
+    m: &MachineProfile,
+    stop_at: Option<std::time::Instant>,
+) -> Result<TurnFit, FitError> {
+    let late = || stop_at.is_some_and(|t| std::time::Instant::now() >= t);
     let mut work = path.clone();
     let mut excess_at = |a: f64| -> Result<f64, PostError> {
         turn_into(path, a, &mut work);
@@ -160,6 +171,9 @@ pub fn turn_to_fit(path: &ToolPath, m: &MachineProfile) -> Result<TurnFit, FitEr
     let mut best = (0.0, excess_at_zero_mm);
     let mut confirmed = 0;
     for a in coarse_turns() {
+        if late() {
+            return Err(FitError::TimeLimit);
+        }
         let e = if a == 0.0 {
             excess_at_zero_mm
         } else {

@@ -46,6 +46,7 @@ use region::{bounds, region_shapes, shape_region};
 
 pub use crate::geom2d::{Point2, Region};
 pub(crate) use boolean::{difference, grow, intersection, outside_grown, union};
+pub(crate) use offset::simplified;
 pub use offset::thinner_than;
 pub use order::{order_greedy, order_paths};
 pub use region::regions_from_loops;

@@ -165,6 +165,18 @@ pub(super) fn simplify(shapes: Shapes, tol: f64) -> Shapes {
         .collect()
 }
 
+/// `regions` with each ring, outer and holes, simplified within `tol` ([`simplify_ring`]: the
+/// vertices kept are original ones; a ring that would lose its area is kept whole).
+pub(crate) fn simplified(regions: Vec<Region>, tol: f64) -> Vec<Region> {
+    regions
+        .into_iter()
+        .map(|r| Region {
+            outer: simplify_ring(r.outer, tol),
+            holes: r.holes.into_iter().map(|h| simplify_ring(h, tol)).collect(),
+        })
+        .collect()
+}
+
 /// Douglas-Peucker on one closed contour (see [`simplify`]): every dropped vertex lies within
 /// `tol` of the contour left, whose vertices are original ones. Contours of four points or
 /// fewer, and any that would lose all their area, come back as they were.
