@@ -513,3 +513,18 @@ fn a_contact_thinner_than_a_ring_off_a_wider_body_is_filled() {
         }
     }
 }
+
+#[test]
+fn a_strip_narrower_than_a_third_of_a_spacing_is_filled() {
+    // An LED's lead 0.5 x 0.2 mm, a contact 2 x 0.2 mm: they fell between the vertices of the
+    // lattice (a third of a spacing, 0.15 mm) and got no bead; the lattice is now finer for
+    // a region that narrow.
+    let surf = world_plane();
+    let chart = Chart::unit(&surf);
+    for (a, b) in [(0.5, 0.2), (2.0, 0.2), (1.0, 0.25)] {
+        let outer = vec![[0.0, 0.0], [a, 0.0], [a, b], [0.0, b]];
+        let paths = fill_on_layer(&chart, outer, PathMode::ContourZigzag);
+        let r = covered_area(&paths) / (a * b);
+        assert!((r - 1.0).abs() < 0.015, "{a} x {b}: {r} of its area");
+    }
+}
