@@ -105,8 +105,8 @@ pub fn lay(
             cursor = plan.exit().map(P3::from).or(cursor);
             let (laid, below) = laid_feature(extracted, slot, &params, &plan, fallback, machine);
             let mut plan = plan;
-            // Below the nozzle's resolution (issue 31, item 4): named, and judged within what
-            // the widening adds.
+            // Below the nozzle's resolution (issue 31, item 4): named, and judged within the
+            // share of it narrower than the nozzle lays.
             let t = &extracted.assembly.trees[slot.tree];
             let below_resolution = crate::resolution::below_resolution(
                 t,
@@ -118,8 +118,7 @@ pub fn lay(
             )?;
             let mut laid = laid.widen(&mut plan.points, machine);
             if let Some(b) = &below_resolution {
-                let expected = laid.planned.volume * laid.planned.fill;
-                laid.planned.tolerance = crate::resolution::tolerance(laid.widened, expected);
+                laid.planned.tolerance = crate::resolution::tolerance(b.narrow_share);
                 laid.warnings.push(Warning::feature(
                     id,
                     WarningKind::Planner(crate::resolution::warning(

@@ -67,7 +67,7 @@ pub struct PlannedFeature {
     pub extruded: f64,
     /// How far `extruded` may stray from `volume × fill`, as a fraction: [`VOLUME_TOLERANCE`],
     /// or more for a feature below the nozzle's resolution (the plan crate's `resolution`
-    /// module derives it from the beads widened there).
+    /// module derives it from the share of the feature narrower than the nozzle lays).
     pub tolerance: f64,
 }
 
