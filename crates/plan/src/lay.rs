@@ -235,6 +235,8 @@ fn laid_feature(
             layers: fig.layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,
+            // A bead min_bead_width wide, as long, min_layer_height thick.
+            smallest_bead: machine.min_bead_width().powi(2) * params.min_layer_height,
         },
         layers: fig.layers,
         points: fig.points,

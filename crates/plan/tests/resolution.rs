@@ -77,6 +77,7 @@ fn a_lost_feature_fails_below_resolution_or_not() {
         layers,
         extruded,
         tolerance,
+        smallest_bead: 0.0,
     };
     // No layer: a lost feature, whatever its tolerance.
     assert!(matches!(
