@@ -162,13 +162,9 @@ pub(crate) fn fill_region(
     // fill's narrowest bead, the ring widens to take it. A ring less than a tenth of a bead
     // below the deepest point is left out.
     let (rings, levels) = ring_levels(params, width, spacing, dmax);
-    let gap_inset = 0.02 * width;
-    // The ridge is needed only where the rings' iso-lines and the gap fills between them run:
+    let insets = Insets::new(sliver_inset, width);
+    // The ridge is needed only where the rings' iso-lines and the gap fills beside them run:
     // at both ends of each lattice edge those levels cross.
-    let insets = Insets {
-        sliver: sliver_inset,
-        gap: gap_inset,
-    };
     let ridge = ring_ridge(&lm, &db, &levels, width, insets, spacing);
     let (last_ring, last_ring_from) = lay_rings(&lm, &db, &ridge, &levels, width, insets, &mut out);
     // Infill where the rings stop: lines end a spacing past the last ring, joined along that
@@ -432,6 +428,16 @@ fn infill_pieces(
 struct Insets {
     sliver: f64,
     gap: f64,
+}
+
+impl Insets {
+    /// `sliver` beside the boundary, [`GAP_INSET`] of a bead `width` beside a bead's edge.
+    fn new(sliver: f64, width: f64) -> Insets {
+        Insets {
+            sliver,
+            gap: GAP_INSET * width,
+        }
+    }
 }
 
 /// The gap fill where ring `j` (at level `c`) does not reach: the strip the ring before
