@@ -175,6 +175,7 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
                 narrowest_mm: round(b.narrowest_mm, 1e3),
                 nozzle_needed_mm: round(b.nozzle_needed_mm, 1e3),
                 narrow_share: round(b.narrow_share, 1e4),
+                tolerance_pct: round(b.tolerance_pct, 1e2),
             }),
         thickness_min_mm: round(f.thickness.0, 1e6),
         thickness_mean_mm: round(f.thickness.1, 1e6),

@@ -108,8 +108,8 @@ pub fn lay(
             cursor = plan.exit().map(P3::from).or(cursor);
             let (laid, below) = laid_feature(extracted, slot, &params, &plan, fallback, machine);
             let mut plan = plan;
-            // Below the nozzle's resolution (issue 31, item 4): named, and judged within what
-            // the widening adds.
+            // Below the nozzle's resolution (issue 31, item 4): named, and judged within the
+            // share of it narrower than the nozzle lays.
             let t = &extracted.assembly.trees[slot.tree];
             let below_resolution = crate::resolution::below_resolution(
                 t,
@@ -121,8 +121,7 @@ pub fn lay(
             )?;
             let mut laid = laid.widen(&mut plan.points, machine);
             if let Some(b) = &below_resolution {
-                let expected = laid.planned.expected();
-                laid.planned.tolerance = crate::resolution::tolerance(laid.widened, expected);
+                laid.planned.tolerance = crate::resolution::tolerance(b.narrow_share);
                 laid.warnings.push(Warning::feature(
                     id,
                     WarningKind::Planner(crate::resolution::warning(
@@ -241,6 +240,8 @@ fn laid_feature(
             layers: fig.layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,
+            // A bead min_bead_width wide, as long, min_layer_height thick.
+            smallest_bead: machine.min_bead_width().powi(2) * params.min_layer_height,
         },
         layers: fig.layers,
         points: fig.points,

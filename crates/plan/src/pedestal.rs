@@ -346,6 +346,7 @@ impl Stood {
             layers: self.plan.figures.layers,
             extruded: self.plan.figures.filament * filament_area,
             tolerance: slicer::verify::VOLUME_TOLERANCE,
+            smallest_bead: 0.0,
         }
     }
 

@@ -4,7 +4,7 @@
 //! what is printed there is as much as the nozzle allows, not the feature. Such a feature is
 //! named (a warning and `below_resolution` in `plan.json`, with its narrowest width and the
 //! nozzle it would need) and judged by the self-check with a tolerance derived from the
-//! widening ([`tolerance`]), not failed at [`VOLUME_TOLERANCE`].
+//! share of it that narrow ([`tolerance`]), not failed at [`VOLUME_TOLERANCE`].
 
 use features::{Feature, FeatureTree};
 use serde::Serialize;
@@ -32,6 +32,9 @@ pub struct BelowResolution {
     pub nozzle_needed_mm: f64,
     /// The share of the feature in regions narrower than `min_bead_width`.
     pub narrow_share: f64,
+    /// How far the self-check lets its extruded volume stray from volume × fill, percent
+    /// ([`tolerance`]).
+    pub tolerance_pct: f64,
 }
 
 /// Whether feature `f`, planned with `params` as `points` (before its narrow beads are
@@ -71,25 +74,28 @@ pub fn below_resolution(
             narrowest_mm: n.narrowest,
             nozzle_needed_mm: nozzle * n.narrowest / min_bead,
             narrow_share: n.share,
+            tolerance_pct: 100.0 * tolerance(n.share),
         }),
     )
 }
 
-/// The self-check's tolerance for a feature below resolution whose narrow beads were widened
-/// by `widened` mm³ for `expected` mm³ (its volume × fill): [`VOLUME_TOLERANCE`] plus
-/// `widened / expected`.
+/// The self-check's tolerance for a feature below resolution whose regions narrower than
+/// `min_bead_width` hold the share `narrow_share` of it: [`VOLUME_TOLERANCE`] plus that
+/// share, `tolerance = 0.03 + V_narrow / V`.
 ///
 /// Derivation: where the feature is narrower than `min_bead_width` its fill lays beads as wide
 /// as it is, down to a fifth of a bead, and leaves out what is narrower still (or the margin
-/// a bead's middle keeps inside a sliver), so what is planned there may miss the feature by up
-/// to all of it; the program lays those beads `min_bead_width` wide, `widened` mm³ more. The
-/// material of those stretches is the planned narrow beads' plus what their widening adds,
-/// and the widening is the most the nozzle's resolution puts beside the feature's own: the
-/// planned volume is held to the plan's tolerance plus that share of the feature. Features
-/// whose narrow beads carry no material (`widened` = 0) keep [`VOLUME_TOLERANCE`].
-pub fn tolerance(widened: f64, expected: f64) -> f64 {
-    if expected > 0.0 && widened.is_finite() && widened > 0.0 {
-        VOLUME_TOLERANCE + widened / expected
+/// a bead's middle keeps inside a sliver), and a stretch too short or too thin for the
+/// lattice the fill reads its widths on gets less or more than it holds; so what is planned
+/// there may miss those stretches by up to all of their volume, `V_narrow` (measured on the
+/// layers' own sections, [`slicer::resolution::narrow_sections`]), and no more. The rest of
+/// the feature is held to the plan's 3 %. (The program then lays the narrow beads
+/// `min_bead_width` wide: that material is reported apart, `widened_volume_mm3`, and is not in
+/// the self-check.) A feature with no narrow region is not below resolution and keeps
+/// [`VOLUME_TOLERANCE`]; a feature with no layer at all fails whatever its share.
+pub fn tolerance(narrow_share: f64) -> f64 {
+    if narrow_share.is_finite() && narrow_share > 0.0 {
+        VOLUME_TOLERANCE + narrow_share.min(1.0)
     } else {
         VOLUME_TOLERANCE
     }
@@ -98,10 +104,11 @@ pub fn tolerance(widened: f64, expected: f64) -> f64 {
 /// The warning line of a feature below resolution.
 pub fn warning(id: usize, b: &BelowResolution, min_bead: f64) -> String {
     format!(
-        "feature {id}: below the nozzle's resolution: {:.1} % of it narrower than min_bead_width {min_bead} mm, down to {:.3} mm; a nozzle of {:.2} mm would lay it (judged by the self-check within what the widening adds)",
+        "feature {id}: below the nozzle's resolution: {:.1} % of it narrower than min_bead_width {min_bead} mm, down to {:.3} mm; a nozzle of {:.2} mm would lay it (judged by the self-check within {:.1} %)",
         100.0 * b.narrow_share,
         b.narrowest_mm,
-        b.nozzle_needed_mm
+        b.nozzle_needed_mm,
+        b.tolerance_pct
     )
 }
 
@@ -159,9 +166,9 @@ mod tests {
     }
 
     #[test]
-    fn the_tolerance_grows_with_the_widening() {
-        assert_eq!(tolerance(0.0, 10.0), VOLUME_TOLERANCE);
-        assert!((tolerance(2.0, 10.0) - (VOLUME_TOLERANCE + 0.2)).abs() < 1e-12);
-        assert_eq!(tolerance(1.0, 0.0), VOLUME_TOLERANCE);
+    fn the_tolerance_grows_with_the_narrow_share() {
+        assert_eq!(tolerance(0.0), VOLUME_TOLERANCE);
+        assert!((tolerance(0.2) - (VOLUME_TOLERANCE + 0.2)).abs() < 1e-12);
+        assert_eq!(tolerance(f64::NAN), VOLUME_TOLERANCE);
     }
 }

@@ -40,7 +40,7 @@ use crate::fold::{check_folds, fold_check};
 use crate::geom2d::{dist2, segment_foot, Point2, Region};
 use crate::lift::{lift, Lifted};
 use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
-use crate::region_fill::{corner_spurs, fill_region, order_fill_paths, SLIVER_INSET};
+use crate::region_fill::{corner_spurs_beside, fill_region, order_fill_paths, SLIVER_INSET};
 use crate::sst::{Sides, WALL_REACH};
 use crate::support::{reach, sliver_area};
 use crate::tolerance::{FLAT_CURVATURE, HEIGHT_SLACK, MICROMETRE, SHORT_VECTOR};
@@ -473,7 +473,7 @@ fn fill_layer(
         .min(spacing.max(MICROMETRE) * 1e3);
     let mut paths = vec![];
     for r in &regions {
-        paths.extend(fill_region(
+        let fill = fill_region(
             chart,
             r,
             z,
@@ -482,8 +482,10 @@ fn fill_layer(
             bead_width,
             spacing,
             SLIVER_INSET * bead_width,
-        ));
-        paths.extend(corner_spurs(chart, r, z, bead_width));
+        );
+        let spurs = corner_spurs_beside(chart, r, z, bead_width, &fill);
+        paths.extend(fill);
+        paths.extend(spurs);
     }
     if let Some((field, z)) = clip {
         paths = clip_paths(paths, |q| field.lower(q) >= z - HEIGHT_SLACK);

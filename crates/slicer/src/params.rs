@@ -17,6 +17,10 @@ pub const MAX_LAYERS: usize = 1_000_000;
 /// without support on common materials (45° is the usual rule, 50–60° the usual reach).
 pub const DEFAULT_OVERHANG_ANGLE_DEG: f64 = 50.0;
 
+/// A piece of a stack between two steps of [`LayerParams::layer_heights_through`] within this
+/// share of a whole number of layers (a model in inches) takes that many, a little thicker.
+const STEP_COUNT_SLACK: f64 = 1e-3;
+
 /// `overhang_angle_deg` must stay under this: at 90° a layer may reach out without limit.
 pub const MAX_OVERHANG_ANGLE_DEG: f64 = 90.0;
 
@@ -455,6 +459,49 @@ impl LayerParams {
         }
     }
 
+    /// [`LayerParams::layer_heights`] with a layer boundary at each height of `steps` (where a
+    /// two5d feature's section changes at once: its faces parallel to the layers), for the
+    /// uniform pattern: the stack is cut at those heights and each piece gets
+    /// `n = ceil(piece / h − 0.001)` layers of `piece / n`. A slab 0.3 mm thick (a contact's
+    /// pad, a clip's plate) took one layer of 0.2 mm or two (33 % short or over, the layer's
+    /// middle deciding); it now takes two of 0.15 mm. A step nearer than `min_layer_height`
+    /// (at most `h`) to the one kept before it or to the top is passed over: no layer is
+    /// thinner than that, and what lies between is as quantised as before. The adaptive
+    /// pattern keeps its list.
+    pub fn layer_heights_through(&self, extent: f64, steps: &[f64]) -> Vec<f64> {
+        let h = self.uniform_layer_height;
+        let least = self.min_layer_height.min(h);
+        if self.layer_height_pattern != LayerHeightPattern::Uniform
+            || steps.is_empty()
+            || !(least.is_finite() && least > 0.0 && extent.is_finite() && extent > 0.0)
+        {
+            return self.layer_heights(extent);
+        }
+        let mut steps: Vec<f64> = steps.iter().copied().filter(|s| s.is_finite()).collect();
+        steps.sort_by(f64::total_cmp);
+        let mut cuts = vec![];
+        let mut last = 0.0;
+        for s in steps {
+            if s - last >= least && extent - s >= least {
+                cuts.push(s);
+                last = s;
+            }
+        }
+        cuts.push(extent);
+        let mut out = vec![];
+        let mut a = 0.0;
+        for b in cuts {
+            let piece = b - a;
+            let n = (piece / h - STEP_COUNT_SLACK).ceil().max(1.0);
+            if !n.is_finite() || out.len() as f64 + n > MAX_LAYERS as f64 {
+                return Vec::new();
+            }
+            out.extend(std::iter::repeat_n(piece / n, n as usize));
+            a = b;
+        }
+        out
+    }
+
     /// Checks the parameters; the error is one line naming the offending key.
     pub fn validate(&self) -> Result<(), String> {
         fn positive(key: &str, v: f64) -> Result<(), String> {
@@ -823,6 +870,38 @@ mod tests {
         p.adaptive_offset = vec![0.4, 0.5];
         assert_eq!(p.spacing_for_layer(0.4, 0), 0.4);
         assert_eq!(p.spacing_for_layer(0.4, 3), 0.5);
+    }
+
+    #[test]
+    fn stepped_heights_put_a_layer_boundary_on_each_step() {
+        // A clip 1.6 mm high: pads 0.3 mm thick, legs, a plate 0.3 mm thick (psstep13's
+        // inductor terminal), at 0.2 mm layers.
+        let p = LayerParams::default();
+        let h = p.layer_heights_through(1.6, &[0.3, 1.3, 0.3]);
+        let mut z = 0.0;
+        let mut tops = vec![];
+        for dl in &h {
+            assert!(*dl <= p.uniform_layer_height + 1e-9 && *dl >= p.min_layer_height);
+            z += dl;
+            tops.push(z);
+        }
+        assert!((z - 1.6).abs() < 1e-9);
+        for step in [0.3, 1.3] {
+            assert!(
+                tops.iter().any(|t| (t - step).abs() < 1e-9),
+                "{step}: {tops:?}"
+            );
+        }
+        assert_eq!(h.len(), 2 + 5 + 2);
+        // A step nearer than min_layer_height to the bottom, the top or the step before is
+        // passed over; no steps, or the adaptive pattern, give layer_heights.
+        assert_eq!(
+            p.layer_heights_through(1.0, &[0.05, 0.95]),
+            p.layer_heights(1.0)
+        );
+        assert_eq!(p.layer_heights_through(1.0, &[]), p.layer_heights(1.0));
+        let h = p.layer_heights_through(1.0, &[0.4, 0.45]);
+        assert_eq!(h.len(), 2 + 3, "{h:?}");
     }
 
     #[test]

@@ -202,7 +202,7 @@ pub fn fill_two5d(
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
-    let heights = params.layer_heights(top);
+    let heights = two5d_layer_heights(params, &mesh, &plane, top);
     let spacing = params.spacing(bead.width);
     let fig = FeatureFigures {
         below_plate: below_plate(tree, &mesh.positions),
@@ -245,7 +245,7 @@ pub fn plate_regions(
     params: &LayerParams,
 ) -> Result<(Plane, Vec<Region>), FeatureError> {
     let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
-    let Some(&first) = params.layer_heights(top).first() else {
+    let Some(&first) = two5d_layer_heights(params, &mesh, &plane, top).first() else {
         return Ok((plane, vec![]));
     };
     let regions = section_regions(&mesh, &plane.offset(0.5 * first), &plane);
@@ -262,6 +262,37 @@ pub(crate) fn plane_mesh_top(
     let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
     let (mesh, top) = mesh_and_top(tree, f, params, &plane)?;
     Ok((plane, mesh, top))
+}
+
+/// The faces of a mesh whose points lie within this of one height over the layers' plane
+/// (mm) are parallel to it: steps of the feature's section.
+const FLAT_FACE_SPAN: f64 = 1e-4;
+
+/// The layer thicknesses of a two5d feature meshed as `mesh`, `top` high over its reference
+/// `plane`: [`LayerParams::layer_heights_through`] the heights of its faces parallel to the
+/// plane (each face's points within [`FLAT_FACE_SPAN`] of one height), so that a layer
+/// boundary lies where the section changes at once.
+pub(crate) fn two5d_layer_heights(
+    params: &LayerParams,
+    mesh: &brep::mesh::Mesh,
+    plane: &Plane,
+    top: f64,
+) -> Vec<f64> {
+    let mut steps = vec![];
+    for f in &mesh.faces {
+        let (lo, hi) = f
+            .vertex
+            .iter()
+            .filter_map(|&v| mesh.positions.get(v as usize))
+            .map(|p| plane.height(p))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+                (lo.min(z), hi.max(z))
+            });
+        if hi - lo <= FLAT_FACE_SPAN && !f.triangles.is_empty() {
+            steps.push(0.5 * (lo + hi));
+        }
+    }
+    params.layer_heights_through(top, &steps)
 }
 
 /// A feature's mesh at the slicing tolerance, and the height of its highest point over `plane`.

@@ -44,7 +44,7 @@ pub fn narrow_sections(
     let (mesh, top) = crate::planar::mesh_and_top(tree, f, params, &plane)?;
     let mut mids = vec![];
     let mut z = 0.0;
-    for dl in params.layer_heights(top) {
+    for dl in crate::planar::two5d_layer_heights(params, &mesh, &plane, top) {
         mids.push((z + 0.5 * dl, dl));
         z += dl;
     }

@@ -152,7 +152,7 @@ pub fn planar_support(
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let tol = slicing_tolerance(params);
     let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
-    let heights = params.layer_heights(top);
+    let heights = crate::planar::two5d_layer_heights(params, &mesh, &plane, top);
     let mut mids = Vec::with_capacity(heights.len());
     let mut z = 0.0;
     for &dl in &heights {

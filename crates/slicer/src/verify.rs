@@ -90,8 +90,14 @@ pub struct PlannedFeature {
     pub extruded: f64,
     /// How far `extruded` may stray from `volume × fill`, as a fraction: [`VOLUME_TOLERANCE`],
     /// or more for a feature below the nozzle's resolution (the plan crate's `resolution`
-    /// module derives it from the beads widened there).
+    /// module derives it from the share of the feature narrower than the nozzle lays).
     pub tolerance: f64,
+    /// The least material the nozzle lays, mm³: a bead `min_bead_width` wide, as long and
+    /// `min_layer_height` thick (0 for none). A miss smaller than that is below the nozzle's
+    /// resolution, and so is a feature holding less (a sliver 0.01 mm thick, a face's
+    /// 0.001 mm³ stretch): it passes with no layer, as the planner's warning that it has no
+    /// printable layer says.
+    pub smallest_bead: f64,
 }
 
 impl PlannedFeature {
@@ -105,8 +111,18 @@ impl PlannedFeature {
 }
 
 /// Checks one feature's plan: at least one layer, and extruded volume within its
-/// `tolerance` (at least [`VOLUME_TOLERANCE`]) of [`PlannedFeature::expected`].
+/// `tolerance` (at least [`VOLUME_TOLERANCE`]) of [`PlannedFeature::expected`], unless what
+/// it misses is no more than the smallest bead (`smallest_bead`).
 pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
+    let expected = f.expected();
+    let smallest = if f.smallest_bead.is_finite() {
+        f.smallest_bead.max(0.0)
+    } else {
+        0.0
+    };
+    if (f.extruded - expected).abs() <= smallest {
+        return None;
+    }
     if f.layers == 0 || f.extruded <= 0.0 {
         return Some(PlanProblem::NoLayers {
             id: f.id,
@@ -114,7 +130,6 @@ pub fn check_planned(f: &PlannedFeature) -> Option<PlanProblem> {
             volume: f.volume,
         });
     }
-    let expected = f.expected();
     let rel = (f.extruded - expected) / expected.max(crate::tolerance::VOLUME_FLOOR);
     (rel.abs() > f.tolerance.max(VOLUME_TOLERANCE)).then(|| PlanProblem::Volume {
         id: f.id,
@@ -149,6 +164,7 @@ mod tests {
             layers,
             extruded,
             tolerance: VOLUME_TOLERANCE,
+            smallest_bead: 0.0,
         }
     }
 
@@ -157,6 +173,21 @@ mod tests {
         assert!(matches!(
             check_planned(&f(0, 0.0, 1.0)),
             Some(PlanProblem::NoLayers { id: 3, .. })
+        ));
+        // Unless it holds less than the smallest bead: then no miss is above resolution.
+        let speck = PlannedFeature {
+            volume: 0.003,
+            smallest_bead: 0.0058,
+            ..f(0, 0.0, 1.0)
+        };
+        assert!(check_planned(&speck).is_none());
+        let pin = PlannedFeature {
+            volume: 0.02,
+            ..speck
+        };
+        assert!(matches!(
+            check_planned(&pin),
+            Some(PlanProblem::NoLayers { .. })
         ));
     }
 

@@ -22,7 +22,7 @@ use brep::math::{P3, V3};
 use brep::surface::Surface;
 use gap::{gap_fill, ridge, ridge_for, Gap};
 
-pub(crate) use spurs::corner_spurs;
+pub(crate) use spurs::corner_spurs_beside;
 
 /// One path of a curved layer in chart coordinates (or of a planar layer in its plane's),
 /// with the bead width at each point and what it is for.
@@ -100,7 +100,8 @@ pub fn fill_flat_region(
         spacing,
         sliver_inset,
     );
-    paths.extend(corner_spurs(&chart, region, 0.0, width));
+    let spurs = corner_spurs_beside(&chart, region, 0.0, width, &paths);
+    paths.extend(spurs);
     paths.retain(|p| p.points.len() >= 2);
     if boundary == Boundary::Beads {
         // A strip the rings leave: its beads, as wide as the strip, are gap fill.
@@ -161,12 +162,11 @@ pub(crate) fn fill_region(
     // fill's narrowest bead, the ring widens to take it. A ring less than a tenth of a bead
     // below the deepest point is left out.
     let (rings, levels) = ring_levels(params, width, spacing, dmax);
-    let gap_inset = 0.02 * width;
-    // The ridge is needed only where the rings' iso-lines and the gap fills between them run:
+    let insets = Insets::new(sliver_inset, width);
+    // The ridge is needed only where the rings' iso-lines and the gap fills beside them run:
     // at both ends of each lattice edge those levels cross.
-    let ridge = ring_ridge(&lm, &db, &levels, (width, gap_inset), spacing);
-    let (last_ring, last_ring_from) =
-        lay_rings(&lm, &db, &ridge, &levels, (width, gap_inset), &mut out);
+    let ridge = ring_ridge(&lm, &db, &levels, width, insets, spacing);
+    let (last_ring, last_ring_from) = lay_rings(&lm, &db, &ridge, &levels, width, insets, &mut out);
     // Infill where the rings stop: lines end a spacing past the last ring, joined along that
     // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
     // the rings leave only a strip narrower than that (a thin blade), the lines cross the strip
@@ -202,7 +202,7 @@ pub(crate) fn fill_region(
             let gap = Gap {
                 edge: 0.0,
                 inset: sliver_inset,
-                min_width: 0.2 * width,
+                min_width: SLIVER_MIN_WIDTH_SHARE * width,
                 below: f64::INFINITY,
             };
             out.extend(core_fill(gap));
@@ -307,10 +307,47 @@ fn raster_dir(params: &LayerParams, turned: bool) -> [f64; 2] {
     [angle.cos(), angle.sin()]
 }
 
+/// The lattice step of a region filled with lines `spacing` apart: a third of a spacing, or
+/// for a region narrower than that allows (its mean width, twice its area over its
+/// perimeter, under [`LATTICE_PER_WIDTH`] steps) finer, down to [`FINEST_LATTICE_SHARE`] of
+/// a spacing. A strip 0.2 mm wide (a contact, an LED's lead) fell between the vertices of a
+/// 0.15 mm lattice and got no bead at all.
+fn lattice_step(region: &Region, spacing: f64) -> f64 {
+    let coarse = spacing / 3.0;
+    let perimeter: f64 = std::iter::once(&region.outer)
+        .chain(region.holes.iter())
+        .map(|r| {
+            (0..r.len())
+                .map(|i| {
+                    let (a, b) = (r[i], r[(i + 1) % r.len()]);
+                    (b[0] - a[0]).hypot(b[1] - a[1])
+                })
+                .sum::<f64>()
+        })
+        .sum();
+    let area = 0.5 * crate::geom2d::area2(&region.outer).abs()
+        - region
+            .holes
+            .iter()
+            .map(|h| 0.5 * crate::geom2d::area2(h).abs())
+            .sum::<f64>();
+    if !(perimeter > 0.0 && area > 0.0) {
+        return coarse;
+    }
+    let width = 2.0 * area / perimeter;
+    (width / LATTICE_PER_WIDTH).clamp(FINEST_LATTICE_SHARE * spacing, coarse)
+}
+
+/// Lattice steps across a region's mean width, at least ([`lattice_step`]).
+const LATTICE_PER_WIDTH: f64 = 6.0;
+/// The finest lattice step, in spacings ([`lattice_step`]).
+const FINEST_LATTICE_SHARE: f64 = 0.02;
+
 /// The lattice of a region at offset `z`, lifted onto the layer surface; `None` where it has no
 /// triangle or a point does not lift.
 fn lifted_mesh(chart: &Chart, region: &Region, z: f64, spacing: f64) -> Option<LayerMesh> {
-    let mut lm = LayerMesh::build_with_metric(region, spacing / 3.0, chart.metric(region, z));
+    let step = lattice_step(region, spacing);
+    let mut lm = LayerMesh::build_with_metric(region, step, chart.metric(region, z));
     if lm.tris.is_empty() {
         return None;
     }
@@ -384,22 +421,60 @@ fn infill_pieces(
     pieces
 }
 
+/// How far inside the strip it fills a gap fill's bead middles stay: `sliver` where the
+/// strip's edge is the region's boundary (beside the first ring, where the region is too
+/// narrow for it), `gap` where it is the edge of a ring's bead.
+#[derive(Debug, Clone, Copy)]
+struct Insets {
+    sliver: f64,
+    gap: f64,
+}
+
+impl Insets {
+    /// `sliver` beside the boundary, [`GAP_INSET`] of a bead `width` beside a bead's edge.
+    fn new(sliver: f64, width: f64) -> Insets {
+        Insets {
+            sliver,
+            gap: GAP_INSET * width,
+        }
+    }
+}
+
+/// The gap fill where ring `j` (at level `c`) does not reach: the strip the ring before
+/// leaves along the ridge, or for the first ring the stretches of the region too narrow for
+/// it (a contact 0.3 mm wide off a body 1 mm thick, which the rings left empty: 25 % of
+/// such a region), its beads down to a fifth of a bead as a region too thin for any ring.
+fn gap_beside_ring(j: usize, c: f64, width: f64, insets: Insets) -> Gap {
+    let (inset, min_width) = if j == 0 {
+        (insets.sliver, SLIVER_MIN_WIDTH_SHARE * width)
+    } else {
+        (insets.gap, GAP_MIN_WIDTH_SHARE * width)
+    };
+    Gap {
+        edge: c - 0.5 * width,
+        inset,
+        min_width,
+        below: c,
+    }
+}
+
 /// The ridge of the distance to the boundary where the rings at `levels` and the gap fills
-/// between them run (at both ends of each lattice edge those levels cross); empty without
+/// beside them run (at both ends of each lattice edge those levels cross); empty without
 /// rings.
 fn ring_ridge(
     lm: &LayerMesh,
     db: &[f64],
     levels: &[f64],
-    (width, gap_inset): (f64, f64),
+    width: f64,
+    insets: Insets,
     spacing: f64,
 ) -> Vec<f64> {
     if levels.is_empty() {
         vec![]
     } else {
         // Each level with the highest ridge its fill tells apart: a ring's width (a full bead
-        // above the gap fill's narrowest one past its edge) and the gap fill between rings
-        // (nothing at or above the next ring's level).
+        // above the gap fill's narrowest one past its edge) and the gap fill where it does
+        // not reach (nothing at or above the ring's level).
         let wanted: Vec<(f64, f64)> = levels
             .iter()
             .map(|&c| {
@@ -408,12 +483,10 @@ fn ring_ridge(
                     c - 0.5 * width + GAP_MIN_WIDTH_SHARE.mul_add(width, width),
                 )
             })
-            .chain(
-                levels
-                    .iter()
-                    .skip(1)
-                    .map(|&c| (c - 0.5 * width + gap_inset, c)),
-            )
+            .chain(levels.iter().enumerate().map(|(j, &c)| {
+                let g = gap_beside_ring(j, c, width, insets);
+                (g.edge + g.inset, g.below)
+            }))
             .collect();
         ridge(lm, db, &wanted, spacing)
     }
@@ -427,7 +500,8 @@ fn lay_rings(
     db: &[f64],
     ridge: &[f64],
     levels: &[f64],
-    (width, gap_inset): (f64, f64),
+    width: f64,
+    insets: Insets,
     out: &mut Vec<FillPath>,
 ) -> (Option<f64>, usize) {
     let mut last_ring = None;
@@ -435,17 +509,16 @@ fn lay_rings(
     for (j, &c) in levels.iter().enumerate() {
         last_ring_from = out.len();
         let edge = c - 0.5 * width;
-        if j > 0 {
-            // Where this ring does not reach (the region's half width is under `c` there),
-            // the strip the ring before leaves along the ridge gets its gap fill.
-            let gap = Gap {
-                edge,
-                inset: gap_inset,
-                min_width: GAP_MIN_WIDTH_SHARE * width,
-                below: c,
-            };
-            out.extend(gap_fill(lm, db, ridge, gap, width));
-        }
+        // Where this ring does not reach (the region's half width is under `c` there), the
+        // strip the ring before leaves along the ridge, or the region itself, gets its gap
+        // fill.
+        out.extend(gap_fill(
+            lm,
+            db,
+            ridge,
+            gap_beside_ring(j, c, width, insets),
+            width,
+        ));
         for line in lm.iso_lines(db, c, ridge) {
             let widths = line
                 .other
@@ -678,6 +751,9 @@ const MAX_CORE_WIDENING: f64 = 1.5;
 /// The narrowest gap fill between rings, in bead widths: a ring with less than this left
 /// beyond its bead widens to take it.
 const GAP_MIN_WIDTH_SHARE: f64 = 0.1;
+/// The narrowest bead of the gap fill of a region (or a stretch of one) too thin for a ring,
+/// in bead widths.
+const SLIVER_MIN_WIDTH_SHARE: f64 = 0.2;
 
 /// Distances to a layer region's boundary are exact (not marched) this many spacings deep.
 const SEED_DEPTH: f64 = 3.0;

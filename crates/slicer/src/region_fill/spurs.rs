@@ -22,7 +22,36 @@ const SPUR_MIN_LENGTH: f64 = 0.1;
 /// towards the tip, each point as wide as the wedge there (`2ρ·sin(θ/2)` at distance ρ from the
 /// corner, capped by twice the distance to the boundary), down to 0.3 of a bead; the
 /// extrusion follows that width by Eq. 1, so the wedge is filled rather than over-filled.
-pub(crate) fn corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -> Vec<FillPath> {
+///
+/// Those whose tip the region's `fill` reaches with its gap fill already (a bead middle
+/// within half a bead of the spur's tip end) are left out: the gap fill of a region's
+/// stretches too narrow for its first ring runs into the tip of a wedge that sharp, and a
+/// spur there would lay it twice.
+pub(crate) fn corner_spurs_beside(
+    chart: &Chart,
+    region: &Region,
+    z: f64,
+    width: f64,
+    fill: &[FillPath],
+) -> Vec<FillPath> {
+    let gap: Vec<Point2> = fill
+        .iter()
+        .filter(|p| p.role == Role::GapFill)
+        .flat_map(|p| p.points.iter().copied())
+        .collect();
+    let reached = |spur: &FillPath| {
+        spur.points.last().is_some_and(|t| {
+            gap.iter()
+                .any(|q| (q[0] - t[0]).hypot(q[1] - t[1]) < 0.5 * width)
+        })
+    };
+    let mut spurs = all_corner_spurs(chart, region, z, width);
+    spurs.retain(|s| !reached(s));
+    spurs
+}
+
+/// Every corner spur of a region ([`corner_spurs_beside`] with no fill).
+fn all_corner_spurs(chart: &Chart, region: &Region, z: f64, width: f64) -> Vec<FillPath> {
     let mut out = vec![];
     let rings: Vec<&Vec<Point2>> = std::iter::once(&region.outer)
         .chain(region.holes.iter())

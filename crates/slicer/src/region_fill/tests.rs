@@ -155,7 +155,7 @@ fn small_regions_are_filled_to_their_area_in_every_mode() {
                     ..LayerParams::default()
                 };
                 let mut paths = fill_test_region(&chart, &region, 0.0, &params, 0);
-                paths.extend(corner_spurs(&chart, &region, 0.0, 0.45));
+                paths.extend(corner_spurs_beside(&chart, &region, 0.0, 0.45, &[]));
                 let r = covered_area(&paths) / (a * b);
                 // Contour-only fills end in a last ring narrowed to the room left, laid
                 // on its iso-line rather than the middle of that room: a compact core
@@ -313,7 +313,7 @@ fn a_sharp_wedge_gets_a_spur_into_its_tip() {
         outer: outer.clone(),
         holes: vec![],
     };
-    let spurs = corner_spurs(&chart, &region, 0.2, w);
+    let spurs = corner_spurs_beside(&chart, &region, 0.2, w, &[]);
     // The tip; the two base corners are 75°, too blunt for a spur.
     assert_eq!(spurs.len(), 1, "{spurs:?}");
     let spur = &spurs[0];
@@ -331,9 +331,11 @@ fn a_sharp_wedge_gets_a_spur_into_its_tip() {
     assert!((tip - 0.15 * w / half.sin()).abs() < 0.02, "tip {tip}");
     let rho_s = 0.5 * w * (1.0 / half.sin() - 1.0);
     assert!((start - rho_s).abs() < 0.02, "start {start}");
-    // With the rings, the nearest path point to the tip moves from 0.87 mm to the spur's.
+    // The rings stop 0.87 mm short of the tip; the spur reaches to 0.3 mm of it. With the
+    // rings, the gap fill of the stretch too narrow for the first ring runs on into the tip
+    // (issue 31, item 4), so the spur is left out there: the tip is not laid twice.
     let params = LayerParams::default();
-    let rings = fill_region(&chart, &region, 0.2, &params, 0, w, w, SLIVER_INSET * w);
+    let fill = fill_region(&chart, &region, 0.2, &params, 0, w, w, SLIVER_INSET * w);
     let nearest = |paths: &[FillPath]| {
         paths
             .iter()
@@ -341,7 +343,11 @@ fn a_sharp_wedge_gets_a_spur_into_its_tip() {
             .map(|q| q[0].hypot(q[1]))
             .fold(f64::INFINITY, f64::min)
     };
+    let (gap, rings): (Vec<FillPath>, Vec<FillPath>) =
+        fill.iter().cloned().partition(|p| p.role == Role::GapFill);
     assert!(nearest(&rings) > 0.8, "rings reach {}", nearest(&rings));
+    assert!(nearest(&gap) < 0.3, "gap fill reaches {}", nearest(&gap));
+    assert!(corner_spurs_beside(&chart, &region, 0.2, w, &fill).is_empty());
     assert!(nearest(&spurs) < 0.3, "spur reaches {}", nearest(&spurs));
 }
 
@@ -464,5 +470,61 @@ fn a_sliver_thinner_than_a_bead_is_filled_not_dropped() {
                 assert!(q[1] > 0.0 && q[1] < 0.3, "{mode:?}: {q:?} outside");
             }
         }
+    }
+}
+
+#[test]
+fn a_contact_thinner_than_a_ring_off_a_wider_body_is_filled() {
+    // A body 0.6 to 1 mm wide with a contact 0.2 to 0.4 mm wide running 4 mm off it (a
+    // connector's section): the body takes a ring, the contact does not. The contact was left
+    // empty (a 1 mm body with a 0.3 mm contact 25 % short, the FPC connector's layers 60 %);
+    // the gap fill beside the first ring lays it, as wide as it is.
+    let surf = world_plane();
+    let chart = Chart::unit(&surf);
+    for (wide, thin) in [(0.6, 0.3), (0.8, 0.3), (1.0, 0.3), (1.0, 0.4), (0.6, 0.2)] {
+        let (lo, hi) = (0.5 * (wide - thin), 0.5 * (wide + thin));
+        let outer = vec![
+            [0.0, 0.0],
+            [4.0, 0.0],
+            [4.0, lo],
+            [8.0, lo],
+            [8.0, hi],
+            [4.0, hi],
+            [4.0, wide],
+            [0.0, wide],
+        ];
+        let area = 4.0 * (wide + thin);
+        for mode in [PathMode::ContourZigzag, PathMode::Contour] {
+            let paths = fill_on_layer(&chart, outer.clone(), mode);
+            let r = covered_area(&paths) / area;
+            assert!(
+                (r - 1.0).abs() < 0.015,
+                "{mode:?} {wide}/{thin}: {r} of the area"
+            );
+            let reach = paths
+                .iter()
+                .flat_map(|p| p.points.iter())
+                .map(|q| q[0])
+                .fold(0.0f64, f64::max);
+            assert!(
+                reach > 7.8,
+                "{mode:?} {wide}/{thin}: beads reach x = {reach}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_strip_narrower_than_a_third_of_a_spacing_is_filled() {
+    // An LED's lead 0.5 x 0.2 mm, a contact 2 x 0.2 mm: they fell between the vertices of the
+    // lattice (a third of a spacing, 0.15 mm) and got no bead; the lattice is now finer for
+    // a region that narrow.
+    let surf = world_plane();
+    let chart = Chart::unit(&surf);
+    for (a, b) in [(0.5, 0.2), (2.0, 0.2), (1.0, 0.25)] {
+        let outer = vec![[0.0, 0.0], [a, 0.0], [a, b], [0.0, b]];
+        let paths = fill_on_layer(&chart, outer, PathMode::ContourZigzag);
+        let r = covered_area(&paths) / (a * b);
+        assert!((r - 1.0).abs() < 0.015, "{a} x {b}: {r} of its area");
     }
 }
