@@ -78,6 +78,8 @@ fn a_lost_feature_fails_below_resolution_or_not() {
         extruded,
         tolerance,
         smallest_bead: 0.0,
+        sparse: 0.0,
+        density: 1.0,
     };
     // No layer: a lost feature, whatever its tolerance.
     assert!(matches!(
