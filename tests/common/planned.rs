@@ -39,7 +39,8 @@ impl Planned {
 /// (name, args) for the whole binary.
 pub fn planned(name: &str, args: &[&str]) -> Arc<Planned> {
     type Cell = Arc<OnceLock<Arc<Planned>>>;
-    static PLANS: OnceLock<Mutex<HashMap<(String, Vec<String>), Cell>>> = OnceLock::new();
+    type Plans = HashMap<(String, Vec<String>), Cell>;
+    static PLANS: OnceLock<Mutex<Plans>> = OnceLock::new();
     let key = (
         name.to_string(),
         args.iter().map(|a| a.to_string()).collect::<Vec<_>>(),
