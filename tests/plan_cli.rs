@@ -1284,11 +1284,12 @@ const NOT_YET: [(&str, &str, &str); 4] = [
     ("stacked_solids", "marlin", "a box in the air"),
     ("stacked_solids", "delta5", "a box in the air"),
     ("stacked_solids", "kuka", "a box in the air"),
-    // As modelled 24,478 print points out of the arm's reach or joint limits (78 % of blades
-    // 1, 3 and 5, whose tool axes lie horizontal along the arm's X: the arm cannot fold that
-    // far), and no move on the table reaches them; the other face tried is as far and costs
-    // minutes more.
-    ("fan", "kuka", "blades out of the arm's reach"),
+    // Plans (exit 0), but only as the third placement tried, sliced whole in planar layers:
+    // as modelled 24,478 print points are out of the arm's reach or joint limits (78 % of
+    // blades 1, 3 and 5, whose tool axes lie horizontal along the arm's X) and no move on the
+    // table reaches them, nor on face #1924 (27,461 out of reach). 103 s of CPU (release), the
+    // matrix's costliest by far: left out for the test suite's time.
+    ("fan", "kuka", "plans, planar, after 100 s"),
 ];
 
 /// Issue 31, done when: every fixture plans with exit 0, no colliding move, no unsupported
