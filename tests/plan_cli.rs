@@ -4,8 +4,11 @@
 
 #[path = "common/cli.rs"]
 mod cli;
+#[path = "common/planned.rs"]
+mod planned;
 
 use cli::{fixture, plan, stderr, Scratch, BIN};
+use planned::{planned, planned_all};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -195,16 +198,29 @@ fn strict_turns_warnings_into_an_error_and_writes_nothing() {
 #[test]
 fn unreachable_robot_points_stop_the_plan_unless_allowed() {
     let s = Scratch::new("reach");
-    let out = s.path("cap");
+    // The built-in cell with its work table 2 m in front of the arm's foot (the arm reaches
+    // about 0.9 m): no place on the table is in reach, so moving the part on it (issue 31,
+    // item 3) does not help. A box plans in a second; the capsule this test planned before
+    // is now moved into reach, and planned in the fixture matrix below.
+    let o = Command::new(BIN)
+        .args(["profiles", "show", "kuka"])
+        .output()
+        .expect("runs");
+    let far = String::from_utf8_lossy(&o.stdout).replace(
+        "base = { X = 450.0, Y = 0.0,",
+        "base = { X = 2000.0, Y = 0.0,",
+    );
+    assert!(
+        far.contains("X = 2000.0"),
+        "the base frame is in the profile"
+    );
+    let cell = s.write("far.toml", &far);
+    let out = s.path("box");
     let o = plan(
-        "capsule.step",
-        // The cone boss collides too (issue 18); that is not what this test is about. As
-        // modelled: by default the other placements are tried, and the capsule turned over
-        // plans (tests/placement.rs).
+        "box.step",
         &[
-            "--machine",
-            "kuka",
-            "--allow-collisions",
+            "--machine-profile",
+            &cell,
             "--orient",
             "modelled",
             "-o",
@@ -213,7 +229,7 @@ fn unreachable_robot_points_stop_the_plan_unless_allowed() {
     );
     assert_refused(&o, &["out of the arm's reach", "--allow-unreachable"]);
     assert!(
-        !out.join("capsule.src").exists() && !out.join("toolpath.csv").exists(),
+        !out.join("box.src").exists() && !out.join("toolpath.csv").exists(),
         "no KRL written for an arm that cannot reach"
     );
     assert!(
@@ -221,12 +237,11 @@ fn unreachable_robot_points_stop_the_plan_unless_allowed() {
         "the refused plan's report shows why"
     );
     let o = plan(
-        "capsule.step",
+        "box.step",
         &[
-            "--machine",
-            "kuka",
+            "--machine-profile",
+            &cell,
             "--allow-unreachable",
-            "--allow-collisions",
             "--orient",
             "modelled",
             "-o",
@@ -910,23 +925,20 @@ fn a_fixed_axis_against_a_feature_growing_downward_warns() {
         serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
     assert_eq!(report["features"][1]["reference"]["surface"], "cone");
     assert_eq!(report["features"][2]["reference"]["surface"], "sphere");
-    // Without a fixed axis the layers' normals are the axes: no such warning.
-    let o = plan(
-        "capsule.step",
-        &["--allow-collisions", "-o", s.path("n").to_str().unwrap()],
-    );
-    assert!(!stderr(&o).contains("fixed_tool_axis"), "{}", stderr(&o));
+    // Without a fixed axis the layers' normals are the axes: no such warning (the fixture
+    // matrix's plan of the capsule).
+    let o = planned("capsule", &["--machine", "delta5"]);
+    assert_eq!(o.code, Some(0), "{}", o.stderr);
+    assert!(!o.stderr.contains("fixed_tool_axis"), "{}", o.stderr);
 }
 
 #[test]
 fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
-    let s = Scratch::new("gcode");
-    let out = s.path("o");
-    let o = plan("plate_boss_boss.step", &["-o", out.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    // The fixture matrix's plan (marlin is the default machine).
+    let p = planned("plate_boss_boss", &["--machine", "marlin"]);
+    assert_eq!(p.code, Some(0), "{}", p.stderr);
+    let program = p.file("program.gcode");
+    let report = p.report().expect("plan.json");
     // `;LAYER:` runs 0, 1, 2, ... over the whole build order: one per feature layer.
     let global: Vec<usize> = program
         .lines()
@@ -951,7 +963,7 @@ fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
     );
     assert!(program.contains(";WIDTH:0.450\n"));
     // The filament is the sum of the tool path's E; its mass by PLA's density.
-    let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
+    let csv = p.file("toolpath.csv");
     let e: f64 = csv
         .lines()
         .skip(1)
@@ -993,14 +1005,10 @@ fn the_gcode_counts_layers_over_the_build_order_and_estimates_the_print() {
 /// points of each as the program has print moves under it).
 #[test]
 fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
-    let s = Scratch::new("types");
-    let out = s.path("o");
-    let o = plan(
-        "plate_boss_boss.step",
-        &["--machine", "marlin", "-o", out.to_str().unwrap()],
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let program = std::fs::read_to_string(out.join("program.gcode")).unwrap();
+    // The fixture matrix's plan.
+    let p = planned("plate_boss_boss", &["--machine", "marlin"]);
+    assert_eq!(p.code, Some(0), "{}", p.stderr);
+    let program = p.file("program.gcode");
     let known = [
         "External perimeter",
         "Perimeter",
@@ -1071,7 +1079,7 @@ fn every_print_move_lies_under_a_type_and_the_outermost_ring_is_external() {
             assert_eq!(t, "External perimeter", "layer {n}, {side}");
         }
     }
-    let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
+    let csv = p.file("toolpath.csv");
     let mut csv_types = std::collections::BTreeMap::<String, usize>::new();
     // A print point that goes nowhere as the program writes X, Y, Z (to the micrometre) is
     // merged into the next move: it is no G1 of its own.
@@ -1140,8 +1148,9 @@ fn a_part_too_big_to_plan_is_refused_before_any_layer() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// The freeform fixtures and the machine they are meant for (issue 31): `delta5`. Every other
-/// fixture is planar and meant for `marlin`.
+/// The freeform fixtures (issue 31): meant for `delta5` and `kuka` (`--orient auto` below
+/// plans them on `delta5`). Every other fixture is planar, meant for all three machines
+/// (`--orient auto` below plans them on `marlin`).
 const FREEFORM: [&str; 7] = [
     "impeller",
     "fan",
@@ -1184,41 +1193,35 @@ const ROUND: [&str; 2] = ["sphere", "torus"];
 
 #[test]
 fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
-    let s = Scratch::new("support");
-    let mut names: Vec<String> = std::fs::read_dir(fixture(""))
-        .unwrap()
-        .flatten()
-        .filter_map(|e| {
-            let n = e.file_name().to_string_lossy().into_owned();
-            n.strip_suffix(".step").map(str::to_string)
-        })
-        .collect();
-    names.sort();
+    let names = fixture_names();
     assert!(names.len() > 20, "{names:?}");
-    let mut failures = vec![];
-    for name in &names {
-        let machine = match FREEFORM.contains(&name.as_str()) {
+    // The freeform parts' blades and bosses may meet the head's body on delta5 (issue 31,
+    // item 2: a pedestal): collisions are allowed here, this test is about support.
+    let args = |name: &str| -> Vec<String> {
+        let machine = match FREEFORM.contains(&name) {
             true => "delta5",
             false => "marlin",
         };
-        let out = s.path(name);
-        // The freeform parts' blades and bosses meet the head's body on delta5 (issue 31,
-        // item 2: a pedestal): collisions are allowed here, this test is about support.
-        let o = plan(
-            &format!("{name}.step"),
-            &[
-                "--machine",
-                machine,
-                "--orient",
-                "auto",
-                "--allow-collisions",
-                "-o",
-                out.to_str().unwrap(),
-            ],
-        );
-        let err = stderr(&o);
+        [
+            "--machine",
+            machine,
+            "--orient",
+            "auto",
+            "--allow-collisions",
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let runs: Vec<(String, Vec<String>)> = names.iter().map(|n| (n.clone(), args(n))).collect();
+    planned_all(&runs);
+    let mut failures = vec![];
+    for (name, args) in &runs {
+        let machine = &args[1];
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = planned(name, &args);
+        let err = &o.stderr;
         if ROUND.contains(&name.as_str()) {
-            if o.status.code() != Some(2) || !err.contains("no planar face") {
+            if o.code != Some(2) || !err.contains("no planar face") {
                 failures.push(format!(
                     "{name}: not refused for want of a planar face: {err}"
                 ));
@@ -1230,25 +1233,27 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
                 .lines()
                 .any(|l| l.contains(feature) && l.contains("mm^2 unsupported"));
             // Refused: no program, its report and preview showing why.
-            if o.status.code() != Some(2) || !named || out.join("program.gcode").exists() {
+            if o.code != Some(2) || !named || o.files.contains_key("program.gcode") {
                 failures.push(format!("{name}: its overhang was not refused: {err}"));
             }
             continue;
         }
         if let Some((_, cause)) = REFUSED_OTHERWISE.iter().find(|(n, _)| n == name) {
-            if o.status.code() != Some(2) || !err.contains(cause) {
+            if o.code != Some(2) || !err.contains(cause) {
                 failures.push(format!("{name}: not refused for `{cause}` any more: {err}"));
             }
             continue;
         }
-        if !o.status.success() {
+        if o.code != Some(0) {
             failures.push(format!("{name} on {machine}: {err}"));
             continue;
         }
-        let report: Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+        let Some(report) = o.report() else {
+            failures.push(format!("{name} on {machine}: no plan.json"));
+            continue;
+        };
         let mut support = 0.0;
-        for f in report["features"].as_array().unwrap() {
+        for f in report["features"].as_array().into_iter().flatten() {
             let a = f["unsupported_area_mm2"].as_f64();
             if a != Some(0.0) {
                 failures.push(format!("{name}: feature {} unsupported {a:?}", f["id"]));
@@ -1258,6 +1263,105 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
         // Support material only where no placement avoids an overhang.
         if (support > 0.0) != SUPPORTED.contains(&name.as_str()) {
             failures.push(format!("{name}: {support} mm^3 of support material"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The fixtures' names (every `fixtures/*.step` holds a solid), sorted.
+fn fixture_names() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(fixture(""))
+        .expect("the fixtures folder")
+        .flatten()
+        .filter_map(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.strip_suffix(".step").map(str::to_string)
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Fixture and machine pairs of the matrix below that do not plan yet, with why (measured
+/// with the release build, default settings).
+const NOT_YET: [(&str, &str, &str); 4] = [
+    // A 10 x 10 x 5 mm box floats 5 mm over the others by design (the fixture of the solids'
+    // build order and the warning for a solid in the air): 100 mm^2 unsupported on its first
+    // layer on every placement tried (as modelled, four faces, sliced whole); support would
+    // have to reach below the box's first layer, which support material does not yet do.
+    ("stacked_solids", "marlin", "a box in the air"),
+    ("stacked_solids", "delta5", "a box in the air"),
+    ("stacked_solids", "kuka", "a box in the air"),
+    // Plans (exit 0), but only as the third placement tried, sliced whole in planar layers:
+    // as modelled 24,478 print points are out of the arm's reach or joint limits (78 % of
+    // blades 1, 3 and 5, whose tool axes lie horizontal along the arm's X) and no move on the
+    // table reaches them, nor on face #1924 (27,461 out of reach). 103 s of CPU (release), the
+    // matrix's costliest by far: left out for the test suite's time.
+    ("fan", "kuka", "plans, planar, after 100 s"),
+];
+
+/// Issue 31, done when: every fixture plans with exit 0, no colliding move, no unsupported
+/// bead, in reach and with a passing self-check, with default settings, on each machine it is
+/// meant for: the freeform ones on `delta5` and `kuka`, the planar ones on all three. Each
+/// plan is made once for this binary ([`planned`]): other tests read the same ones.
+#[test]
+fn every_fixture_plans_clean_on_each_machine_it_is_meant_for() {
+    let mut runs: Vec<(String, Vec<String>)> = vec![];
+    for name in fixture_names() {
+        let machines: &[&str] = match FREEFORM.contains(&name.as_str()) {
+            true => &["delta5", "kuka"],
+            false => &["marlin", "delta5", "kuka"],
+        };
+        for m in machines {
+            if !NOT_YET.iter().any(|(n, k, _)| *n == name && k == m) {
+                runs.push((name.clone(), vec!["--machine".into(), m.to_string()]));
+            }
+        }
+    }
+    assert!(runs.len() > 50, "{runs:?}");
+    planned_all(&runs);
+    let mut failures = vec![];
+    for (name, args) in &runs {
+        let machine = &args[1];
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = planned(name, &args);
+        let last = o.stderr.lines().last().unwrap_or("");
+        let report = o.report();
+        let (Some(0), Some(report)) = (o.code, report) else {
+            failures.push(format!("{name} on {machine}: exit {:?}: {last}", o.code));
+            continue;
+        };
+        if report["complete"] != true {
+            failures.push(format!("{name} on {machine}: incomplete: {last}"));
+        }
+        for f in report["features"].as_array().into_iter().flatten() {
+            let id = &f["id"];
+            for key in ["collisions", "unreachable_points"] {
+                // unreachable_points: kuka only.
+                if f[key].as_u64().unwrap_or(0) != 0 {
+                    failures.push(format!(
+                        "{name} on {machine}: feature {id}: {key} {}",
+                        f[key]
+                    ));
+                }
+            }
+            if f["unsupported_area_mm2"].as_f64() != Some(0.0) {
+                failures.push(format!(
+                    "{name} on {machine}: feature {id}: unsupported {}",
+                    f["unsupported_area_mm2"]
+                ));
+            }
+        }
+        // A program was written.
+        let program = o
+            .files
+            .keys()
+            .any(|f| f.ends_with(".gcode") || f.ends_with(".src"));
+        if !program {
+            failures.push(format!(
+                "{name} on {machine}: no program in {:?}",
+                o.files.keys()
+            ));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -1342,14 +1446,19 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
     // Sparse columns under the unsupported area, up to the plate's underside 15 mm high.
     assert!(support > 0.0 && support < expect * 15.0, "{support}");
     // --orient auto stands it on the plate's bottom face, every feature held up.
-    let auto = s.path("auto");
-    let o = plan(
-        "plate_boss_boss.step",
-        &["--orient", "auto", "-o", auto.to_str().unwrap()],
+    // (The plan of the test above: nothing collides on marlin, --allow-collisions or not.)
+    let o = planned(
+        "plate_boss_boss",
+        &[
+            "--machine",
+            "marlin",
+            "--orient",
+            "auto",
+            "--allow-collisions",
+        ],
     );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(auto.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(o.code, Some(0), "{}", o.stderr);
+    let report = o.report().expect("plan.json");
     let down: Vec<f64> = report["placement"]["down"]
         .as_array()
         .unwrap()
