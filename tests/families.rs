@@ -452,9 +452,9 @@ fn check_part(file: &str, run: usize) -> Vec<String> {
         }
         // Support material lies outside the part, under its overhangs; skirt and brim
         // around it.
-        if c.get(12).is_some_and(|r| {
-            r.starts_with("support_material") || matches!(*r, "skirt" | "brim")
-        }) {
+        if c.get(12)
+            .is_some_and(|r| r.starts_with("support_material") || matches!(*r, "skirt" | "brim"))
+        {
             continue;
         }
         let num = |k: usize| c[k].parse::<f64>().unwrap_or(f64::NAN);
