@@ -276,26 +276,28 @@ pub fn planar_may_help(e: &PlanError, process: &Process) -> bool {
     }
 }
 
-/// Whether `plan` is what slicing the part whole in planar layers along +Z plans: each solid
+/// Whether `plan` is what slicing the part whole in planar layers along +Z plans: one solid,
 /// one two5d feature (the whole solid: nothing split off) on the build plate, growing along
 /// +Z, nothing of it below the plate (the whole solid's layers start at its lowest point).
-/// Sliced whole, it would be planned and refused the same way.
+/// Sliced whole, it would be planned and refused the same way. Several solids are not: sliced
+/// whole, they are laid together in the same layers ([`features::whole_part_features`]).
 fn is_planar_already(plan: &Plan) -> bool {
-    let one_each = plan
-        .assembly
-        .trees
-        .iter()
-        .all(|t| match t.features.as_slice() {
-            [f] => {
-                f.kind == features::FeatureKind::Two5d
-                    && f.parents.is_empty()
-                    && f.reference.surface == "build_plate"
-                    && f.reference
-                        .normal
-                        .is_some_and(|n| n[2] > crate::tolerance::SAME_DIRECTION_DOT)
-            }
-            _ => false,
-        });
+    let one_each = plan.assembly.trees.len() == 1
+        && plan
+            .assembly
+            .trees
+            .iter()
+            .all(|t| match t.features.as_slice() {
+                [f] => {
+                    f.kind == features::FeatureKind::Two5d
+                        && f.parents.is_empty()
+                        && f.reference.surface == "build_plate"
+                        && f.reference
+                            .normal
+                            .is_some_and(|n| n[2] > crate::tolerance::SAME_DIRECTION_DOT)
+                }
+                _ => false,
+            });
     one_each
         && !plan
             .warnings()
