@@ -22,8 +22,8 @@ pub const WHOLE_PART: &str = "whole_part";
 /// The build direction of a solid planned whole: +Z.
 pub const PLUS_Z: [f64; 3] = [0.0, 0.0, 1.0];
 
-/// The solids of `brep` as features: all of them one feature ([`solids_together`]) when they
-/// share at most [`TOGETHER_OVERLAP_SHARE`] of their volume, else each one feature ([`whole_part_tree`]), ordered and checked together like
+/// The solids of `brep` as features: all of them one feature, sliced in the same layers, when
+/// they share at most 0.5 % of their volume, else each one feature ([`whole_part_tree`]), ordered and checked together like
 /// [`crate::extract_all`]'s trees (lowest first, overlaps and floating solids reported).
 /// Solids that enclose no volume are skipped with a warning either way.
 pub fn whole_part_features(brep: &Brep) -> Result<Assembly, ExtractError> {
