@@ -56,10 +56,18 @@ impl Drop for Scratch {
 }
 
 pub fn plan(part: &str, args: &[&str]) -> Output {
+    // The tests are about what is planned, not how long the placement search may take on a
+    // loaded test machine (the limit is wall-clock time).
+    let unlimited: &[&str] = if args.contains(&"--placement-time-limit") {
+        &[]
+    } else {
+        &["--placement-time-limit", "inf"]
+    };
     Command::new(BIN)
         .arg("plan")
         .arg(fixture(part))
         .args(args)
+        .args(unlimited)
         .output()
         .expect("runs")
 }

@@ -71,6 +71,9 @@ fn run(name: &str, args: &[&str]) -> Planned {
         .arg("plan")
         .arg(&part)
         .args(args)
+        // The tests are about what is planned, not how long the placement search may take
+        // on a loaded test machine (the limit is wall-clock time).
+        .args(["--placement-time-limit", "inf"])
         .arg("-o")
         .arg(&dir)
         .output()

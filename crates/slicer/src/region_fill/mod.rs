@@ -311,7 +311,9 @@ fn raster_dir(params: &LayerParams, turned: bool) -> [f64; 2] {
 /// for a region narrower than that allows (its mean width, twice its area over its
 /// perimeter, under [`LATTICE_PER_WIDTH`] steps) finer, down to [`FINEST_LATTICE_SHARE`] of
 /// a spacing. A strip 0.2 mm wide (a contact, an LED's lead) fell between the vertices of a
-/// 0.15 mm lattice and got no bead at all.
+/// 0.15 mm lattice and got no bead at all. Regions at least a spacing wide keep the coarse
+/// lattice: finer, the rims of a pin's curved layers on a dome (family `pin_1`) were filled
+/// 3.02 % over their volume.
 fn lattice_step(region: &Region, spacing: f64) -> f64 {
     let coarse = spacing / 3.0;
     let perimeter: f64 = std::iter::once(&region.outer)
@@ -335,6 +337,10 @@ fn lattice_step(region: &Region, spacing: f64) -> f64 {
         return coarse;
     }
     let width = 2.0 * area / perimeter;
+    if width >= spacing {
+        // Wide enough for the coarse lattice to find: finer steps only move its iso-lines.
+        return coarse;
+    }
     (width / LATTICE_PER_WIDTH).clamp(FINEST_LATTICE_SHARE * spacing, coarse)
 }
 
