@@ -319,6 +319,24 @@ fn walk(
     Ok(())
 }
 
+/// The work envelope of `m` (with geometry `g`) in machine coordinates: its lowest and
+/// highest corners, mm (X and Y over the bed, from the bed's origin; Z from `g.z_min` to the
+/// bed size's height).
+pub(crate) fn work_envelope(
+    m: &MachineProfile,
+    g: &geometry::Delta5Geometry,
+) -> ([f64; 3], [f64; 3]) {
+    let (x0, y0) = if m.bed_origin_centre {
+        (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
+    } else {
+        (0.0, 0.0)
+    };
+    (
+        [x0, y0, g.z_min],
+        [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]],
+    )
+}
+
 /// How far (mm) the nozzle positions of the path's points leave the work envelope (X and Y
 /// within `bed_size` around the bed centre, Z within `z_min`..`bed_size` Z) as [`delta5`]
 /// places the part ([`table_offset`]) and turns the bed (its bed angles, C patched inside the
@@ -336,13 +354,7 @@ pub fn envelope_excess(path: &ToolPath, m: &MachineProfile) -> Result<f64, PostE
     path.check_finite()?;
     let offset = table_offset(path);
     let poses = plan_poses(&path.points, g, &m.name)?;
-    let (x0, y0) = if m.bed_origin_centre {
-        (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
-    } else {
-        (0.0, 0.0)
-    };
-    let lo = [x0, y0, g.z_min];
-    let hi = [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]];
+    let (lo, hi) = work_envelope(m, g);
     let mut excess: f64 = 0.0;
     for (q, pose) in path.points.iter().zip(&poses) {
         excess = excess.max(-(q.p[2] + offset[2]));

@@ -24,13 +24,7 @@ pub fn largest_across(m: &MachineProfile) -> Result<Option<f64>, PostError> {
         }
         MachineKind::Delta5 => {
             let g = m.delta5_table()?;
-            let (x0, y0) = if m.bed_origin_centre {
-                (-m.bed_size[0] / 2.0, -m.bed_size[1] / 2.0)
-            } else {
-                (0.0, 0.0)
-            };
-            let lo = [x0, y0, g.z_min];
-            let hi = [x0 + m.bed_size[0], y0 + m.bed_size[1], m.bed_size[2]];
+            let (lo, hi) = crate::delta5::work_envelope(m, g);
             let q = g.pivot();
             let far = |k: usize| (lo[k] - q[k]).abs().max((hi[k] - q[k]).abs());
             Ok(Some(

@@ -427,13 +427,19 @@ impl Writer {
         // A bead resting on the plate (its bottom within 10 µm of Z0) goes at first-layer speed.
         let on_plate = t[2] - q.thickness.max(0.0) <= 0.01;
         self.fan.set(on_plate, &mut self.out);
+        push_move(&mut self.out, "G1", t);
+        self.end_print_move(de, on_plate, t);
+    }
+
+    /// The end of a print move's line written: its filament `de`, its feed (first-layer speed
+    /// for a bead `on_plate`); the head then stands at `to`.
+    fn end_print_move(&mut self, de: i64, on_plate: bool, to: [f64; 3]) {
         let f = if on_plate {
             &self.first_layer_f
         } else {
             &self.print_f
         };
         let out = &mut self.out;
-        push_move(out, "G1", t);
         if de != 0 {
             out.push_str(" E");
             push_e_text(out, de);
@@ -443,7 +449,7 @@ impl Writer {
         out.push('\n');
         self.extrusion.written(de);
         self.printing = true;
-        self.at = Some(t);
+        self.at = Some(to);
     }
 
     /// A print arc ending at `end` (machine coordinates) standing for `points`: their
@@ -459,11 +465,6 @@ impl Writer {
             .first()
             .is_some_and(|q| end[2] - q.thickness.max(0.0) <= 0.01);
         self.fan.set(on_plate, &mut self.out);
-        let f = if on_plate {
-            &self.first_layer_f
-        } else {
-            &self.print_f
-        };
         let out = &mut self.out;
         out.push_str(if arc.ccw { "G3 X" } else { "G2 X" });
         push_fixed(out, end[0], 3);
@@ -473,16 +474,7 @@ impl Writer {
         push_fixed(out, arc.centre[0] - at[0], 3);
         out.push_str(" J");
         push_fixed(out, arc.centre[1] - at[1], 3);
-        if de != 0 {
-            out.push_str(" E");
-            push_e_text(out, de);
-        }
-        out.push_str(" F");
-        out.push_str(f);
-        out.push('\n');
-        self.extrusion.written(de);
-        self.printing = true;
-        self.at = Some(end);
+        self.end_print_move(de, on_plate, end);
     }
 
     fn footer(&mut self, m: &MachineProfile) {
