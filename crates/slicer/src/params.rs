@@ -836,5 +836,5 @@ pub struct LayerParamsPatch {
 }
 
 #[cfg(test)]
-#[path = "params_tests.rs"]
+#[path = "params/tests.rs"]
 mod tests;
