@@ -426,8 +426,14 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
     let kind = plan.report.settings.machine["kind"]
         .as_str()
         .unwrap_or("the machine");
+    let overlapping = plan::Warning::part(plan::WarningKind::OverlappingSolids).to_string();
+    let overlap = plan.warnings().iter().any(|w| w.contains(&overlapping));
     let planar = match (chosen && plan.report.slicing == "planar", plus_z_only(kind)) {
         (false, _) => String::new(),
+        (true, _) if overlap => {
+            " sliced whole in planar layers along +Z (slicing auto: the part's solids overlap),"
+                .to_string()
+        }
         (true, true) => format!(
             " sliced whole in planar layers along +Z (slicing auto: `{kind}` prints only along +Z),"
         ),

@@ -37,6 +37,10 @@ pub struct Assembly {
     pub trees: Vec<FeatureTree>,
     /// About the solids together: skipped, overlapping, floating.
     pub warnings: Vec<String>,
+    /// Some of its solids overlap (bodies pushed into each other, sharing more than 1 % of
+    /// the smaller's volume): planned one feature tree per solid, the material they share
+    /// would be laid twice.
+    pub overlapping: bool,
 }
 
 impl Assembly {
@@ -163,11 +167,14 @@ fn overlaps_of(solids: &[Solid]) -> Vec<Overlap> {
 /// `trees` (lowest first) as an assembly, with `warnings` and what the user should know about
 /// how its solids sit together: overlaps, and solids that start in the air.
 pub(crate) fn relate(trees: Vec<FeatureTree>, mut warnings: Vec<String>) -> Assembly {
+    let mut overlapping = false;
     if trees.len() > 1 {
         let solids: Vec<Solid> = trees.iter().map(|t| Solid::new(t, t.mesh.bbox())).collect();
         // Solids that overlap one built before them stand on it.
         let mut supported = vec![false; solids.len()];
-        for o in overlaps_of(&solids) {
+        let shared = overlaps_of(&solids);
+        overlapping = !shared.is_empty();
+        for o in shared {
             supported[o.second] = true;
             warnings.push(format!(
                 "{} and {} overlap by about {:.0} mm^3 ({:.0} % of the smaller): each is planned \
@@ -190,7 +197,11 @@ pub(crate) fn relate(trees: Vec<FeatureTree>, mut warnings: Vec<String>) -> Asse
             }
         }
     }
-    Assembly { trees, warnings }
+    Assembly {
+        trees,
+        warnings,
+        overlapping,
+    }
 }
 
 /// A solid's closed analysis mesh and figures.

@@ -2,13 +2,14 @@
 //! plate from the lowest point along +Z, as a planar slicer slices it (issue 33, the process
 //! key `slicing = "planar"`). No loop is split off and no face healed.
 //!
-//! Solids that do not overlap are sliced together, in the same layers, as ONE feature: a
-//! planar slicer lays every body's section of a layer before the next layer, so no body
-//! waits for another to be finished (the head would meet the finished one) and a body that
-//! starts in the air is held up by support from the plate like any overhang. Solids that
-//! overlap by more than half a percent of their volume stay one feature each (as
-//! [`crate::extract_all`] plans them), with the overlap reported: sliced together, the
-//! sections' even-odd regions would leave their common material out.
+//! The solids are sliced together, in the same layers, as ONE feature: a planar slicer lays
+//! every body's section of a layer before the next layer, so no body waits for another to be
+//! finished (the head would meet the finished one) and a body that starts in the air is held
+//! up by support from the plate like any overhang. Solids that overlap (bodies pushed into
+//! each other) are united layer by layer: their section loops cross, and the layer is where
+//! they wind round (the slicer's `regions_by_winding`), so the material they share is laid
+//! once; the feature's volume is the solids' sum less the overlaps measured
+//! ([`crate::assembly`]), which the self-check holds the layers to.
 
 use crate::assembly::{overlaps, relate, solid_name, solid_trees, Assembly};
 use crate::extract::{ExtractError, Feature, FeatureKind, FeatureTree, Reference};
@@ -22,22 +23,21 @@ pub const WHOLE_PART: &str = "whole_part";
 /// The build direction of a solid planned whole: +Z.
 pub const PLUS_Z: [f64; 3] = [0.0, 0.0, 1.0];
 
-/// The solids of `brep` as features: all of them one feature, sliced in the same layers, when
-/// they share at most 0.5 % of their volume, else each one feature ([`whole_part_tree`]), ordered and checked together like
-/// [`crate::extract_all`]'s trees (lowest first, overlaps and floating solids reported).
-/// Solids that enclose no volume are skipped with a warning either way.
+/// The solids of `brep` as features: all of them one feature, sliced in the same layers, the
+/// material two of them share counted once (overlaps reported); a single solid as one
+/// feature ([`whole_part_tree`]) checked like [`crate::extract_all`]'s trees. Solids that
+/// enclose no volume are skipped with a warning.
 pub fn whole_part_features(brep: &Brep) -> Result<Assembly, ExtractError> {
     let (solids, mut warnings) = solid_trees(brep, whole_part_tree)?;
     let (ids, trees): (Vec<SolidId>, Vec<FeatureTree>) = solids.into_iter().unzip();
-    let shared = overlaps(&trees);
-    let common: f64 = shared.iter().map(|o| o.volume).sum();
-    let volume: f64 = trees.iter().map(|t| t.part_volume).sum();
-    if trees.len() > 1 && common <= TOGETHER_OVERLAP_SHARE * volume {
-        if let Some(tree) = solids_together(brep, &ids, &trees)? {
+    if trees.len() > 1 {
+        let shared = overlaps(&trees);
+        let common: f64 = shared.iter().map(|o| o.volume).sum();
+        if let Some(tree) = solids_together(brep, &ids, &trees, common)? {
             warnings.extend(shared.iter().map(|o| {
                 format!(
-                    "{} and {} overlap by about {:.3} mm^3: sliced together, the sections' \
-                     even-odd regions leave that material out",
+                    "{} and {} overlap by about {:.3} mm^3: sliced together, each layer the \
+                     union of their sections, so that material is laid once",
                     solid_name(&trees[o.first]),
                     solid_name(&trees[o.second]),
                     o.volume
@@ -46,6 +46,7 @@ pub fn whole_part_features(brep: &Brep) -> Result<Assembly, ExtractError> {
             return Ok(Assembly {
                 trees: vec![tree],
                 warnings,
+                overlapping: false,
             });
         }
     }
@@ -60,6 +61,7 @@ fn solids_together(
     brep: &Brep,
     ids: &[SolidId],
     trees: &[FeatureTree],
+    common: f64,
 ) -> Result<Option<FeatureTree>, ExtractError> {
     let (mut faces, mut voids) = (vec![], vec![]);
     for &s in ids {
@@ -92,7 +94,8 @@ fn solids_together(
         &analysis_options(bbox.diagonal().max(MIN_DIAG)),
     )
     .map_err(crate::measure::MeasureError::from)?;
-    let part_volume: f64 = trees.iter().map(|t| t.part_volume).sum();
+    // The material two solids share is laid once (the layers' sections are their union).
+    let part_volume: f64 = trees.iter().map(|t| t.part_volume).sum::<f64>() - common;
     let problems: Vec<_> = trees
         .iter()
         .flat_map(|t| t.features[0].problems.iter().cloned())
@@ -127,11 +130,6 @@ fn solids_together(
         warnings,
     }))
 }
-
-/// Solids are sliced together ([`solids_together`]) while the material they share is at most
-/// this share of their volume: left out of the sections, it stays well inside the
-/// self-check's ±3 % (twice the share at worst: counted in the volume, laid nowhere).
-const TOGETHER_OVERLAP_SHARE: f64 = 0.005;
 
 /// The smallest box diagonal (mm) an analysis mesh is sized for.
 const MIN_DIAG: f64 = 1e-3;

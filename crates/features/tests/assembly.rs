@@ -3,6 +3,7 @@
 
 use features::{extract_all, solid_name, ExtractOptions};
 use serde_json::Value;
+use std::f64::consts::PI;
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
@@ -149,10 +150,10 @@ fn shapr3d_impeller_bodies_skip_the_sliver_and_report_each_blade_in_the_hub() {
     );
 }
 
-/// Planned whole (`slicing = "planar"`), solids that do not overlap are one feature sliced in
-/// the same layers; solids that overlap stay one feature each, the overlap reported.
+/// Planned whole (`slicing = "planar"`), the solids are one feature sliced in the same layers;
+/// the material overlapping ones share is counted once, the overlap reported.
 #[test]
-fn whole_part_slices_separate_solids_together_and_overlapping_ones_apart() {
+fn whole_part_slices_solids_together_and_counts_their_overlap_once() {
     let two = brep::read_step(fixture("two_solids.step")).expect("reads");
     let a = features::whole_part_features(&two.brep).expect("whole part");
     assert_eq!(a.trees.len(), 1);
@@ -166,11 +167,25 @@ fn whole_part_slices_separate_solids_together_and_overlapping_ones_apart() {
     let b = t.mesh.bbox();
     assert!(b.min.x.abs() < 1e-6 && (b.max.x - 50.0).abs() < 1e-6 && (b.max.z - 30.0).abs() < 1e-6);
 
+    // Overlapping solids too: the cylinder sunk 5 mm into the base box (r 5 mm) shares
+    // 25π·5 = 392.7 mm^3 with it, which the one feature counts once.
     let stacked = brep::read_step(fixture("stacked_solids.step")).expect("reads");
     let a = features::whole_part_features(&stacked.brep).expect("whole part");
-    assert_eq!(a.trees.len(), 4);
+    assert_eq!(a.trees.len(), 1);
+    let f = &a.trees[0].features[0];
+    assert_eq!(a.trees[0].features.len(), 1);
+    let sum = 9000.0 + 500.0 + 500.0 + 25.0 * PI * 20.0;
+    let shared = 25.0 * PI * 5.0;
     assert!(
-        a.warnings.iter().any(|w| w.contains("overlap")),
+        (f.volume - (sum - shared)).abs() < 0.05 * shared,
+        "{} for {}",
+        f.volume,
+        sum - shared
+    );
+    assert!(
+        a.warnings
+            .iter()
+            .any(|w| w.contains("overlap") && w.contains("laid once")),
         "{:?}",
         a.warnings
     );

@@ -132,7 +132,9 @@ pub fn arrange(
 /// The assembly to plan for the process's `slicing` on a machine of `kind`, how it is sliced,
 /// and a warning for each feature `auto` put into planar layers. `features` keeps `assembly`;
 /// `planar` makes [`planar_assembly`] of `brep` (unless `assembly` already is one); `auto`
-/// does so on a machine that prints only along +Z when [`tilted_features`] finds any.
+/// does so when the part's solids overlap (feature by feature their shared material would be
+/// laid twice), and on a machine that prints only along +Z when [`tilted_features`] finds
+/// any.
 pub fn choose_slicing(
     assembly: Assembly,
     brep: &Brep,
@@ -142,6 +144,11 @@ pub fn choose_slicing(
     let whole = features::is_whole_part(&assembly);
     match process.base().slicing {
         Slicing::Planar if !whole => Ok((planar_assembly(brep)?, Slicing::Planar, vec![])),
+        Slicing::Auto if !whole && assembly.overlapping => Ok((
+            planar_assembly(brep)?,
+            Slicing::Planar,
+            vec![Warning::part(WarningKind::OverlappingSolids)],
+        )),
         Slicing::Auto if !whole && kind.plus_z_only() => {
             let tilted = tilted_features(&assembly, process);
             if tilted.is_empty() {

@@ -69,6 +69,10 @@ pub enum WarningKind {
     Collisions(String),
     /// Layers nothing holds up and `keep_going` wrote the plan anyway: the feature's line.
     Unsupported(String),
+    /// The part's solids overlap (bodies pushed into each other): `slicing = "auto"` planned
+    /// it whole in planar layers, each layer the union of the solids' sections; feature by
+    /// feature, each solid is planned whole and the material they share is laid twice.
+    OverlappingSolids,
     /// A recognised feature grows along another direction than +Z on a machine that prints
     /// only along +Z: `slicing = "auto"` planned the part whole in planar layers.
     PlanarInstead {
@@ -139,6 +143,11 @@ impl std::fmt::Display for Warning {
                 "feature {id}: {axes} tool axes tilted by up to {worst_deg:.3} degrees towards +Z to stay within the machine's B limit of {limit_deg} degrees"
             ),
             WarningKind::SelfCheck(p) => write!(f, "{p}"),
+            WarningKind::OverlappingSolids => f.write_str(
+                "the part's solids overlap: planned whole in planar layers along +Z, each layer \
+                 the union of their sections (feature by feature, the material they share would \
+                 be laid twice; unite them in CAD to plan their features)",
+            ),
             WarningKind::PlanarInstead {
                 feature,
                 kind,

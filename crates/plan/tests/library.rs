@@ -15,11 +15,16 @@ fn fixture(name: &str) -> brep::StepPart {
 }
 
 fn planned(name: &str, machine: MachineKind) -> plan::Plan {
+    planned_with(name, machine, &Process::default())
+}
+
+/// [`planned`] with `process`.
+fn planned_with(name: &str, machine: MachineKind, process: &Process) -> plan::Plan {
     let options = Options {
         source: name.into(),
         stem: "part".into(),
-        // stacked_solids's cylinder is sunk into the base: its head meets the base (planned
-        // whole, as warned); the collision tests check those moves.
+        // stacked_solids's cylinder is sunk into the base: planned feature by feature its head
+        // meets the base (as warned); the collision tests check those moves.
         allow_collisions: true,
         // stacked_solids's floating box and the impeller's blade edges on the hub's flank
         // are refused by the support check (tests/plan_cli.rs checks that): kept going past
@@ -29,7 +34,7 @@ fn planned(name: &str, machine: MachineKind) -> plan::Plan {
     };
     plan(
         &fixture(name),
-        &Process::default(),
+        process,
         &MachineProfile::builtin(machine),
         &options,
     )
@@ -38,8 +43,11 @@ fn planned(name: &str, machine: MachineKind) -> plan::Plan {
 
 #[test]
 fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
+    // Feature by feature: `slicing = "auto"` plans stacked_solids's overlapping solids whole,
+    // one feature, and this test is about several features' ids and counts.
+    let process = Process::from_toml("[defaults]\nslicing = \"features\"\n").expect("process");
     for name in ["two_solids.step", "stacked_solids.step"] {
-        let p = planned(name, MachineKind::Marlin);
+        let p = planned_with(name, MachineKind::Marlin, &process);
         let ids: Vec<usize> = p.features().iter().map(|f| f.feature.id).collect();
         assert!(ids.len() >= 2, "{name}: {ids:?}");
         let mut sorted = ids.clone();

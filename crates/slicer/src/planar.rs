@@ -312,13 +312,60 @@ pub(crate) fn mesh_and_top(
 }
 
 /// The regions of `mesh`'s section by the plane `cut`, in the 2-D frame of `frame` (a plane
-/// parallel to it).
+/// parallel to it). Loops that may cross (the sections of solids pushed into each other,
+/// sliced whole: [`loops_may_cross`]) are united by their winding
+/// ([`crate::fill::regions_by_winding`]), so the material they share is laid once; the others
+/// nest even-odd.
 pub(crate) fn section_regions(mesh: &brep::mesh::Mesh, cut: &Plane, frame: &Plane) -> Vec<Region> {
     let loops: Vec<Vec<[f64; 2]>> = section(mesh, cut)
         .iter()
         .map(|l| l.iter().map(|p| frame.to_2d(p)).collect())
         .collect();
-    regions_from_loops(&loops)
+    match loops_may_cross(&loops) {
+        true => crate::fill::regions_by_winding(&loops),
+        false => regions_from_loops(&loops),
+    }
+}
+
+/// Whether two of `loops` may cross or one lies in the other running the same way round:
+/// their boxes overlap and neither box holds the other (a hole's box lies inside its
+/// outline's, a separate island's apart from it), or one box holds the other and the loops
+/// turn the same way (a hole runs against its outline; a body inside another does not).
+fn loops_may_cross(loops: &[Vec<[f64; 2]>]) -> bool {
+    let turns: Vec<bool> = loops
+        .iter()
+        .map(|l| brep::section::signed_area(l) > 0.0)
+        .collect();
+    let boxes: Vec<[f64; 4]> = loops
+        .iter()
+        .map(|l| {
+            l.iter().fold(
+                [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY],
+                |b, p| {
+                    [
+                        b[0].min(p[0]),
+                        b[1].min(p[1]),
+                        b[2].max(p[0]),
+                        b[3].max(p[1]),
+                    ]
+                },
+            )
+        })
+        .collect();
+    let holds =
+        |a: &[f64; 4], b: &[f64; 4]| a[0] <= b[0] && a[1] <= b[1] && a[2] >= b[2] && a[3] >= b[3];
+    let apart =
+        |a: &[f64; 4], b: &[f64; 4]| a[2] < b[0] || b[2] < a[0] || a[3] < b[1] || b[3] < a[1];
+    boxes.iter().enumerate().any(|(i, a)| {
+        boxes[i + 1..].iter().enumerate().any(|(k, b)| {
+            let j = i + 1 + k;
+            match (apart(a, b), holds(a, b) || holds(b, a)) {
+                (true, _) => false,
+                (false, false) => true,
+                (false, true) => turns[i] == turns[j],
+            }
+        })
+    })
 }
 
 /// A prism's layers filled like a two5d feature's (feature `id`): `layers` layers `height` mm

@@ -115,3 +115,8 @@ pub(crate) const BARYCENTRIC_SLACK: f64 = 1e-9;
 /// A floor, mm³, for a feature's expected volume before its extrusion error is taken relative
 /// to it.
 pub(crate) const VOLUME_FLOOR: f64 = 1e-12;
+
+/// Share of a section's area (and as many mm²) by which the winding reading of crossing loops
+/// must exceed the even-odd one to be taken ([`crate::fill::regions_by_winding`]): above
+/// i_overlay's snapping, far below any overlap of two bodies worth a bead.
+pub(crate) const UNION_GAIN: f64 = 1e-6;

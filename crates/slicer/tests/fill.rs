@@ -1,7 +1,8 @@
 //! Layer filling: coverage, containment, closure, holes, degenerate input, ordering.
 
 use slicer::fill::{
-    fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region, END_MARGIN,
+    fill_layer, order_paths, regions_by_winding, regions_from_loops, Path2, PathKind, Point2,
+    Region, END_MARGIN,
 };
 use slicer::freeform::FillPath;
 use slicer::params::{LayerParams, PathMode};
@@ -1283,4 +1284,50 @@ fn contour_rings_are_simplified_within_the_tolerance() {
             "ring {k}: {n} points, {need:.0} needed"
         );
     }
+}
+
+fn total_area(rs: &[Region]) -> f64 {
+    rs.iter().map(region_area).sum()
+}
+
+fn reversed(mut p: Vec<Point2>) -> Vec<Point2> {
+    p.reverse();
+    p
+}
+
+#[test]
+fn crossing_sections_of_overlapping_solids_are_united_by_their_winding() {
+    // Two 10 x 10 squares overlapping by 5 x 5, both counter-clockwise (two solids' sections):
+    // their union, 175 mm², whichever way round the loops are given.
+    let a = rect(0.0, 0.0, 10.0, 10.0);
+    let b = rect(5.0, 5.0, 15.0, 15.0);
+    for loops in [
+        vec![a.clone(), b.clone()],
+        vec![reversed(a.clone()), reversed(b.clone())],
+    ] {
+        let rs = regions_by_winding(&loops);
+        assert!(
+            (total_area(&rs) - 175.0).abs() < 1e-6,
+            "{}",
+            total_area(&rs)
+        );
+        for p in [[2.0, 2.0], [7.5, 7.5], [12.0, 12.0]] {
+            assert!(rs.iter().any(|r| in_region(p, r, 0.0)), "{p:?} not covered");
+        }
+    }
+    // A body inside another, both counter-clockwise (a cylinder pushed into a box): the box.
+    let inner = circle([5.0, 5.0], 2.0, 64, true);
+    let rs = regions_by_winding(&[a.clone(), inner.clone()]);
+    assert!(
+        (total_area(&rs) - 100.0).abs() < 1e-6,
+        "{}",
+        total_area(&rs)
+    );
+    // A hole runs the other way round: the even-odd regions, outline less the hole.
+    let hole = circle([5.0, 5.0], 2.0, 64, false);
+    let expect = regions_from_loops(&[a.clone(), hole.clone()]);
+    assert_eq!(regions_by_winding(&[a, hole]), expect);
+    assert!(
+        (total_area(&expect) - (100.0 - total_area(&regions_from_loops(&[inner])))).abs() < 1e-9
+    );
 }

@@ -49,7 +49,7 @@ pub(crate) use boolean::{difference, grow, intersection, outside_grown, union};
 pub(crate) use offset::simplified;
 pub use offset::thinner_than;
 pub use order::{order_greedy, order_paths};
-pub use region::regions_from_loops;
+pub use region::{regions_by_winding, regions_from_loops};
 pub use sparse::SparseLayer;
 
 /// One continuous extrusion path (an open polyline; a closed perimeter repeats its first point

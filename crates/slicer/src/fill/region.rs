@@ -2,7 +2,7 @@
 
 use super::{Contour, Shape, Shapes, MAX_COORD};
 use crate::geom2d::{area2, inside, on_boundary, perimeter, Point2, Region};
-use crate::tolerance::{ROUND_OFF, SLIVER_AREA};
+use crate::tolerance::{ROUND_OFF, SLIVER_AREA, UNION_GAIN};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
@@ -119,6 +119,40 @@ pub fn regions_from_loops(loops: &[Vec<Point2>]) -> Vec<Region> {
         }
     }
     regions
+}
+
+/// Regions of closed section loops that may cross: the loops of several solids that overlap
+/// (a part modelled as bodies pushed into each other, sliced whole). A mesh section runs
+/// counter-clockwise around material and clockwise around holes, so material is where the
+/// loops wind round once or more (their union): of the two winding readings (the loops one
+/// way round or the other), the one with more area. It is taken where it covers more than
+/// the even-odd reading, which leaves out what two loops share; elsewhere (loops that do not
+/// cross) the even-odd regions of [`regions_from_loops`] are kept.
+pub fn regions_by_winding(loops: &[Vec<Point2>]) -> Vec<Region> {
+    let contours: Shape = loops.iter().filter_map(|l| clean_loop(l)).collect();
+    if contours.len() < 2 {
+        return regions_from_loops(loops);
+    }
+    let area = |rs: &[Region]| -> f64 {
+        rs.iter()
+            .map(|r| area2(&r.outer).abs() - r.holes.iter().map(|h| area2(h).abs()).sum::<f64>())
+            .sum()
+    };
+    let read = |rule: FillRule| -> Vec<Region> {
+        let shapes: Shapes = contours.simplify_shape(rule);
+        shapes.into_iter().filter_map(shape_region).collect()
+    };
+    let (positive, negative) = (read(FillRule::Positive), read(FillRule::Negative));
+    let (pa, na) = (area(&positive), area(&negative));
+    let (winding, wa) = match pa >= na {
+        true => (positive, pa),
+        false => (negative, na),
+    };
+    let even_odd = area(&read(FillRule::EvenOdd));
+    match wa > even_odd * (1.0 + UNION_GAIN) + UNION_GAIN {
+        true => winding,
+        false => regions_from_loops(loops),
+    }
 }
 
 /// The region as clean i_overlay shapes (outer minus holes, non-zero fill, so orientation and
