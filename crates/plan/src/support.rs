@@ -71,7 +71,11 @@ pub fn planar(
         for f in &t.features {
             let id = offset + f.id;
             let params = process.params_for(&base, id)?;
-            let found = planar_support(t, f, &params, bead_width, &earlier, columns)?;
+            let gap = match (lifted, standing[ti]) {
+                (true, Some(z)) => z - plate,
+                _ => 0.0,
+            };
+            let found = planar_support(t, f, &params, bead_width, &earlier, gap, columns)?;
             if let Some(p) = found {
                 let angle_deg = params.overhang_angle_deg;
                 let kind = f.kind;

@@ -35,6 +35,10 @@ pub struct SupportRegions {
     pub sparse: Vec<Vec<Region>>,
     /// Each layer's interface support, right under a held surface.
     pub interface: Vec<Vec<Region>>,
+    /// The thicknesses (bottom up) of the layers below the feature's reference plane, for
+    /// a solid lifted over the plate ([`crate::support_below`]): the first `below.len()`
+    /// entries of `sparse` and `interface` are theirs, laid before the feature's first layer.
+    pub below: Vec<f64>,
 }
 
 impl SupportRegions {
@@ -90,6 +94,7 @@ pub fn columns(
         regions: SupportRegions {
             sparse: vec![vec![]; n],
             interface: vec![vec![]; n],
+            below: vec![],
         },
         left: vec![0.0; n],
     };
