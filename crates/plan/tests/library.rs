@@ -21,9 +21,9 @@ fn planned(name: &str, machine: MachineKind) -> plan::Plan {
         // stacked_solids's cylinder is sunk into the base: its head meets the base (planned
         // whole, as warned); the collision tests check those moves.
         allow_collisions: true,
-        // stacked_solids's floating box and the impeller's blade edges on the hub's flank
-        // are refused by the support check (tests/plan_cli.rs checks that): kept going past
-        // it, as these tests are about ids, counts and streaming.
+        // The impeller's blade edges on the hub's flank are refused by the support check
+        // (tests/plan_cli.rs checks that): kept going past it, as these tests are about ids,
+        // counts and streaming.
         keep_going: true,
         ..Default::default()
     };
