@@ -5,7 +5,9 @@
 //! they are laid (`FreeformFigures::support`). A feature with unsupported area fails the plan
 //! like the self-check ([`crate::Gate::Unsupported`], one [`line()`] each), unless support
 //! material carries it (issue 33, [`slicer::support_material`]): then only what support
-//! cannot stand under (below a feature's first layer) is refused.
+//! cannot stand under (below the first layer of a feature growing from others) is refused. A
+//! solid lifted over the plate gets columns below its base's first layer down to the plate
+//! ([`slicer::support_below`]), across the gap between its base plane and the lowest solid's.
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
