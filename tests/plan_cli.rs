@@ -158,7 +158,8 @@ fn strict_turns_warnings_into_an_error_and_writes_nothing() {
         "stacked_solids.step",
         // The overlapping solids also collide (the later is printed inside the earlier): let
         // those be warnings, which --strict then refuses with the rest.
-        // The floating box is unsupported (issue 31): --keep-going makes that a warning too.
+        // The floating box stands on support from the plate (issue 31): --keep-going is kept
+        // for any feature still unsupported.
         &[
             "--strict",
             "--set",

@@ -5,7 +5,9 @@
 //! they are laid (`FreeformFigures::support`). A feature with unsupported area fails the plan
 //! like the self-check ([`crate::Gate::Unsupported`], one [`line()`] each), unless support
 //! material carries it (issue 33, [`slicer::support_material`]): then only what support
-//! cannot stand under (below a feature's first layer) is refused.
+//! cannot stand under (below the first layer of a feature growing from others) is refused. A
+//! solid lifted over the plate gets columns below its base's first layer down to the plate
+//! ([`slicer::support_below`]), across the gap between its base plane and the lowest solid's.
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
@@ -71,7 +73,11 @@ pub fn planar(
         for f in &t.features {
             let id = offset + f.id;
             let params = process.params_for(&base, id)?;
-            let found = planar_support(t, f, &params, bead_width, &earlier, columns)?;
+            let gap = match (lifted, standing[ti]) {
+                (true, Some(z)) => z - plate,
+                _ => 0.0,
+            };
+            let found = planar_support(t, f, &params, bead_width, &earlier, gap, columns)?;
             if let Some(p) = found {
                 let angle_deg = params.overhang_angle_deg;
                 let kind = f.kind;

@@ -26,9 +26,9 @@ fn planned_with(name: &str, machine: MachineKind, process: &Process) -> plan::Pl
         // stacked_solids's cylinder is sunk into the base: planned feature by feature its head
         // meets the base (as warned); the collision tests check those moves.
         allow_collisions: true,
-        // stacked_solids's floating box and the impeller's blade edges on the hub's flank
-        // are refused by the support check (tests/plan_cli.rs checks that): kept going past
-        // it, as these tests are about ids, counts and streaming.
+        // The impeller's blade edges on the hub's flank are refused by the support check
+        // (tests/plan_cli.rs checks that): kept going past it, as these tests are about ids,
+        // counts and streaming.
         keep_going: true,
         ..Default::default()
     };

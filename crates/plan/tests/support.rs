@@ -157,3 +157,110 @@ fn with_support_off_the_bridge_is_refused_as_before() {
         Ok(_) => panic!("planned without support"),
     }
 }
+
+/// `stacked_solids.step` (issue 31 item 1): a box A 0..30 × 0..30 × 0..10, a cylinder B of
+/// radius 5 round (15, 15) from z 5 to 25 sunk into it, a box C 0..10 × 0..10 × 10..15 on A, and
+/// a box D 40..50 × 0..10 × 20..25 over nothing. D's columns go on below its first layer down
+/// to the plate, clear of the other solids; its first layer is held. (The solids overlap, so
+/// the head collides where B is printed inside A: collisions are allowed here.)
+#[test]
+fn a_box_over_nothing_gets_support_from_the_plate_to_its_first_layer() {
+    let opts = Options {
+        allow_collisions: true,
+        ..options("stacked_solids.step")
+    };
+    let p = plan(
+        &fixture("stacked_solids.step"),
+        &Process::default(),
+        &MachineProfile::builtin(MachineKind::Marlin),
+        &opts,
+    )
+    .expect("plans with support under the lifted box");
+    let d = p.features().iter().find(|f| f.feature.id == 3).expect("D");
+    assert_eq!(d.unsupported_area_mm2, 0.0);
+    // The self-check counts D's part alone.
+    let rel = (d.extruded_volume_mm3 - d.feature.volume_mm3) / d.feature.volume_mm3;
+    assert!(rel.abs() <= 0.03, "{rel}");
+    let prints: Vec<&PathPoint> = p
+        .toolpath
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .collect();
+    let part: Vec<&PathPoint> = prints
+        .iter()
+        .copied()
+        .filter(|q| q.role.is_part())
+        .collect();
+    let support: Vec<&PathPoint> = prints
+        .iter()
+        .copied()
+        .filter(|q| q.role.is_support())
+        .collect();
+    assert!(
+        support.iter().all(|q| q.feature == 3),
+        "support under D only"
+    );
+    // The frame: A's corner at the lowest part bead (less half a bead), the plate under the
+    // lowest bead's bottom.
+    let width = MachineProfile::builtin(MachineKind::Marlin).bead().width;
+    let pts: Vec<[f64; 3]> = part.iter().map(|q| q.p).collect();
+    let lo = low(&pts);
+    let (x0, y0) = (lo[0] - 0.5 * width, lo[1] - 0.5 * width);
+    let plate = part
+        .iter()
+        .map(|q| q.p[2] - q.thickness)
+        .fold(f64::INFINITY, f64::min);
+    // D's first layer's bottom: 20 mm over the plate.
+    let d_bottom = part
+        .iter()
+        .filter(|q| q.feature == 3)
+        .map(|q| q.p[2] - q.thickness)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (d_bottom - plate - 20.0).abs() < SLACK,
+        "{}",
+        d_bottom - plate
+    );
+    // From the plate to the contact gap under D's first layer, in every layer between.
+    let bottom = support
+        .iter()
+        .map(|q| q.p[2] - q.thickness)
+        .fold(f64::INFINITY, f64::min);
+    let top = support
+        .iter()
+        .map(|q| q.p[2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let contact = slicer::params::LayerParams::default().support_contact_distance;
+    assert!((bottom - plate).abs() < SLACK, "{}", bottom - plate);
+    assert!(
+        (top - (d_bottom - contact)).abs() < SLACK,
+        "{top} vs {d_bottom}"
+    );
+    let mut layers: Vec<i64> = support
+        .iter()
+        .map(|q| ((q.p[2] - plate) / q.thickness).round() as i64)
+        .collect();
+    layers.sort();
+    layers.dedup();
+    assert_eq!(
+        layers.len() as i64,
+        layers[layers.len() - 1] - layers[0] + 1
+    );
+    // Under D, and clear of A, B and C by the XY gap wherever it is at their heights.
+    for q in &support {
+        let (x, y, z) = (q.p[0] - x0, q.p[1] - y0, q.p[2] - plate);
+        assert!((40.0 - SLACK..=50.0 + SLACK).contains(&x), "{q:?}");
+        assert!((-SLACK..=10.0 + SLACK).contains(&y), "{q:?}");
+        let clear = XY_GAP - SLACK;
+        let outside_box = |x0: f64, y0: f64, x1: f64, y1: f64| {
+            x < x0 - clear || x > x1 + clear || y < y0 - clear || y > y1 + clear
+        };
+        assert!(z > 10.0 || outside_box(0.0, 0.0, 30.0, 30.0), "in A: {q:?}");
+        assert!(!(10.0..=15.0).contains(&z) || outside_box(0.0, 0.0, 10.0, 10.0));
+        let r = ((x - 15.0).powi(2) + (y - 15.0).powi(2)).sqrt();
+        assert!(!(5.0..=25.0).contains(&z) || r > 5.0 + clear, "in B: {q:?}");
+    }
+    // Sparse: more than nothing, less than the column under D (10 × 10 × 20).
+    assert!(d.support_volume_mm3 > 0.0 && d.support_volume_mm3 < 0.5 * 10.0 * 10.0 * 20.0);
+}

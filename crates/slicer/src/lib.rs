@@ -21,6 +21,7 @@
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
 //! - [`support_material`]: columns of support under what the overhang limit leaves unheld;
+//!   [`support_below`]: their layers below a lifted solid's first layer, down to the plate;
 //! - [`skirt`]: skirt and brim loops around the first layer's footprint;
 //! - [`planar`]: planar layers of `two5d` features, sections, fills and extrusion (Eq. 1);
 //! - [`toolpath`]: the planned path (`toolpath.csv`) the posts consume (the `toolpath` crate,
@@ -54,6 +55,7 @@ mod skins;
 pub mod skirt;
 mod sst;
 pub mod support;
+pub mod support_below;
 pub mod support_material;
 mod tolerance;
 mod top_field;

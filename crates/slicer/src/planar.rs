@@ -626,11 +626,32 @@ fn without_straight_vertices(ring: &[Point2]) -> Vec<Point2> {
 impl Two5dFill {
     /// These layers with support material in `columns` (the feature's
     /// [`crate::support::planar_support`], one entry a layer): sparse and interface lines
-    /// ([`crate::support_material`]) added to each layer, laid before the part's paths.
+    /// ([`crate::support_material`]) added to each layer, laid before the part's paths. The
+    /// layers below the reference plane ([`SupportRegions::below`], a lifted solid's) go
+    /// before the first, support alone.
     pub fn with_support(mut self, columns: &SupportRegions, params: &LayerParams) -> Two5dFill {
-        let paths = crate::support_material::fill_columns(columns, params, self.bead.width);
+        let mut paths =
+            crate::support_material::fill_columns(columns, params, self.bead.width).into_iter();
+        let under: Vec<Vec<FillPath>> = paths.by_ref().take(columns.below.len()).collect();
         for (layer, support) in self.filled.iter_mut().zip(paths) {
             layer.extend(support);
+        }
+        let u = under.len();
+        if u > 0 {
+            let mut z = -columns.below[..u].iter().sum::<f64>();
+            let mut tops = Vec::with_capacity(u + self.tops.len());
+            for &dl in &columns.below[..u] {
+                tops.push((z + 0.5 * dl, z + dl, dl));
+                z += dl;
+            }
+            tops.append(&mut self.tops);
+            self.tops = tops;
+            let mut filled = under;
+            filled.append(&mut self.filled);
+            self.filled = filled;
+            let mut sparse = vec![(0.0, 0.0); u];
+            sparse.append(&mut self.sparse);
+            self.sparse = sparse;
         }
         self
     }

@@ -116,7 +116,7 @@ pub fn feature_support(
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
 ) -> Result<Option<FeatureSupport>, FeatureError> {
-    Ok(planar_support(tree, f, params, bead_width, earlier, false)?.map(|p| p.left))
+    Ok(planar_support(tree, f, params, bead_width, earlier, 0.0, false)?.map(|p| p.left))
 }
 
 /// What holds up a two5d feature's planar layers, with support material ([`planar_support`]).
@@ -132,16 +132,20 @@ pub struct PlanarSupport {
 
 /// [`feature_support`], and with `columns` (and `support_material` not `off`) the support
 /// material under the unsupported pieces ([`crate::support_material::columns`]): what it
-/// carries is no longer unsupported. Columns stand on the plate only for a base feature on it
-/// (no parent, `earlier` empty); elsewhere on the feature's own lower layers, or at its first
-/// layer on what that layer rests on (its parents' or the earlier solids' sections), never
-/// lower.
+/// carries is no longer unsupported. Columns stand on the plate for a base feature on it (no
+/// parent, `earlier` empty), and for the base of a solid lifted `gap` mm over the plate on
+/// `earlier` (the solids built before): its columns go on below its first layer down to the
+/// plate, landing on the earlier solids where they lie under them ([`crate::support_below`];
+/// the regions' [`SupportRegions::below`] layers). Elsewhere they stand on the feature's own
+/// lower layers, or at its first layer on what that layer rests on (its parents' sections),
+/// never lower.
 pub fn planar_support(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
+    gap: f64,
     columns: bool,
 ) -> Result<Option<PlanarSupport>, FeatureError> {
     if f.kind != FeatureKind::Two5d {
@@ -217,14 +221,42 @@ pub fn planar_support(
             columns: SupportRegions::default(),
         }));
     }
-    let c = crate::support_material::columns(
-        &sections,
-        &heights,
-        &pieces,
-        foundation.as_deref(),
-        params,
-        sliver,
-    );
+    // A lifted solid's base: its layers carried on below its first one, down to the plate.
+    let lifted = f.parents.is_empty() && !earlier.is_empty();
+    let under = match lifted {
+        true => crate::support_below::below(&plane, gap, earlier, params, tol)?,
+        false => crate::support_below::Below::default(),
+    };
+    let u = under.heights.len();
+    let c = match u {
+        0 => crate::support_material::columns(
+            &sections,
+            &heights,
+            &pieces,
+            foundation.as_deref(),
+            params,
+            sliver,
+        ),
+        _ => {
+            let mut all_sections = under.sections;
+            all_sections.extend(sections);
+            let mut all_heights = under.heights.clone();
+            all_heights.extend(&heights);
+            let mut all_pieces = vec![vec![]; u];
+            all_pieces.extend(pieces);
+            let mut c = crate::support_material::columns(
+                &all_sections,
+                &all_heights,
+                &all_pieces,
+                None,
+                params,
+                sliver,
+            );
+            c.left.drain(..u);
+            c.regions.below = under.heights;
+            c
+        }
+    };
     let mut left = FeatureSupport {
         feature: f.id,
         ..FeatureSupport::default()

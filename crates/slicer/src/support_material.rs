@@ -11,9 +11,10 @@
 //!   grown by `support_xy_distance`; the top `support_interface_layers` printed layers of each
 //!   column are interface (denser lines), the rest sparse lines at `support_density`.
 //! - **What it stands on**: support stands only on the plate or on the feature's own lower
-//!   layers. A base feature on the plate carries every piece. A feature growing from others, or
-//!   the base of a solid lifted on other solids, carries only the part of a piece over its own
-//!   lower layers (its sections up to the piece's layer): what would need a column reaching
+//!   layers. A base feature on the plate carries every piece, and so does the base of a solid
+//!   lifted over the plate: its columns go on below its first layer ([`crate::support_below`]).
+//!   A feature growing from others carries only the part of a piece over its own lower layers
+//!   or its parents (its sections up to the piece's layer): what would need a column reaching
 //!   below its first layer is not supported, and stays unsupported (the gate refuses it).
 //!
 //! Only the feature's own sections are known here: a column is not kept out of another
@@ -35,6 +36,10 @@ pub struct SupportRegions {
     pub sparse: Vec<Vec<Region>>,
     /// Each layer's interface support, right under a held surface.
     pub interface: Vec<Vec<Region>>,
+    /// The thicknesses (bottom up) of the layers below the feature's reference plane, for
+    /// a solid lifted over the plate ([`crate::support_below`]): the first `below.len()`
+    /// entries of `sparse` and `interface` are theirs, laid before the feature's first layer.
+    pub below: Vec<f64>,
 }
 
 impl SupportRegions {
@@ -90,6 +95,7 @@ pub fn columns(
         regions: SupportRegions {
             sparse: vec![vec![]; n],
             interface: vec![vec![]; n],
+            below: vec![],
         },
         left: vec![0.0; n],
     };
