@@ -32,14 +32,43 @@ pub(crate) fn feature_mesh(
             }
         })
     };
-    let mesh = mesh_at(tol)?;
+    let mut mesh = mesh_at(tol)?;
     // A small feature's sections lose to their chords what its volume keeps (issue 31, item
     // 4): meshed again finer for its thickness.
     let fine = THICKNESS_CHORD_SHARE * thickness(f.volume, &mesh);
     if fine.is_finite() && fine < tol {
-        return mesh_at(fine.max(MICROMETRE));
+        mesh = mesh_at(fine.max(MICROMETRE))?;
     }
+    orient_voids(&mut mesh, &f.voids);
     Ok(mesh)
+}
+
+/// Each void shell of `voids` turned to face into the void where a file wrote it facing out
+/// (enclosing a positive volume, like a solid's outer shell): its sections then run clockwise
+/// around the void, as a hole's do, which the winding reading of crossing loops
+/// (`fill::regions_by_winding`) relies on.
+fn orient_voids(mesh: &mut brep::mesh::Mesh, voids: &[Vec<brep::topology::FaceId>]) {
+    for v in voids {
+        let of_void = |t: &brep::mesh::FaceTriangulation| v.contains(&t.face);
+        let volume: f64 = mesh
+            .faces
+            .iter()
+            .filter(|t| of_void(t))
+            .flat_map(|t| {
+                t.triangles.iter().map(|tri| {
+                    let [a, b, c] = tri.map(|i| mesh.positions[t.vertex[i as usize] as usize]);
+                    a.coords.dot(&b.coords.cross(&c.coords)) / 6.0
+                })
+            })
+            .sum();
+        if volume > 0.0 {
+            for t in mesh.faces.iter_mut().filter(|t| v.contains(&t.face)) {
+                for tri in &mut t.triangles {
+                    tri.swap(1, 2);
+                }
+            }
+        }
+    }
 }
 
 /// The chord tolerance of a feature's mesh as a share of its thickness ([`thickness`]): a
