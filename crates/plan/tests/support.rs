@@ -169,9 +169,12 @@ fn a_box_over_nothing_gets_support_from_the_plate_to_its_first_layer() {
         allow_collisions: true,
         ..options("stacked_solids.step")
     };
+    // Feature by feature, each solid a tree of its own (`slicing = "auto"` plans these
+    // overlapping solids whole, the box held up by support in the one feature's layers).
+    let process = Process::from_toml("[defaults]\nslicing = \"features\"\n").expect("process");
     let p = plan(
         &fixture("stacked_solids.step"),
-        &Process::default(),
+        &process,
         &MachineProfile::builtin(MachineKind::Marlin),
         &opts,
     )
