@@ -1287,18 +1287,6 @@ fn fixture_names() -> Vec<String> {
     names
 }
 
-/// Fixture and machine pairs of the matrix below that do not plan yet, with why (measured
-/// with the release build, default settings).
-const NOT_YET: [(&str, &str, &str); 1] = [
-    // Plans (exit 0), but only as the third placement tried, sliced whole in planar layers:
-    // as modelled 24,478 print points are out of the arm's reach or joint limits (78 % of
-    // blades 1, 3 and 5, whose tool axes lie horizontal along the arm's X) and no move on the
-    // table reaches them, nor on face #1924 (27,461 out of reach). 71 s wall (release, 6b585cc,
-    // loaded), with the capsule on kuka (62 s) the matrix's costliest: left out for the test
-    // suite's time.
-    ("fan", "kuka", "plans, planar, after 70 s"),
-];
-
 /// Issue 31, done when: every fixture plans with exit 0, no colliding move, no unsupported
 /// bead, in reach and with a passing self-check, with default settings, on each machine it is
 /// meant for: the freeform ones on `delta5` and `kuka`, the planar ones on all three. Each
@@ -1312,9 +1300,7 @@ fn every_fixture_plans_clean_on_each_machine_it_is_meant_for() {
             false => &["marlin", "delta5", "kuka"],
         };
         for m in machines {
-            if !NOT_YET.iter().any(|(n, k, _)| *n == name && k == m) {
-                runs.push((name.clone(), vec!["--machine".into(), m.to_string()]));
-            }
+            runs.push((name.clone(), vec!["--machine".into(), m.to_string()]));
         }
     }
     assert!(runs.len() > 50, "{runs:?}");
