@@ -8,7 +8,7 @@ mod cli;
 mod planned;
 
 use cli::{fixture, plan, stderr, Scratch, BIN};
-use planned::{planned, planned_all};
+use planned::{each_planned, planned};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -1218,14 +1218,10 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
         .to_vec()
     };
     let runs: Vec<(String, Vec<String>)> = names.iter().map(|n| (n.clone(), args(n))).collect();
-    planned_all(&runs);
     let mut failures = vec![];
-    for (name, args) in &runs {
-        let machine = &args[1];
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let o = planned(name, &args);
+    for (name, machine, o) in each_planned(&runs) {
         let err = &o.stderr;
-        if ROUND.contains(&name.as_str()) {
+        if ROUND.contains(&name) {
             if o.code != Some(2) || !err.contains("no planar face") {
                 failures.push(format!(
                     "{name}: not refused for want of a planar face: {err}"
@@ -1233,7 +1229,7 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
             }
             continue;
         }
-        if let Some((_, feature)) = OVERHANGING.iter().find(|(n, _)| n == name) {
+        if let Some((_, feature)) = OVERHANGING.iter().find(|(n, _)| *n == name) {
             let named = err
                 .lines()
                 .any(|l| l.contains(feature) && l.contains("mm^2 unsupported"));
@@ -1243,7 +1239,7 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
             }
             continue;
         }
-        if let Some((_, cause)) = REFUSED_OTHERWISE.iter().find(|(n, _)| n == name) {
+        if let Some((_, cause)) = REFUSED_OTHERWISE.iter().find(|(n, _)| *n == name) {
             if o.code != Some(2) || !err.contains(cause) {
                 failures.push(format!("{name}: not refused for `{cause}` any more: {err}"));
             }
@@ -1266,7 +1262,7 @@ fn orient_auto_leaves_no_unsupported_bead_on_any_fixture() {
             support += f["support_volume_mm3"].as_f64().unwrap_or(-1.0);
         }
         // Support material only where no placement avoids an overhang.
-        if (support > 0.0) != SUPPORTED.contains(&name.as_str()) {
+        if (support > 0.0) != SUPPORTED.contains(&name) {
             failures.push(format!("{name}: {support} mm^3 of support material"));
         }
     }
@@ -1304,12 +1300,8 @@ fn every_fixture_plans_clean_on_each_machine_it_is_meant_for() {
         }
     }
     assert!(runs.len() > 50, "{runs:?}");
-    planned_all(&runs);
     let mut failures = vec![];
-    for (name, args) in &runs {
-        let machine = &args[1];
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let o = planned(name, &args);
+    for (name, machine, o) in each_planned(&runs) {
         let last = o.stderr.lines().last().unwrap_or("");
         let report = o.report();
         let (Some(0), Some(report)) = (o.code, report) else {

@@ -96,6 +96,18 @@ fn run(name: &str, args: &[&str]) -> Planned {
     }
 }
 
+/// Each of `runs` (a fixture's name, then `--machine M` and any other arguments) planned
+/// ([`planned_all`]), as its name, its machine and its plan.
+pub fn each_planned(runs: &[(String, Vec<String>)]) -> Vec<(&str, &str, Arc<Planned>)> {
+    planned_all(runs);
+    runs.iter()
+        .map(|(name, args)| {
+            let a: Vec<&str> = args.iter().map(String::as_str).collect();
+            (name.as_str(), args[1].as_str(), planned(name, &a))
+        })
+        .collect()
+}
+
 /// [`planned`] of every (name, args) of `runs`, as many at a time as the machine has cores
 /// (the longest first, by the STEP file's size, so that the last to finish are short).
 pub fn planned_all(runs: &[(String, Vec<String>)]) {

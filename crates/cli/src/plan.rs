@@ -426,8 +426,10 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
     let kind = plan.report.settings.machine["kind"]
         .as_str()
         .unwrap_or("the machine");
-    let overlapping = plan::Warning::part(plan::WarningKind::OverlappingSolids).to_string();
-    let overlap = plan.warnings().iter().any(|w| w.contains(&overlapping));
+    let overlap = plan
+        .part_warnings
+        .iter()
+        .any(|w| w.kind == plan::WarningKind::OverlappingSolids);
     let planar = match (chosen && plan.report.slicing == "planar", plus_z_only(kind)) {
         (false, _) => String::new(),
         (true, _) if overlap => {

@@ -124,6 +124,7 @@ impl Stages {
             program: vec![],
             assembly: extracted.assembly,
             collisions: checked.avoided,
+            part_warnings: all,
         }
     }
 }

@@ -154,6 +154,9 @@ pub struct Plan {
     pub assembly: features::Assembly,
     /// The print head's colliding moves left after avoidance (`collisions.csv`).
     pub collisions: collisions::Avoided,
+    /// The part's warnings as typed values, in the report's order (its `warnings` are their
+    /// texts): what a caller branches on.
+    pub part_warnings: Vec<Warning>,
 }
 
 impl Plan {

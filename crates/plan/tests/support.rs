@@ -54,6 +54,13 @@ fn split(p: &plan::Plan) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
 
 /// The lowest corner of the part's beads (the part's frame on the plate: its points' x, y and
 /// z less these are the model's, less a layer's top for z).
+/// The lowest bead bottom (its point less its thickness) of `points`.
+fn lowest_bottom<'a>(points: impl Iterator<Item = &'a PathPoint>) -> f64 {
+    points
+        .map(|q| q.p[2] - q.thickness)
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn low(points: &[[f64; 3]]) -> [f64; 3] {
     let mut lo = [f64::INFINITY; 3];
     for p in points {
@@ -210,26 +217,16 @@ fn a_box_over_nothing_gets_support_from_the_plate_to_its_first_layer() {
     let pts: Vec<[f64; 3]> = part.iter().map(|q| q.p).collect();
     let lo = low(&pts);
     let (x0, y0) = (lo[0] - 0.5 * width, lo[1] - 0.5 * width);
-    let plate = part
-        .iter()
-        .map(|q| q.p[2] - q.thickness)
-        .fold(f64::INFINITY, f64::min);
+    let plate = lowest_bottom(part.iter().copied());
     // D's first layer's bottom: 20 mm over the plate.
-    let d_bottom = part
-        .iter()
-        .filter(|q| q.feature == 3)
-        .map(|q| q.p[2] - q.thickness)
-        .fold(f64::INFINITY, f64::min);
+    let d_bottom = lowest_bottom(part.iter().copied().filter(|q| q.feature == 3));
     assert!(
         (d_bottom - plate - 20.0).abs() < SLACK,
         "{}",
         d_bottom - plate
     );
     // From the plate to the contact gap under D's first layer, in every layer between.
-    let bottom = support
-        .iter()
-        .map(|q| q.p[2] - q.thickness)
-        .fold(f64::INFINITY, f64::min);
+    let bottom = lowest_bottom(support.iter().copied());
     let top = support
         .iter()
         .map(|q| q.p[2])

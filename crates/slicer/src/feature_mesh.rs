@@ -62,7 +62,7 @@ fn orient_voids(mesh: &mut brep::mesh::Mesh, voids: &[Vec<brep::topology::FaceId
             })
             .sum();
         if volume > 0.0 {
-            for t in mesh.faces.iter_mut().filter(|t| v.contains(&t.face)) {
+            for t in mesh.faces.iter_mut().filter(|t| of_void(t)) {
                 for tri in &mut t.triangles {
                     tri.swap(1, 2);
                 }

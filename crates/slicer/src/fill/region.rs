@@ -1,7 +1,7 @@
 //! Regions of a layer from the loops of its section, and as i_overlay shapes.
 
 use super::{Contour, Shape, Shapes, MAX_COORD};
-use crate::geom2d::{area2, inside, on_boundary, perimeter, Point2, Region};
+use crate::geom2d::{area2, inside, on_boundary, perimeter, region_area, Point2, Region};
 use crate::tolerance::{ROUND_OFF, SLIVER_AREA, UNION_GAIN};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -133,11 +133,7 @@ pub fn regions_by_winding(loops: &[Vec<Point2>]) -> Vec<Region> {
     if contours.len() < 2 {
         return regions_from_loops(loops);
     }
-    let area = |rs: &[Region]| -> f64 {
-        rs.iter()
-            .map(|r| area2(&r.outer).abs() - r.holes.iter().map(|h| area2(h).abs()).sum::<f64>())
-            .sum()
-    };
+    let area = |rs: &[Region]| -> f64 { rs.iter().map(region_area).sum() };
     let read = |rule: FillRule| -> Vec<Region> {
         let shapes: Shapes = contours.simplify_shape(rule);
         shapes.into_iter().filter_map(shape_region).collect()
