@@ -10,10 +10,10 @@ use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::fill::{
     fill_layer_with, order_greedy, regions_from_loops, thinner_than, Region, SparseLayer,
 };
-use crate::geom2d::Point2;
+use crate::geom2d::{dist, region_area, Point2};
 use crate::params::{InfillPattern, LayerParams, PathMode};
 use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
-use crate::toolpath::{MoveKind, PathPoint};
+use crate::toolpath::{MoveKind, PathPoint, Role};
 use brep::math::{P3, V3};
 use brep::mesh::{mesh_faces, MeshOptions};
 use brep::section::{section, Plane};
@@ -129,12 +129,31 @@ pub fn fill_regions_with(
     let (thin, thick): (Vec<Region>, Vec<Region>) = regions
         .into_iter()
         .partition(|r| rings && thinner_than(r, thin_depth(params, width, spacing)));
-    let filled = fill_layer_with(&thick, params, layer, width, spacing, sparse);
-    let mut paths: Vec<FillPath> = filled
-        .paths
-        .into_iter()
-        .map(|p| FillPath::uniform(p.points, width, p.role))
-        .collect();
+    let mut paths: Vec<FillPath> = vec![];
+    let mut filled = crate::fill::FilledLayer::default();
+    for r in &thick {
+        let one = fill_layer_with(
+            std::slice::from_ref(r),
+            params,
+            layer,
+            width,
+            spacing,
+            sparse,
+        );
+        let mut laid: Vec<FillPath> = one
+            .paths
+            .into_iter()
+            .map(|p| FillPath::uniform(p.points, width, p.role))
+            .collect();
+        if one.sparse_area <= 0.0 {
+            let gaps: f64 = one.gaps.iter().map(region_area).sum();
+            conserve_solid_infill(&mut laid, region_area(r) - gaps);
+        }
+        paths.extend(laid);
+        filled.gaps.extend(one.gaps);
+        filled.sparse_area += one.sparse_area;
+        filled.sparse_density = one.sparse_density;
+    }
     for r in &thin {
         paths.extend(fill_flat_region(
             r,
@@ -158,6 +177,45 @@ pub fn fill_regions_with(
     let laid = filled.sparse_area * filled.sparse_density;
     (paths, (filled.sparse_area, laid))
 }
+
+/// Widens the solid infill lines of one region's fill (`laid`: its rings and lines, beads of
+/// one width) so that the beads cover `area` (mm², the region less its gaps, which are filled
+/// to their own area), where they fall short by more than [`INFILL_SHORT`] of it: by at most
+/// [`MAX_INFILL_WIDENING`]. A small region's core, a disc a few beads across inside the rings
+/// of a pin, is crossed by two or three lines whose square ends leave the round core's rim
+/// bare: a 3 mm pin was filled 2.6 % short, its core 15 %. The lines put down the core's
+/// volume by Eq. 1 for the wider bead.
+fn conserve_solid_infill(laid: &mut [FillPath], area: f64) {
+    let strip = |p: &FillPath| -> f64 {
+        (1..p.points.len())
+            .map(|i| 0.5 * (p.widths[i - 1] + p.widths[i]) * dist(p.points[i - 1], p.points[i]))
+            .sum()
+    };
+    let total: f64 = laid.iter().map(strip).sum();
+    let infill: f64 = laid
+        .iter()
+        .filter(|p| p.role == Role::SolidInfill)
+        .map(strip)
+        .sum();
+    let short = area - total;
+    if infill <= 0.0 || short.is_nan() || short <= INFILL_SHORT * area {
+        return;
+    }
+    let k = (1.0 + short / infill).min(MAX_INFILL_WIDENING);
+    for p in laid.iter_mut().filter(|p| p.role == Role::SolidInfill) {
+        for w in &mut p.widths {
+            *w *= k;
+        }
+    }
+}
+
+/// The share of a region's area its beads may fall short of before its solid infill is
+/// widened ([`conserve_solid_infill`]): a large region's fill is within a few tenths of a
+/// per cent, and is left as it is.
+const INFILL_SHORT: f64 = 0.005;
+
+/// The most a region's solid infill lines are widened to cover it.
+const MAX_INFILL_WIDENING: f64 = 1.3;
 
 /// Plans one two5d feature in planar layers parallel to its reference plane; its first travel
 /// starts at `entry` (where the nozzle is, if anywhere): [`fill_two5d`], then

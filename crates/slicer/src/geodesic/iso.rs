@@ -12,9 +12,9 @@ impl LayerMesh {
     pub fn iso_lines(&self, f: &[f64], level: f64, other: &[f64]) -> Vec<IsoLine> {
         type Key = (u32, u32);
         let key = |a: u32, b: u32| (a.min(b), a.max(b));
-        let mut point: FastMap<Key, (Point2, f64)> = FastMap::default();
+        let mut point: FastMap<Key, (Point2, f64, u32)> = FastMap::default();
         let mut links: FastMap<Key, Vec<Key>> = FastMap::default();
-        let at = |a: u32, b: u32| -> (Point2, f64) {
+        let at = |a: u32, b: u32| -> (Point2, f64, u32) {
             let (fa, fb) = (f[a as usize], f[b as usize]);
             let t = if (fb - fa).abs() > 0.0 {
                 ((level - fa) / (fb - fa)).clamp(0.0, 1.0)
@@ -25,6 +25,7 @@ impl LayerMesh {
             (
                 [qa[0] + (qb[0] - qa[0]) * t, qa[1] + (qb[1] - qa[1]) * t],
                 other[a as usize] + (other[b as usize] - other[a as usize]) * t,
+                if fa < fb { a } else { b },
             )
         };
         for tri in &self.tris {
@@ -72,13 +73,15 @@ impl LayerMesh {
                 ..IsoLine::default()
             };
             for k in &chain {
-                let (q, o) = point[k];
+                let (q, o, low) = point[k];
                 line.q.push(q);
                 line.other.push(o);
+                line.low.push(low);
             }
             if closed {
                 line.q.push(line.q[0]);
                 line.other.push(line.other[0]);
+                line.low.push(line.low[0]);
             }
             if line.q.len() >= 2 {
                 out.push(line);

@@ -24,6 +24,9 @@ pub struct LayerMesh {
     /// The vertices joined to each vertex by an edge (offsets into one list, and the list),
     /// made by the first search that needs them.
     pub(super) adjacency: std::sync::OnceLock<(Vec<u32>, Vec<u32>)>,
+    /// The triangle across each edge of each triangle, made by the first ray that needs it
+    /// (`LayerMesh::ray_max`).
+    pub(super) tri_adjacency: std::sync::OnceLock<Vec<[u32; 3]>>,
     /// The upper-triangular map `(m00, m01, m11)` from chart to the surface-isotropic frame
     /// of [`LayerMesh::build_with_metric`]; `None`: the chart itself.
     pub(super) frame: Option<[f64; 3]>,
@@ -36,6 +39,9 @@ pub struct IsoLine {
     pub q: Vec<Point2>,
     /// The second field interpolated at each point.
     pub other: Vec<f64>,
+    /// At each point, the end of the lattice edge it lies on where the field is below the
+    /// level (the end farther down; [`LayerMesh::ascent`] there tells which way is up).
+    pub low: Vec<u32>,
     /// The line is a closed ring (the first point is repeated at the end).
     pub closed: bool,
 }
@@ -325,6 +331,53 @@ impl LayerMesh {
             }
         }
         m
+    }
+
+    /// `q` in the frame of the chart's metric at the region, where lengths are the surface's
+    /// ([`LayerMesh::build_with_metric`]); the chart's own coordinates without one.
+    pub fn metric_point(&self, q: Point2) -> Point2 {
+        match self.frame {
+            Some([m00, m01, m11]) => [m00 * q[0] + m01 * q[1], m11 * q[1]],
+            None => q,
+        }
+    }
+
+    /// The chart step at vertex `v` that raises the piecewise-linear field `f` by one, along
+    /// its steepest ascent there: the direction of the triangles' gradients around `v`
+    /// (summed, weighted by area), the length one over the steepest of them (a triangle that
+    /// spans a ridge of `f` is flatter than its flanks, and would overshoot). `None` where
+    /// the field is flat or not finite around `v`.
+    pub fn ascent(&self, f: &[f64], v: u32) -> Option<Point2> {
+        let mut sum = [0.0f64; 2];
+        let mut steepest = 0.0f64;
+        for &t in &self.around[v as usize] {
+            let [a, b, c] = self.tris[t as usize].map(|i| i as usize);
+            let (fa, fb, fc) = (f[a], f[b], f[c]);
+            if !(fa.is_finite() && fb.is_finite() && fc.is_finite()) {
+                continue;
+            }
+            let (qa, qb, qc) = (self.q[a], self.q[b], self.q[c]);
+            let (u, w) = (
+                [qb[0] - qa[0], qb[1] - qa[1]],
+                [qc[0] - qa[0], qc[1] - qa[1]],
+            );
+            let det = u[0] * w[1] - u[1] * w[0];
+            if det.abs() < f64::MIN_POSITIVE.sqrt() {
+                continue;
+            }
+            // The gradient g with g·u = fb − fa and g·w = fc − fa.
+            let (du, dw) = (fb - fa, fc - fa);
+            let g = [(du * w[1] - dw * u[1]) / det, (dw * u[0] - du * w[0]) / det];
+            let area = 0.5 * det.abs();
+            sum = [sum[0] + area * g[0], sum[1] + area * g[1]];
+            steepest = steepest.max(g[0].hypot(g[1]));
+        }
+        let n = sum[0].hypot(sum[1]);
+        if n <= 0.0 || steepest <= 0.0 || !n.is_finite() {
+            return None;
+        }
+        let k = 1.0 / (n * steepest);
+        Some([sum[0] * k, sum[1] * k])
     }
 
     /// The area on the layer surface (the lifted vertices `p`) of the part of the region

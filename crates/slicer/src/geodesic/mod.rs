@@ -17,6 +17,7 @@
 mod field;
 mod iso;
 mod mesh;
+mod ray;
 #[cfg(test)]
 mod tests;
 
@@ -24,3 +25,4 @@ pub use crate::geom2d::region_contains;
 pub(crate) use field::segment_distance;
 pub use iso::{clip_reaching, Piece, RunOn};
 pub use mesh::{IsoLine, LayerMesh};
+pub use ray::RayTop;

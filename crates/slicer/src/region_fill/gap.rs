@@ -2,7 +2,8 @@
 //! as the strip at each point.
 
 use super::FillPath;
-use crate::geodesic::LayerMesh;
+use crate::geodesic::{LayerMesh, RayTop};
+use crate::geom2d::Point2;
 use crate::toolpath::Role;
 
 /// Where a gap fill runs: from `edge` (the distance to the region's boundary where the beads
@@ -20,7 +21,7 @@ pub(super) struct Gap {
 /// above it, mm: far more than the round-off of interpolating between two such values.
 const RIDGE_CAP_MARGIN: f64 = 1e-6;
 
-/// The local ridge height of `db` (within one and a half spacings) seen from the flanks of
+/// The local ridge height of `db` (within `radius`) seen from the flanks of
 /// the region, at the vertices the iso-lines at `levels` interpolate between (the ends of the
 /// lattice edges each `(level, top)` crosses), where the fills read it only through
 /// thresholds no higher than that level's `top` (a ring's width limit, a gap's `below` or
@@ -29,8 +30,7 @@ const RIDGE_CAP_MARGIN: f64 = 1e-6;
 /// own; a vertex above its cap whose crossing edges all end above theirs keeps some value
 /// above it (its search stops there), and so does every value interpolated between two such
 /// ends, which the fills then read as they would the exact one.
-pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], spacing: f64) -> Vec<f64> {
-    let radius = 1.5 * spacing;
+pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], radius: f64) -> Vec<f64> {
     let n = db.len();
     let crosses = |a: usize, b: usize, l: f64| (db[a] - l) * (db[b] - l) <= 0.0;
     let mut cap = vec![f64::NEG_INFINITY; n];
@@ -72,37 +72,31 @@ pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], spacing: 
     r
 }
 
-/// [`ridge`] where [`gap_fill`] runs for `gap`: it reads the ridge only through `below`
-/// (nothing at or above it) or, without one, through the edge plus a bead `width` (a full
-/// bead from there up).
-pub(super) fn ridge_for(
-    lm: &LayerMesh,
-    db: &[f64],
-    gap: Gap,
-    spacing: f64,
-    width: f64,
-) -> Vec<f64> {
-    let top = if gap.below.is_finite() {
-        gap.below
-    } else {
-        gap.edge + width
-    };
-    ridge(lm, db, &[(gap.edge + gap.inset, top)], spacing)
-}
-
 /// Gap fill: the strip of a region farther than `gap.edge` from its boundary (`db`, the
-/// distance to the boundary) but too narrow for a bead: its local half width β is the ridge
-/// height (`ridge`, [`ridge_for`]) of `db` above the edge. The fill is one loop round the
-/// ridge, `gap.inset` inside the strip's edge (an iso-line of `db`), each point β wide and
-/// extruded for that width by Eq. 1: the two flanks together put down the strip's volume.
-/// Stretches narrower than `gap.min_width`, or where the ridge reaches `gap.below`, are left
-/// out.
+/// distance to the boundary) but too narrow for a bead: its local half width β is the height
+/// of the ridge of `db` above the edge. The fill follows one loop round the ridge,
+/// `gap.inset` inside the strip's edge (an iso-line of `db`), each point moved up the
+/// distance along its steepest ascent to where it stops rising ([`LayerMesh::ray_max`]):
+///
+/// - where the strip is at most [`SINGLE_BEAD_MAX`] beads across, onto the ridge, as one bead
+///   2β wide: the loop's two flanks meet there, and the second time the loop comes along a
+///   stretch of ridge it has laid ([`Laid`]) it is cut. A wall one bead across (a 0.45 mm
+///   frame of a connector housing) took two beads 0.2 mm wide a tenth of a bead inside its
+///   faces, each under the narrowest bead the machine lays, and its middle stayed empty;
+/// - where it is wider, to the middle of its own half, a bead β wide: the two flanks lie edge
+///   to edge.
+///
+/// Each point is extruded for its width by Eq. 1, so the fill puts down the strip's volume.
+/// Beads narrower than `gap.min_width`, where the ridge reaches `gap.below` (the next ring
+/// runs there), or lying more than half inside the beads `beside` (the ring beside the gap: at
+/// a convex corner of the region the ridge runs into the corner below the ring's level, but
+/// the ring's bead rounds the corner), are left out.
 pub(super) fn gap_fill(
     lm: &LayerMesh,
     db: &[f64],
-    ridge: &[f64],
     gap: Gap,
     width: f64,
+    beside: Option<&Beside>,
 ) -> Vec<FillPath> {
     let mut out = vec![];
     let dmax = db
@@ -110,29 +104,301 @@ pub(super) fn gap_fill(
         .copied()
         .filter(|d| d.is_finite())
         .fold(0.0f64, f64::max);
+    let level = gap.edge + gap.inset;
     if dmax <= gap.edge + gap.inset.max(0.05 * width) {
         return out;
     }
-    for line in lm.iso_lines(db, gap.edge + gap.inset, ridge) {
+    let mut laid = Laid::new(RETRACE_SHARE * width);
+    // The highest distance near each loop point (on a lattice coarse for the strip, the loop
+    // breaks into islands along the ridge, and a ray from it may meet the ridge between
+    // vertices that sample it low).
+    let near = ridge(
+        lm,
+        db,
+        &[(level, gap.edge + width)],
+        NEAR_RIDGE_SHARE * width,
+    );
+    for line in lm.iso_lines(db, level, &near) {
+        // Up the distance from the loop to where it stops rising: the ridge the flanks meet
+        // on, the strip's local half width β there. Where the ridge reaches `below` as the
+        // lattice's iso-lines see it, the next ring runs.
+        let ups: Vec<(Option<Point2>, Option<RayTop>, f64)> = line
+            .q
+            .iter()
+            .zip(&line.low)
+            .zip(&line.other)
+            .map(|((q, low), near)| {
+                let ascent = lm.ascent(db, *low);
+                let top = ascent.and_then(|a| lm.ray_max(db, *low, *q, a, RIDGE_SLACK * width));
+                let beta = match top {
+                    Some(t) if t.sampled < gap.below => {
+                        (t.height.max(near.min(gap.below)) - gap.edge).clamp(0.0, width)
+                    }
+                    _ => 0.0,
+                };
+                (ascent, top, beta)
+            })
+            .collect();
+        // A closed loop starts where the strip is narrowest (a strip's end): its first flank
+        // is laid from there along the whole ridge, and the other comes back over it. From
+        // anywhere else, the stretch between that start and the end was laid by neither.
+        let (q, ups) = if line.closed && ups.len() > 2 {
+            let n = ups.len() - 1;
+            let k = (0..n)
+                .min_by(|&a, &b| ups[a].2.total_cmp(&ups[b].2))
+                .unwrap_or(0);
+            let order = (k..n).chain(0..=k);
+            let q: Vec<Point2> = order.clone().map(|i| line.q[i]).collect();
+            (q, order.map(|i| ups[i]).collect())
+        } else {
+            (line.q, ups)
+        };
+        // One bead on the ridge or one on each flank, for the whole loop by its median width
+        // (point by point, a strip near the limit went to and fro between the two).
+        let mut betas: Vec<f64> = ups.iter().map(|u| u.2).filter(|b| *b > 0.0).collect();
+        betas.sort_by(f64::total_cmp);
+        let median = betas.get(betas.len() / 2).copied();
+        let single = median.is_none_or(|b| 2.0 * b <= SINGLE_BEAD_MAX * width);
+        // Into a corner, the ridge's branch narrows to nothing: its single beads stop at a
+        // quarter bead, or at half the loop's usual width where the whole strip is narrower
+        // (a contact thinner than a bead keeps its beads).
+        let corner_floor = (SINGLE_MIN_WIDTH * width).min(median.unwrap_or(0.0));
         let mut cur = FillPath::empty(Role::GapFill);
-        for (q, r) in line.q.iter().zip(&line.other) {
-            let w = if *r < gap.below {
-                (r - gap.edge).clamp(0.0, width)
-            } else {
-                0.0
+        for (q, (ascent, top, beta)) in q.iter().zip(ups) {
+            let (at, w) = match (top, ascent) {
+                (Some(t), _) if single => (t.at, 2.0 * beta),
+                (_, Some(a)) => {
+                    let up = (gap.edge + 0.5 * beta - level).max(0.0);
+                    ([q[0] + a[0] * up, q[1] + a[1] * up], beta)
+                }
+                _ => (*q, beta),
             };
-            if w >= gap.min_width {
-                cur.points.push(*q);
-                cur.widths.push(w);
-            } else if cur.points.len() >= 2 {
-                out.push(std::mem::replace(&mut cur, FillPath::empty(Role::GapFill)));
+            // The bead's half width, mm, and where it lies in the metric's frame (mm).
+            let half = if single { beta } else { 0.5 * beta };
+            let m = lm.metric_point(at);
+            let narrowest = if single {
+                (SINGLE_MIN_SHARE * gap.min_width).max(corner_floor)
             } else {
-                cur = FillPath::empty(Role::GapFill);
+                gap.min_width
+            };
+            let keep = w >= narrowest
+                && !(single && laid.retraces(m, out.len()))
+                && !beside.is_some_and(|b| b.covers(m, half));
+            if !keep {
+                let done = std::mem::replace(&mut cur, FillPath::empty(Role::GapFill));
+                if done.points.len() >= 2 {
+                    out.push(done);
+                }
+                laid.next_path();
+                continue;
             }
+            // Neighbouring loop points may land on one spot of the ridge: one point there, as
+            // wide as the wider.
+            if cur.points.last().is_some_and(|&l| {
+                crate::geom2d::dist(lm.metric_point(l), m) < MIN_STEP_SHARE * width
+            }) {
+                if let Some(last) = cur.widths.last_mut() {
+                    *last = last.max(w);
+                }
+                continue;
+            }
+            if single {
+                laid.add(m, out.len());
+            }
+            cur.points.push(at);
+            cur.widths.push(w);
         }
         if cur.points.len() >= 2 {
             out.push(cur);
         }
+        laid.next_path();
     }
     out
+}
+
+/// How far, in bead widths, a gap fill looks round each loop point for the ridge's height
+/// (besides up its ray).
+const NEAR_RIDGE_SHARE: f64 = 0.5;
+
+/// The shortest step between a gap fill's points, in bead widths.
+const MIN_STEP_SHARE: f64 = 0.002;
+
+/// How far past the last rise of the distance, in bead widths, a gap fill's point looks for
+/// it to rise again before taking that rise for the ridge ([`LayerMesh::ray_max`]).
+const RIDGE_SLACK: f64 = 0.7;
+
+/// Beads laid beside a gap fill (the ring it runs beside), in a grid of cells: segments in
+/// the frame of the chart's metric ([`LayerMesh::metric_point`], mm) with their bead widths.
+pub(super) struct Beside {
+    cell: f64,
+    widest: f64,
+    cells: crate::fast_hash::FastMap<(i64, i64), Vec<usize>>,
+    segs: Vec<([f64; 2], [f64; 2], f64)>,
+}
+
+impl Beside {
+    /// The beads of `paths` (chart coordinates) on `lm`, in cells `cell` mm wide.
+    pub(super) fn new(lm: &LayerMesh, paths: &[FillPath], cell: f64) -> Beside {
+        let mut b = Beside {
+            cell,
+            widest: 0.0,
+            cells: Default::default(),
+            segs: vec![],
+        };
+        for p in paths {
+            for i in 1..p.points.len() {
+                let (a, c) = (
+                    lm.metric_point(p.points[i - 1]),
+                    lm.metric_point(p.points[i]),
+                );
+                let w = 0.5 * (p.widths[i - 1] + p.widths[i]);
+                let k = b.segs.len();
+                b.segs.push((a, c, w));
+                b.widest = b.widest.max(w);
+                let (c0, c1) = (b.at(a), b.at(c));
+                for x in c0.0.min(c1.0)..=c0.0.max(c1.0) {
+                    for y in c0.1.min(c1.1)..=c0.1.max(c1.1) {
+                        b.cells.entry((x, y)).or_default().push(k);
+                    }
+                }
+            }
+        }
+        b
+    }
+
+    fn at(&self, p: [f64; 2]) -> (i64, i64) {
+        (
+            (p[0] / self.cell).floor() as i64,
+            (p[1] / self.cell).floor() as i64,
+        )
+    }
+
+    /// Whether a bead centred at `p` (the metric's frame), `half` mm to each side, lies more
+    /// than half inside these beads.
+    fn covers(&self, p: [f64; 2], half: f64) -> bool {
+        if self.segs.is_empty() {
+            return false;
+        }
+        let reach = 0.5 * self.widest + half;
+        let (lo, hi) = (
+            self.at([p[0] - reach, p[1] - reach]),
+            self.at([p[0] + reach, p[1] + reach]),
+        );
+        if (hi.0 - lo.0 + 1).saturating_mul(hi.1 - lo.1 + 1) > 10_000 {
+            return false;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for &k in self.cells.get(&(x, y)).into_iter().flatten() {
+                    let (a, b, w) = self.segs[k];
+                    let d = crate::geom2d::seg_dist(p, a, b);
+                    if d - half < 0.5 * (w - half) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The narrowest single bead on a ridge, as a multiple of the gap's narrowest flank bead
+/// (`Gap::min_width`): a little wider, so that a bead into a sharp corner keeps its middle
+/// half a layer from the part's sides (a blade's last layer is checked so).
+const SINGLE_MIN_SHARE: f64 = 1.1;
+
+/// The narrowest single bead on a ridge in bead widths where the strip is wider (twice that,
+/// or more, as a rule): narrower, the medial axis's branches into a region's corners got beads
+/// a tenth of a bead wide, which a nozzle lays several times as wide (the plan widens them to
+/// the machine's narrowest bead), and the head leaned into the corner to lay them.
+const SINGLE_MIN_WIDTH: f64 = 0.25;
+
+/// The widest strip, in bead widths, a gap fill lays as one bead on its ridge ([`gap_fill`]);
+/// a wider one gets a bead on each flank.
+const SINGLE_BEAD_MAX: f64 = 1.1;
+
+/// How close, in bead widths, a point of a gap fill's single beads may come to a stretch
+/// laid before (other than the last [`RETRACE_SHARE`]·[`OWN_RUN`] of its own path) and still
+/// be laid: the two flanks of a loop meet on the ridge within the lattice's error.
+const RETRACE_SHARE: f64 = 0.25;
+
+/// How much of a path's own last stretch, in multiples of the retrace distance, a new point
+/// is not checked against (the point before it, and the turn at a strip's tip).
+const OWN_RUN: f64 = 4.0;
+
+/// The single beads a gap fill has laid, in the frame of the chart's metric (mm): segments in
+/// a grid of cells the retrace distance wide, each with the path it belongs to and how far along it it ends.
+struct Laid {
+    tol: f64,
+    cells: crate::fast_hash::FastMap<(i64, i64), Vec<usize>>,
+    /// Segments: ends, path number, length along the path at the second end.
+    segs: Vec<([f64; 2], [f64; 2], usize, f64)>,
+    /// The last point laid on the current path, and the length laid on it so far.
+    last: Option<([f64; 2], f64)>,
+}
+
+impl Laid {
+    fn new(tol: f64) -> Laid {
+        Laid {
+            tol,
+            cells: Default::default(),
+            segs: vec![],
+            last: None,
+        }
+    }
+
+    fn cell(&self, p: [f64; 2]) -> (i64, i64) {
+        (
+            (p[0] / self.tol).floor() as i64,
+            (p[1] / self.tol).floor() as i64,
+        )
+    }
+
+    /// Whether `p`, to be laid on path `path`, lies within the retrace distance of a stretch
+    /// laid before: of another path, or of this one farther back than its own last run.
+    fn retraces(&self, p: [f64; 2], path: usize) -> bool {
+        let along = self.last.map_or(0.0, |(_, s)| s);
+        let (cx, cy) = self.cell(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let Some(list) = self.cells.get(&(cx + dx, cy + dy)) else {
+                    continue;
+                };
+                for &k in list {
+                    let (a, b, on, s) = self.segs[k];
+                    if on == path && s > along - OWN_RUN * self.tol {
+                        continue;
+                    }
+                    if crate::geom2d::seg_dist(p, a, b) < self.tol {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Lays `p` on path `path` (joined to the point laid before it on that path).
+    fn add(&mut self, p: [f64; 2], path: usize) {
+        if let Some((a, s)) = self.last {
+            let s = s + crate::geom2d::dist(a, p);
+            let k = self.segs.len();
+            self.segs.push((a, p, path, s));
+            // Every cell the segment's box touches (segments are short: a lattice step).
+            let (c0, c1) = (self.cell(a), self.cell(p));
+            for x in c0.0.min(c1.0)..=c0.0.max(c1.0) {
+                for y in c0.1.min(c1.1)..=c0.1.max(c1.1) {
+                    self.cells.entry((x, y)).or_default().push(k);
+                }
+            }
+            self.last = Some((p, s));
+        } else {
+            self.last = Some((p, 0.0));
+        }
+    }
+
+    /// The path laid on is done: the next point starts another.
+    fn next_path(&mut self) {
+        self.last = None;
+    }
 }

@@ -20,7 +20,7 @@ use crate::toolpath::Role;
 use border::Border;
 use brep::math::{P3, V3};
 use brep::surface::Surface;
-use gap::{gap_fill, ridge, ridge_for, Gap};
+use gap::{gap_fill, ridge, Beside, Gap};
 
 pub(crate) use spurs::corner_spurs_beside;
 
@@ -163,9 +163,9 @@ pub(crate) fn fill_region(
     // below the deepest point is left out.
     let (rings, levels) = ring_levels(params, width, spacing, dmax);
     let insets = Insets::new(sliver_inset, width);
-    // The ridge is needed only where the rings' iso-lines and the gap fills beside them run:
-    // at both ends of each lattice edge those levels cross.
-    let ridge = ring_ridge(&lm, &db, &levels, width, insets, spacing);
+    // The ridge is needed only where the rings' iso-lines run: at both ends of each lattice
+    // edge those levels cross.
+    let ridge = ring_ridge(&lm, &db, &levels, width, spacing);
     let (last_ring, last_ring_from) = lay_rings(&lm, &db, &ridge, &levels, width, insets, &mut out);
     // Infill where the rings stop: lines end a spacing past the last ring, joined along that
     // boundary (as on planar layers), or half a bead inside the boundary without rings. Where
@@ -173,7 +173,7 @@ pub(crate) fn fill_region(
     // from the edge of the last ring's bead instead, filling the gap.
     // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
     // it), within what that core holds.
-    let core_fill = |gap: Gap| core_fill(&lm, &db, chart, z, gap, (spacing, width));
+    let core_fill = |gap: Gap| core_fill(&lm, &db, chart, z, gap, width);
     let inner = match last_ring {
         Some(c) if dmax > c + 1.5 * spacing => c + spacing,
         Some(c) => {
@@ -376,11 +376,10 @@ fn core_fill(
     chart: &Chart,
     z: f64,
     gap: Gap,
-    (spacing, width): (f64, f64),
+    width: f64,
 ) -> Vec<FillPath> {
-    let ridge = ridge_for(lm, db, gap, spacing, width);
     conserved(
-        gap_fill(lm, db, &ridge, gap, width),
+        gap_fill(lm, db, gap, width, None),
         lm,
         db,
         gap.edge,
@@ -464,23 +463,14 @@ fn gap_beside_ring(j: usize, c: f64, width: f64, insets: Insets) -> Gap {
     }
 }
 
-/// The ridge of the distance to the boundary where the rings at `levels` and the gap fills
-/// beside them run (at both ends of each lattice edge those levels cross); empty without
-/// rings.
-fn ring_ridge(
-    lm: &LayerMesh,
-    db: &[f64],
-    levels: &[f64],
-    width: f64,
-    insets: Insets,
-    spacing: f64,
-) -> Vec<f64> {
+/// The ridge of the distance to the boundary where the rings at `levels` run (at both ends
+/// of each lattice edge those levels cross); empty without rings.
+fn ring_ridge(lm: &LayerMesh, db: &[f64], levels: &[f64], width: f64, spacing: f64) -> Vec<f64> {
     if levels.is_empty() {
         vec![]
     } else {
-        // Each level with the highest ridge its fill tells apart: a ring's width (a full bead
-        // above the gap fill's narrowest one past its edge) and the gap fill where it does
-        // not reach (nothing at or above the ring's level).
+        // Each level with the highest ridge its ring tells apart: a full bead above the gap
+        // fill's narrowest one past its edge (the gap fill finds its own ridge).
         let wanted: Vec<(f64, f64)> = levels
             .iter()
             .map(|&c| {
@@ -489,12 +479,8 @@ fn ring_ridge(
                     c - 0.5 * width + GAP_MIN_WIDTH_SHARE.mul_add(width, width),
                 )
             })
-            .chain(levels.iter().enumerate().map(|(j, &c)| {
-                let g = gap_beside_ring(j, c, width, insets);
-                (g.edge + g.inset, g.below)
-            }))
             .collect();
-        ridge(lm, db, &wanted, spacing)
+        ridge(lm, db, &wanted, 1.5 * spacing)
     }
 }
 
@@ -515,40 +501,46 @@ fn lay_rings(
     for (j, &c) in levels.iter().enumerate() {
         last_ring_from = out.len();
         let edge = c - 0.5 * width;
+        let role = if j == 0 {
+            Role::ExternalPerimeter
+        } else {
+            Role::Perimeter
+        };
+        let ring: Vec<FillPath> = lm
+            .iso_lines(db, c, ridge)
+            .into_iter()
+            .map(|line| {
+                let widths = line
+                    .other
+                    .iter()
+                    .map(|r| {
+                        let room = r - edge;
+                        if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
+                            room.max(0.2 * width)
+                        } else {
+                            width
+                        }
+                    })
+                    .collect();
+                FillPath {
+                    points: line.q,
+                    widths,
+                    role,
+                }
+            })
+            .collect();
         // Where this ring does not reach (the region's half width is under `c` there), the
         // strip the ring before leaves along the ridge, or the region itself, gets its gap
         // fill.
+        let beside = Beside::new(lm, &ring, 0.5 * width);
         out.extend(gap_fill(
             lm,
             db,
-            ridge,
             gap_beside_ring(j, c, width, insets),
             width,
+            Some(&beside),
         ));
-        for line in lm.iso_lines(db, c, ridge) {
-            let widths = line
-                .other
-                .iter()
-                .map(|r| {
-                    let room = r - edge;
-                    if room <= GAP_MIN_WIDTH_SHARE.mul_add(width, width) {
-                        room.max(0.2 * width)
-                    } else {
-                        width
-                    }
-                })
-                .collect();
-            let role = if j == 0 {
-                Role::ExternalPerimeter
-            } else {
-                Role::Perimeter
-            };
-            out.push(FillPath {
-                points: line.q,
-                widths,
-                role,
-            });
-        }
+        out.extend(ring);
         last_ring = Some(c);
     }
     (last_ring, last_ring_from)
