@@ -363,13 +363,37 @@ pub(crate) fn fill_columns(
             .filter(|p| p.points.len() >= 2)
             .collect()
     };
-    regions
-        .sparse
-        .iter()
-        .zip(&regions.interface)
+    // The sparse lines are laid in one direction on every layer, so a layer whose sparse
+    // support is the layer below's has the same lines: a column standing clear of the part
+    // keeps its outline for many layers (67 of the impeller's 92 support layers), each
+    // thousands of vertices.
+    let firsts: Vec<usize> = (0..regions.sparse.len())
+        .filter(|&k| k == 0 || regions.sparse[k] != regions.sparse[k - 1])
+        .collect();
+    let sparse: Vec<Vec<FillPath>> = firsts
+        .par_iter()
+        .map(|&k| {
+            fill(
+                &regions.sparse[k],
+                0,
+                params.support_density,
+                Role::SupportMaterial,
+            )
+        })
+        .collect();
+    let mut run = 0;
+    (0..regions.sparse.len())
+        .map(|k| {
+            if run + 1 < firsts.len() && firsts[run + 1] == k {
+                run += 1;
+            }
+            sparse.get(run).cloned().unwrap_or_default()
+        })
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .zip(regions.interface.par_iter())
         .enumerate()
-        .map(|(k, (sparse, interface))| {
-            let mut paths = fill(sparse, 0, params.support_density, Role::SupportMaterial);
+        .map(|(k, (mut paths, interface))| {
             paths.extend(fill(
                 interface,
                 k,

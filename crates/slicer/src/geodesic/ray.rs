@@ -3,13 +3,10 @@
 
 use super::mesh::LayerMesh;
 use crate::geom2d::Point2;
+use crate::tolerance::BARYCENTRIC_SLACK;
 
 /// No triangle across this edge (the region's boundary).
 const NONE: u32 = u32::MAX;
-
-/// How far outside a triangle (in barycentric coordinates) a ray's start may lie for the
-/// triangle to hold it: the round-off of interpolating the start along a lattice edge.
-const START_SLACK: f64 = 1e-9;
 
 /// How far outside a triangle (in barycentric coordinates) a ray's exit point may be found for
 /// the ray to be taken as crossing it: the round-off of the exit's line intersection.
@@ -198,9 +195,9 @@ impl LayerMesh {
         out
     }
 
-    /// Whether triangle `t` holds `p` (within a micrometre-scale slack: `p` may lie on an edge).
+    /// Whether triangle `t` holds `p` (within [`BARYCENTRIC_SLACK`]: `p` may lie on an edge).
     fn holds(&self, t: u32, p: Point2) -> bool {
-        self.holds_within(t, p, START_SLACK)
+        self.holds_within(t, p, BARYCENTRIC_SLACK)
     }
 
     /// Whether triangle `t` holds `p`, each barycentric coordinate down to `-slack`.
