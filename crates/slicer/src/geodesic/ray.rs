@@ -67,7 +67,7 @@ impl LayerMesh {
     /// Follows the ray from `q` (a point of a triangle around vertex `v`) up the field `f`
     /// along `ascent` ([`LayerMesh::ascent`] at `v`: its direction, and one over its length
     /// the field's slope) through the triangles to where `f` stops rising: the last point
-    /// where `f` had risen by at least [`RISE_SHARE`] of that slope over the way from the
+    /// where `f` had risen by at least a twentieth of that slope over the way from the
     /// point before, once `f` has not done so for `slack` (the field's units, mm of distance; the
     /// piecewise-linear field wobbles on irregular triangles, and is level along a strip's
     /// ridge). The field is linear in each triangle, so the points looked at are where the
