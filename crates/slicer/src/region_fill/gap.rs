@@ -1,5 +1,5 @@
-//! Gap fill: the strip of a region too narrow for a bead, filled by one loop of beads as wide
-//! as the strip at each point.
+//! Gap fill: the strip of a region too narrow for a bead, filled along its ridge by one bead
+//! as wide as the strip at each point (or, a strip over a bead across, one bead on each half).
 
 use super::FillPath;
 use crate::geodesic::{LayerMesh, RayTop};

@@ -693,14 +693,13 @@ fn level_span(lm: &LayerMesh, phi: &[f64], db: &[f64], edge: f64) -> Option<(f64
 
 /// Gap fill of the whole core a region's rings leave (or of a region too thin for a ring),
 /// its widths scaled so that it puts down what the core holds: down where it would put down
-/// more, up (by at most [`MAX_CORE_WIDENING`]) where less. Up: the ridge of a strip a few
-/// lattice steps wide falls between the lattice's vertices, so its height (each flank's
-/// width) comes out short, by 12 % on a 2 mm rib's 0.2 mm core (−3.8 % of the rib). The ridge
-/// height a gap fill takes as its width is right along a strip, whose two flanks meet at the
-/// ridge, but not where the core is compact (a small boss's square core, whose flanks are
-/// all four sides): there each side took the whole half width and the loop laid the core
-/// twice over (+5 % on a 3 mm pin). The core's area on the layer surface is exact (the
-/// lattice's triangles clipped at the core's edge), and so is each bead's strip by Eq. 1.
+/// more, up (by at most [`MAX_CORE_WIDENING`]) where less. Up: a core a lattice step or two
+/// across breaks into islands along its ridge, whose beads fall short (the loop that made
+/// them was two flanks of half-width beads: 12 % short on a 2 mm rib's 0.2 mm core, −3.8 % of
+/// the rib); down: a compact core (a small boss's square one) whose ridge branches into its
+/// corners (the loop laid it twice over: +5 % on a 3 mm pin). The core's area on the layer
+/// surface is exact (the lattice's triangles clipped at the core's edge), and so is each
+/// bead's strip by Eq. 1.
 fn conserved(
     mut paths: Vec<FillPath>,
     lm: &LayerMesh,
