@@ -258,27 +258,59 @@ pub(crate) fn fill_region(
         (inner, reach),
         dir,
     );
-    if !zig {
+    let from = out.len();
+    lay_lines(
+        &lm,
+        &db,
+        pieces,
+        zig,
+        inner,
+        (spacing, width),
+        infill,
+        &mut out,
+    );
+    // A small core's few lines put down what it holds ([`SMALL_CORE_LINES`]).
+    if n <= SMALL_CORE_LINES {
+        let lines = out.split_off(from);
+        out.extend(conserved(lines, &lm, &db, edge, |a, b| {
+            surface_length(chart, z, a, b)
+        }));
+    }
+    out
+}
+
+/// The infill's pieces as paths onto `out`: zig-zag, each line's end joined to the nearest end
+/// of a line on the next level along the infill boundary (the iso-line of `db` at `inner`,
+/// where the lines were cut) when that way is short; or raster lines, each run on.
+#[allow(clippy::too_many_arguments)]
+fn lay_lines(
+    lm: &LayerMesh,
+    db: &[f64],
+    pieces: Vec<(i64, Piece)>,
+    zig: bool,
+    inner: f64,
+    (spacing, width): (f64, f64),
+    infill: Role,
+    out: &mut Vec<FillPath>,
+) {
+    if zig {
+        let border = lm.iso_lines(db, inner, db);
+        join_zigzag(pieces, &Border::new(&border), spacing, width, infill, out);
+    } else {
         out.extend(
             pieces
                 .into_iter()
                 .map(|(_, p)| FillPath::uniform(p.reaching(), width, infill)),
         );
-        return out;
     }
-    // Zig-zag: join each line's end to the nearest end of a line on the next level, along the
-    // infill boundary (the iso-line where the lines were cut), when that way is short.
-    let border = lm.iso_lines(&db, inner, &db);
-    join_zigzag(
-        pieces,
-        &Border::new(&border),
-        spacing,
-        width,
-        infill,
-        &mut out,
-    );
-    out
 }
+
+/// The most infill lines a core has for its lines to be made to put down what it holds
+/// ([`fill_region`]). Their strips' square ends stand past a round core's rim or fall short of
+/// it, by a share that grows as the lines get fewer (a pin 3.8 mm across on a dome, its core
+/// crossed by three lines, was laid 9 % over its core, 2.1 % over the pin); past a few, their
+/// ends' error is a small share of the core.
+const SMALL_CORE_LINES: f64 = 4.0;
 
 /// The rings asked for by the path mode, and their levels: half a bead in, then a spacing
 /// apart, down to a tenth of a bead below the deepest point `dmax`.
