@@ -186,11 +186,7 @@ pub fn fill_regions_with(
 /// bare: a 3 mm pin was filled 2.6 % short, its core 15 %. The lines put down the core's
 /// volume by Eq. 1 for the wider bead.
 fn conserve_solid_infill(laid: &mut [FillPath], area: f64) {
-    let strip = |p: &FillPath| -> f64 {
-        (1..p.points.len())
-            .map(|i| 0.5 * (p.widths[i - 1] + p.widths[i]) * dist(p.points[i - 1], p.points[i]))
-            .sum()
-    };
+    let strip = |p: &FillPath| p.strip_area(dist);
     let total: f64 = laid.iter().map(strip).sum();
     let infill: f64 = laid
         .iter()

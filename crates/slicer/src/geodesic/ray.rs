@@ -201,7 +201,7 @@ impl LayerMesh {
     }
 
     /// Whether triangle `t` holds `p`, each barycentric coordinate down to `-slack`.
-    pub(crate) fn holds_within(&self, t: u32, p: Point2, slack: f64) -> bool {
+    fn holds_within(&self, t: u32, p: Point2, slack: f64) -> bool {
         self.barycentric(t, p)
             .is_some_and(|l| l.iter().all(|x| *x >= -slack))
     }

@@ -227,78 +227,104 @@ const MIN_STEP_SHARE: f64 = 0.002;
 /// it to rise again before taking that rise for the ridge ([`LayerMesh::ray_max`]).
 const RIDGE_SLACK: f64 = 0.7;
 
-/// Beads laid beside a gap fill (the ring it runs beside), in a grid of cells: segments in
-/// the frame of the chart's metric ([`LayerMesh::metric_point`], mm) with their bead widths.
-pub(super) struct Beside {
+/// Segments in a grid of square cells, each listed in every cell its box touches (they are
+/// short: a lattice step or a bead's): which of them lie near a point.
+struct SegmentGrid<T> {
     cell: f64,
-    widest: f64,
     cells: crate::fast_hash::FastMap<(i64, i64), Vec<usize>>,
-    segs: Vec<([f64; 2], [f64; 2], f64)>,
+    segs: Vec<(Point2, Point2, T)>,
 }
 
-impl Beside {
-    /// The beads of `paths` (chart coordinates) on `lm`, in cells `cell` mm wide.
-    pub(super) fn new(lm: &LayerMesh, paths: &[FillPath], cell: f64) -> Beside {
-        let mut b = Beside {
+/// Most cells a [`SegmentGrid`] looks through for one point (none found past it).
+const MAX_NEAR_CELLS: i64 = 10_000;
+
+impl<T> SegmentGrid<T> {
+    /// An empty grid of cells `cell` wide.
+    fn new(cell: f64) -> SegmentGrid<T> {
+        SegmentGrid {
             cell,
-            widest: 0.0,
             cells: Default::default(),
             segs: vec![],
-        };
-        for p in paths {
-            for i in 1..p.points.len() {
-                let (a, c) = (
-                    lm.metric_point(p.points[i - 1]),
-                    lm.metric_point(p.points[i]),
-                );
-                let w = 0.5 * (p.widths[i - 1] + p.widths[i]);
-                let k = b.segs.len();
-                b.segs.push((a, c, w));
-                b.widest = b.widest.max(w);
-                let (c0, c1) = (b.at(a), b.at(c));
-                for x in c0.0.min(c1.0)..=c0.0.max(c1.0) {
-                    for y in c0.1.min(c1.1)..=c0.1.max(c1.1) {
-                        b.cells.entry((x, y)).or_default().push(k);
-                    }
-                }
-            }
         }
-        b
     }
 
-    fn at(&self, p: [f64; 2]) -> (i64, i64) {
+    fn at(&self, p: Point2) -> (i64, i64) {
         (
             (p[0] / self.cell).floor() as i64,
             (p[1] / self.cell).floor() as i64,
         )
     }
 
-    /// Whether a bead centred at `p` (the metric's frame), `half` mm to each side, lies more
-    /// than half inside these beads.
-    fn covers(&self, p: [f64; 2], half: f64) -> bool {
-        if self.segs.is_empty() {
-            return false;
+    /// Lists the segment `a`–`b` with `tag`.
+    fn push(&mut self, a: Point2, b: Point2, tag: T) {
+        let k = self.segs.len();
+        self.segs.push((a, b, tag));
+        let (c0, c1) = (self.at(a), self.at(b));
+        for x in c0.0.min(c1.0)..=c0.0.max(c1.0) {
+            for y in c0.1.min(c1.1)..=c0.1.max(c1.1) {
+                self.cells.entry((x, y)).or_default().push(k);
+            }
         }
-        let reach = 0.5 * self.widest + half;
+    }
+
+    /// Whether `hit` holds for a segment listed in a cell of the box `reach` round `p` (every
+    /// segment within `reach` of `p` is among them, some more than once); false where that box
+    /// spans more than [`MAX_NEAR_CELLS`] cells.
+    fn any_near(
+        &self,
+        p: Point2,
+        reach: f64,
+        mut hit: impl FnMut(Point2, Point2, &T) -> bool,
+    ) -> bool {
         let (lo, hi) = (
             self.at([p[0] - reach, p[1] - reach]),
             self.at([p[0] + reach, p[1] + reach]),
         );
-        if (hi.0 - lo.0 + 1).saturating_mul(hi.1 - lo.1 + 1) > 10_000 {
+        if (hi.0 - lo.0 + 1).saturating_mul(hi.1 - lo.1 + 1) > MAX_NEAR_CELLS {
             return false;
         }
-        for x in lo.0..=hi.0 {
-            for y in lo.1..=hi.1 {
-                for &k in self.cells.get(&(x, y)).into_iter().flatten() {
-                    let (a, b, w) = self.segs[k];
-                    let d = crate::geom2d::seg_dist(p, a, b);
-                    if d - half < 0.5 * (w - half) {
-                        return true;
-                    }
-                }
+        (lo.0..=hi.0).any(|x| {
+            (lo.1..=hi.1).any(|y| {
+                self.cells.get(&(x, y)).into_iter().flatten().any(|&k| {
+                    let (a, b, tag) = &self.segs[k];
+                    hit(*a, *b, tag)
+                })
+            })
+        })
+    }
+}
+
+/// Beads laid beside a gap fill (the ring it runs beside): segments in the frame of the
+/// chart's metric ([`LayerMesh::metric_point`], mm) with their bead widths.
+pub(super) struct Beside {
+    widest: f64,
+    grid: SegmentGrid<f64>,
+}
+
+impl Beside {
+    /// The beads of `paths` (chart coordinates) on `lm`, in cells `cell` mm wide.
+    pub(super) fn new(lm: &LayerMesh, paths: &[FillPath], cell: f64) -> Beside {
+        let mut b = Beside {
+            widest: 0.0,
+            grid: SegmentGrid::new(cell),
+        };
+        for p in paths {
+            for i in 1..p.points.len() {
+                let w = 0.5 * (p.widths[i - 1] + p.widths[i]);
+                b.widest = b.widest.max(w);
+                let (a, c) = (p.points[i - 1], p.points[i]);
+                b.grid.push(lm.metric_point(a), lm.metric_point(c), w);
             }
         }
-        false
+        b
+    }
+
+    /// Whether a bead centred at `p` (the metric's frame), `half` mm to each side, lies more
+    /// than half inside these beads.
+    fn covers(&self, p: Point2, half: f64) -> bool {
+        self.grid.any_near(p, 0.5 * self.widest + half, |a, b, &w| {
+            crate::geom2d::seg_dist(p, a, b) - half < 0.5 * (w - half)
+        })
     }
 }
 
@@ -327,74 +353,44 @@ const RETRACE_SHARE: f64 = 0.25;
 const OWN_RUN: f64 = 4.0;
 
 /// The single beads a gap fill has laid, in the frame of the chart's metric (mm): segments in
-/// a grid of cells the retrace distance wide, each with the path it belongs to and how far along it it ends.
+/// a grid of cells the retrace distance wide, each with the path it belongs to and how far
+/// along it it ends.
 struct Laid {
     tol: f64,
-    cells: crate::fast_hash::FastMap<(i64, i64), Vec<usize>>,
-    /// Segments: ends, path number, length along the path at the second end.
-    segs: Vec<([f64; 2], [f64; 2], usize, f64)>,
+    grid: SegmentGrid<(usize, f64)>,
     /// The last point laid on the current path, and the length laid on it so far.
-    last: Option<([f64; 2], f64)>,
+    last: Option<(Point2, f64)>,
 }
 
 impl Laid {
     fn new(tol: f64) -> Laid {
         Laid {
             tol,
-            cells: Default::default(),
-            segs: vec![],
+            grid: SegmentGrid::new(tol),
             last: None,
         }
     }
 
-    fn cell(&self, p: [f64; 2]) -> (i64, i64) {
-        (
-            (p[0] / self.tol).floor() as i64,
-            (p[1] / self.tol).floor() as i64,
-        )
-    }
-
     /// Whether `p`, to be laid on path `path`, lies within the retrace distance of a stretch
     /// laid before: of another path, or of this one farther back than its own last run.
-    fn retraces(&self, p: [f64; 2], path: usize) -> bool {
+    fn retraces(&self, p: Point2, path: usize) -> bool {
         let along = self.last.map_or(0.0, |(_, s)| s);
-        let (cx, cy) = self.cell(p);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                let Some(list) = self.cells.get(&(cx + dx, cy + dy)) else {
-                    continue;
-                };
-                for &k in list {
-                    let (a, b, on, s) = self.segs[k];
-                    if on == path && s > along - OWN_RUN * self.tol {
-                        continue;
-                    }
-                    if crate::geom2d::seg_dist(p, a, b) < self.tol {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
+        self.grid.any_near(p, self.tol, |a, b, &(on, s)| {
+            !(on == path && s > along - OWN_RUN * self.tol)
+                && crate::geom2d::seg_dist(p, a, b) < self.tol
+        })
     }
 
     /// Lays `p` on path `path` (joined to the point laid before it on that path).
-    fn add(&mut self, p: [f64; 2], path: usize) {
-        if let Some((a, s)) = self.last {
-            let s = s + crate::geom2d::dist(a, p);
-            let k = self.segs.len();
-            self.segs.push((a, p, path, s));
-            // Every cell the segment's box touches (segments are short: a lattice step).
-            let (c0, c1) = (self.cell(a), self.cell(p));
-            for x in c0.0.min(c1.0)..=c0.0.max(c1.0) {
-                for y in c0.1.min(c1.1)..=c0.1.max(c1.1) {
-                    self.cells.entry((x, y)).or_default().push(k);
-                }
+    fn add(&mut self, p: Point2, path: usize) {
+        self.last = Some(match self.last {
+            Some((a, s)) => {
+                let s = s + crate::geom2d::dist(a, p);
+                self.grid.push(a, p, (path, s));
+                (p, s)
             }
-            self.last = Some((p, s));
-        } else {
-            self.last = Some((p, 0.0));
-        }
+            None => (p, 0.0),
+        });
     }
 
     /// The path laid on is done: the next point starts another.

@@ -56,6 +56,21 @@ impl FillPath {
         }
     }
 
+    /// The area its beads cover, mm²: each segment's length by `len` (the chord on the layer
+    /// surface, or in the plane) times its mean width; segments of no finite length count none.
+    pub fn strip_area(&self, len: impl Fn(Point2, Point2) -> f64) -> f64 {
+        (1..self.points.len())
+            .map(|i| {
+                let l = len(self.points[i - 1], self.points[i]);
+                if l.is_finite() {
+                    0.5 * (self.widths[i - 1] + self.widths[i]) * l
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    }
+
     /// The same path run the other way.
     pub fn reverse(&mut self) {
         self.points.reverse();
@@ -739,21 +754,7 @@ fn conserved(
     edge: f64,
     len: impl Fn(Point2, Point2) -> f64,
 ) -> Vec<FillPath> {
-    let covered: f64 = paths
-        .iter()
-        .map(|p| {
-            (1..p.points.len())
-                .map(|i| {
-                    let l = len(p.points[i - 1], p.points[i]);
-                    if l.is_finite() {
-                        0.5 * (p.widths[i - 1] + p.widths[i]) * l
-                    } else {
-                        0.0
-                    }
-                })
-                .sum::<f64>()
-        })
-        .sum();
+    let covered: f64 = paths.iter().map(|p| p.strip_area(&len)).sum();
     let held = lm.area_above(db, edge);
     if covered > 0.0 && (covered - held).abs() > ROUND_OFF * held {
         let k = (held / covered).min(MAX_CORE_WIDENING);
