@@ -29,11 +29,15 @@ pub(super) const MAX_LAST_RING_SCALE: f64 = 2.0;
 /// (`GAP_MIN_WIDTH_SHARE` over a bead).
 const MAX_SCALED_WIDTH: f64 = 1.1;
 
-/// Scales the narrowed beads of `paths` (narrower than the bead `width`) so that all of them
-/// cover `held` (mm² on the layer surface), segment by segment length (`len`) × mean width,
-/// by a factor above 0 and at most `max_scale`, no bead wider than [`MAX_SCALED_WIDTH`]
-/// beads; the full beads are kept. Nothing changes when there is no narrowed bead or the
-/// factor falls outside those bounds (the full beads alone cover what the region holds).
+/// Scales the beads of `paths` narrowed or widened to their room (other than the bead `width`)
+/// so that all of them cover `held` (mm² on the layer surface), segment by segment length
+/// (`len`) × mean width, by a factor above 0 and at most `max_scale`, no bead wider than
+/// [`MAX_SCALED_WIDTH`] beads; the beads of the nominal width are kept. A ring widened to its
+/// room keeps its middle where it was and so stands past a round region's rim more than it
+/// leaves bare inside (a pin 1.1 mm across: +6.1 %): it is scaled too. Where every bead is
+/// nominal (the core inside a ring too small for any gap fill: a pin 1.05 mm across, −3.0 %),
+/// all of them are scaled, by at most [`MAX_NOMINAL_SCALE`] either way, when they miss by
+/// more than [`NOMINAL_SLACK`]. Nothing changes where the factor is not positive.
 pub(super) fn conserve_core(
     paths: &mut [FillPath],
     held: f64,
@@ -41,8 +45,9 @@ pub(super) fn conserve_core(
     max_scale: f64,
     len: impl Fn(Point2, Point2) -> f64,
 ) {
-    let full = FULL_BEAD_SHARE * width;
-    let (mut covered_full, mut covered_narrow) = (0.0, 0.0);
+    let (full, wide) = (FULL_BEAD_SHARE * width, width / FULL_BEAD_SHARE);
+    let nominal = |w: f64| (full..=wide).contains(&w);
+    let (mut covered_nominal, mut covered_other) = (0.0, 0.0);
     for p in paths.iter() {
         for i in 1..p.points.len() {
             let l = len(p.points[i - 1], p.points[i]);
@@ -50,28 +55,48 @@ pub(super) fn conserve_core(
                 continue;
             }
             for w in [p.widths[i - 1], p.widths[i]] {
-                if w >= full {
-                    covered_full += 0.5 * w * l;
+                if nominal(w) {
+                    covered_nominal += 0.5 * w * l;
                 } else {
-                    covered_narrow += 0.5 * w * l;
+                    covered_other += 0.5 * w * l;
                 }
             }
         }
     }
-    if covered_narrow <= 0.0 || !held.is_finite() {
+    if !held.is_finite() {
         return;
     }
-    let k = (held - covered_full) / covered_narrow;
-    if k.is_nan() || k <= 0.0 || k > max_scale {
+    // The factor, and whether the nominal beads take it too.
+    let (k, all) = if covered_other > 0.0 {
+        ((held - covered_nominal) / covered_other, false)
+    } else if covered_nominal > 0.0 {
+        let k = held / covered_nominal;
+        if (k - 1.0).abs() <= NOMINAL_SLACK {
+            return;
+        }
+        (k.clamp(1.0 / MAX_NOMINAL_SCALE, MAX_NOMINAL_SCALE), true)
+    } else {
+        return;
+    };
+    if k.is_nan() || k <= 0.0 {
         return;
     }
+    let k = k.min(max_scale);
     let widest = MAX_SCALED_WIDTH * width;
     for p in paths.iter_mut() {
-        for w in p.widths.iter_mut().filter(|w| **w < full) {
+        for w in p.widths.iter_mut().filter(|w| all || !nominal(**w)) {
             *w = (*w * k).min(widest);
         }
     }
 }
+
+/// The most [`conserve_core`] scales beads of the nominal width by, either way, where no other
+/// bead can take what they miss.
+const MAX_NOMINAL_SCALE: f64 = 1.1;
+
+/// What beads of the nominal width may miss the area they cover by before [`conserve_core`]
+/// scales them: the lattice's area is exact at its vertices, linear between.
+const NOMINAL_SLACK: f64 = 0.005;
 
 #[cfg(test)]
 mod tests {
@@ -119,7 +144,11 @@ mod tests {
         // A pin 1.76 mm across was 5 % short, 1.66 mm 8.3 % (its ring on the lattice's
         // underestimated ridge and on chords of a small circle; 1.66 mm needs a scale of
         // 1.6). A pin 1.1 mm across is 4.7 % over, before and after (not this cause).
-        for d in [1.0, 1.2, 1.39, 1.5, 1.66, 1.76, 1.92, 2.4, 3.0, 4.0] {
+        let mut missed = vec![];
+        for d in [
+            0.9, 0.95, 1.0, 1.05, 1.1, 1.13, 1.15, 1.2, 1.25, 1.3, 1.39, 1.5, 1.66, 1.76, 1.92,
+            2.4, 3.0, 4.0,
+        ] {
             let r: f64 = 0.5 * d;
             let n = 96;
             let outer: Vec<Point2> = (0..n)
@@ -130,12 +159,11 @@ mod tests {
                 .collect();
             let area = crate::geom2d::area2(&outer) * 0.5;
             let rel = covered(&fill(outer)) / area - 1.0;
-            assert!(
-                rel.abs() <= WITHIN,
-                "pin {d} mm across: {:+.2} %",
-                100.0 * rel
-            );
+            if rel.abs() > WITHIN {
+                missed.push(format!("pin {d} mm across: {:+.2} %", 100.0 * rel));
+            }
         }
+        assert!(missed.is_empty(), "{}", missed.join("\n"));
     }
 
     #[test]
