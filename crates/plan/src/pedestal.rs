@@ -492,12 +492,16 @@ pub fn stand(
     drop(first);
     // The least pedestal that clears the table, with its check's result.
     let mut best: Option<(Stood, ToolPath, Avoided)> = None;
+    // The tallest's check when it leaves a hit (`least` asks for it last before giving up).
+    let mut tallest: Option<(Stood, ToolPath, Avoided)> = None;
     let fits = |n: usize| -> Result<bool, PedestalError> {
         let stood = build(&o, n);
         let (p, a) = check(&stood)?;
         let clear = table_hits(&a) == 0;
         if clear && best.as_ref().is_none_or(|(s, _, _)| n < s.layers) {
             best = Some((stood, p, a));
+        } else if !clear && n == max {
+            tallest = Some((stood, p, a));
         }
         Ok(clear)
     };
@@ -513,8 +517,14 @@ pub fn stand(
     // Not even the tallest: the height that would do, from how deep the head still reaches,
     // checked (the tilts found change with the height: a move cleared at one height may hit
     // at the next), and raised again from where it still hits, a few times.
-    let stood = build(&o, max);
-    let (p, a) = check(&stood)?;
+    let (stood, p, a) = match tallest {
+        Some(checked) => checked,
+        None => {
+            let stood = build(&o, max);
+            let (p, a) = check(&stood)?;
+            (stood, p, a)
+        }
+    };
     let moves = table_hits(&a);
     let mut n = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
     let mut cleared = false;
