@@ -61,6 +61,8 @@ pub struct Row {
     pub support: bool,
     /// The skirt's or the brim's bead (role `skirt` or `brim`), laid around the part.
     pub adhesion: bool,
+    /// A gap fill's bead (role `gap_fill`).
+    pub gap_fill: bool,
 }
 
 /// The rows of `toolpath.csv`, its header checked (other tools read these columns by place).
@@ -85,6 +87,7 @@ pub fn rows(csv: &str) -> Vec<Row> {
                 width: f(11),
                 support: c.get(12).is_some_and(|r| r.starts_with("support_material")),
                 adhesion: c.get(12).is_some_and(|r| *r == "skirt" || *r == "brim"),
+                gap_fill: c.get(12).is_some_and(|r| *r == "gap_fill"),
             }
         })
         .collect()
