@@ -396,6 +396,22 @@ pub struct Checked {
     pub warnings: Vec<String>,
 }
 
+impl Stood {
+    /// The pedestal of `n` layers `layer` mm thick under the outline `o`.
+    fn build(ctx: &Context, o: &Outline, n: usize, layer: f64) -> Stood {
+        let plan = layers(o, n, layer, ctx.id, ctx.params, ctx.bead);
+        let height = n as f64 * layer;
+        Stood {
+            id: ctx.id,
+            layers: n,
+            height,
+            volume: o.area * height,
+            normal: [o.plane.normal.x, o.plane.normal.y, o.plane.normal.z],
+            plan,
+        }
+    }
+}
+
 /// The head check (`avoid`: [`collisions::avoid`] with the machine and the features) of `path`
 /// (`planned` its planned axes) with the pedestal `ctx` asks for: `auto` checks the part as
 /// it is and, where moves hit the table, the part on pedestals of whole layers, keeping the
@@ -415,18 +431,7 @@ pub fn stand(
     } else {
         0
     };
-    let build = |o: &Outline, n: usize| {
-        let plan = layers(o, n, layer, ctx.id, ctx.params, ctx.bead);
-        let height = n as f64 * layer;
-        Stood {
-            id: ctx.id,
-            layers: n,
-            height,
-            volume: o.area * height,
-            normal: [o.plane.normal.x, o.plane.normal.y, o.plane.normal.z],
-            plan,
-        }
-    };
+    let build = |o: &Outline, n: usize| Stood::build(ctx, o, n, layer);
     let check = |stood: &Stood| {
         crate::in_time(ctx.stop_at).map_err(|_| PedestalError::TimeLimit)?;
         let (mut p, axes) = on_pedestal(&stood.plan, &path, &planned);
@@ -526,18 +531,13 @@ pub fn stand(
         }
     };
     let moves = table_hits(&a);
-    let mut n = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
-    let mut cleared = false;
-    for _ in 0..NAMED_TRIES {
+    let first = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
+    let (height, cleared) = named_height(first, layer, |n| {
         let s = build(&o, n);
         let (q, b) = check(&s)?;
-        if table_hits(&b) == 0 {
-            cleared = true;
-            break;
-        }
-        n = layer_count(s.height + lift_needed(&b, &q, ctx.machine), layer).max(n + 1);
-    }
-    let height = round(n as f64 * layer, 1e3);
+        let lift = lift_needed(&b, &q, ctx.machine);
+        Ok((table_hits(&b) == 0, s.height + lift))
+    })?;
     let e = if cleared {
         PedestalError::TooLow {
             max: max_height,
@@ -560,6 +560,28 @@ pub fn stand(
         pedestal: Some(stood),
         warnings: vec![e.to_string()],
     })
+}
+
+/// The height (mm) a refusal names where not even the tallest pedestal clears the table, and
+/// whether it was found to clear: from `first` layers, `check(n)` (whether `n` layers clear
+/// it, and how tall a pedestal the moves still hitting it ask for) raised again from where it
+/// still hits, [`NAMED_TRIES`] times at most.
+fn named_height(
+    first: usize,
+    layer: f64,
+    mut check: impl FnMut(usize) -> Result<(bool, f64), PedestalError>,
+) -> Result<(f64, bool), PedestalError> {
+    let mut n = first;
+    let mut cleared = false;
+    for _ in 0..NAMED_TRIES {
+        let (clear, wanted) = check(n)?;
+        if clear {
+            cleared = true;
+            break;
+        }
+        n = layer_count(wanted, layer).max(n + 1);
+    }
+    Ok((round(n as f64 * layer, 1e3), cleared))
 }
 
 #[cfg(test)]
