@@ -50,6 +50,10 @@ pub(crate) const FOOT_OFF_NORMAL: f64 = 1e-7;
 /// A surface's area element `|S_u × S_v|` at or below this is singular: no native chart.
 pub(crate) const AREA_ELEMENT_MIN: f64 = 1e-12;
 
+/// A hole whose area (mm²) is below this, a micrometre square, is the noise of a boolean
+/// between nearly coincident edges, not a hole in the part or its support.
+pub(crate) const NOISE_AREA: f64 = 1e-6;
+
 /// A contour whose doubled signed area (mm²) is at most this is empty.
 pub(crate) const EMPTY_AREA2: f64 = 1e-18;
 

@@ -1331,3 +1331,54 @@ fn crossing_sections_of_overlapping_solids_are_united_by_their_winding() {
         (total_area(&expect) - (100.0 - total_area(&regions_from_loops(&[inner])))).abs() < 1e-9
     );
 }
+
+#[test]
+fn holes_of_no_area_do_not_break_the_lines() {
+    // A boolean between nearly coincident edges leaves holes of 1e-16 to 1e-8 mm² (741 in
+    // one support column under the sphere fixture): each was grown by half a bead where the
+    // region was eroded for its lines, cutting a 0.45 mm gap into every line through it, and
+    // made the erosion take seconds.
+    let params = LayerParams {
+        path_mode: PathMode::Zigzag,
+        ..LayerParams::default()
+    };
+    let outer = rect(0.0, 0.0, 10.0, 6.0);
+    let noise: Vec<Vec<Point2>> = (0..40)
+        .map(|k| {
+            let (x, y) = (0.37 + 0.23 * k as f64, 0.5 + 0.12 * k as f64);
+            // A sliver triangle 1e-5 mm tall: 5e-6 mm² at most.
+            vec![[x, y], [x + 1e-5, y], [x, y + 1e-5]]
+        })
+        .collect();
+    let clean = Region {
+        outer: outer.clone(),
+        holes: vec![],
+    };
+    let noisy = Region {
+        outer,
+        holes: noise,
+    };
+    let lines = |r: &Region| -> Vec<Path2> {
+        fill_layer(std::slice::from_ref(r), &params, 0, 0.45, 0.45).paths
+    };
+    let (a, b) = (lines(&clean), lines(&noisy));
+    let length = |ps: &[Path2]| -> f64 {
+        ps.iter()
+            .flat_map(|p| p.points.windows(2))
+            .map(|s| (s[1][0] - s[0][0]).hypot(s[1][1] - s[0][1]))
+            .sum()
+    };
+    assert_eq!(
+        a.len(),
+        b.len(),
+        "paths: {} clean, {} with noise",
+        a.len(),
+        b.len()
+    );
+    assert!(
+        (length(&a) - length(&b)).abs() < 1e-6,
+        "{} vs {}",
+        length(&a),
+        length(&b)
+    );
+}
