@@ -93,6 +93,12 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
         let mut keep = vec![false; dense.len()];
         keep[0] = true;
         keep[dense.len() - 1] = true;
+        // The dense path's length from its start to each point.
+        let mut run = Vec::with_capacity(dense.len());
+        run.push(0.0);
+        for k in 1..dense.len() {
+            run.push(run[k - 1] + (dense[k].p - dense[k - 1].p).norm());
+        }
         let mut stack = vec![(0usize, dense.len() - 1)];
         while let Some((i, j)) = stack.pop() {
             if j <= i + 1 {
@@ -110,7 +116,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
             // Within the distance, the chord may still be shorter than the points it drops:
             // a path that doubles back inside the tolerance (the gap fill of a pin's core 0.2
             // mm across, a loop of nine points, was laid 45 % short).
-            let along: f64 = (i..j).map(|k| (dense[k + 1].p - dense[k].p).norm()).sum();
+            let along = run[j] - run[i];
             let long_enough = along - (b - a).norm() <= LENGTH_SLACK * along;
             if worst > 0.5 * tol || !long_enough {
                 if at == i {
@@ -186,12 +192,7 @@ mod tests {
             role: Role::GapFill,
         };
         for path in [scribble, zigzag] {
-            let want: f64 = path
-                .points
-                .windows(2)
-                .zip(path.widths.windows(2))
-                .map(|(p, w)| 0.5 * (w[0] + w[1]) * (p[1][0] - p[0][0]).hypot(p[1][1] - p[0][1]))
-                .sum();
+            let want = path.strip_area(crate::geom2d::dist);
             let kept = lift(&chart, &path, 0.0, tol);
             let got = strip(&kept);
             assert!(

@@ -130,7 +130,8 @@ pub fn fill_regions_with(
         .into_iter()
         .partition(|r| rings && thinner_than(r, thin_depth(params, width, spacing)));
     let mut paths: Vec<FillPath> = vec![];
-    let mut filled = crate::fill::FilledLayer::default();
+    // What the rings of the thick regions leave, and their sparse area and its density.
+    let (mut gaps, mut sparse_area, mut density) = (vec![], 0.0, 0.0);
     for r in &thick {
         let one = fill_layer_with(
             std::slice::from_ref(r),
@@ -150,9 +151,9 @@ pub fn fill_regions_with(
             conserve_solid_infill(&mut laid, region_area(r) - gaps);
         }
         paths.extend(laid);
-        filled.gaps.extend(one.gaps);
-        filled.sparse_area += one.sparse_area;
-        filled.sparse_density = one.sparse_density;
+        gaps.extend(one.gaps);
+        sparse_area += one.sparse_area;
+        density = one.sparse_density;
     }
     for r in &thin {
         paths.extend(fill_flat_region(
@@ -164,7 +165,7 @@ pub fn fill_regions_with(
             Boundary::Part,
         ));
     }
-    for r in &filled.gaps {
+    for r in &gaps {
         paths.extend(fill_flat_region(
             r,
             params,
@@ -174,8 +175,7 @@ pub fn fill_regions_with(
             Boundary::Beads,
         ));
     }
-    let laid = filled.sparse_area * filled.sparse_density;
-    (paths, (filled.sparse_area, laid))
+    (paths, (sparse_area, sparse_area * density))
 }
 
 /// Widens the solid infill lines of one region's fill (`laid`: its rings and lines, beads of

@@ -381,19 +381,14 @@ pub(crate) fn fill_columns(
             )
         })
         .collect();
-    let mut run = 0;
-    (0..regions.sparse.len())
-        .map(|k| {
-            if run + 1 < firsts.len() && firsts[run + 1] == k {
-                run += 1;
-            }
-            sparse.get(run).cloned().unwrap_or_default()
-        })
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .zip(regions.interface.par_iter())
+    // Layer k's sparse lines: those of the last first layer at or below it.
+    let first_below = |k: usize| firsts.partition_point(|&f| f <= k).saturating_sub(1);
+    regions
+        .interface
+        .par_iter()
         .enumerate()
-        .map(|(k, (mut paths, interface))| {
+        .map(|(k, interface)| {
+            let mut paths = sparse.get(first_below(k)).cloned().unwrap_or_default();
             paths.extend(fill(
                 interface,
                 k,
