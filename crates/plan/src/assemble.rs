@@ -168,6 +168,8 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
         print_length_mm: round(f.print_length, 1e3),
         travel_length_mm: round(f.travel_length, 1e3),
         extruded_volume_mm3: round(f.extruded, 1e3),
+        expected_volume_mm3: round(f.planned.expected(), 1e3),
+        sparse_volume_mm3: round(f.planned.sparse, 1e3),
         widened_volume_mm3: round(f.widened, 1e3),
         support_volume_mm3: round(f.support_volume, 1e3),
         below_resolution: f

@@ -89,7 +89,7 @@ pub fn head_check(
     })?;
     let pedestal_planned = stood.pedestal.as_ref().map(|p| {
         let area = machine.bead().filament_area();
-        p.planned(area, params.filling_ratio, params.infill_density)
+        p.planned(area)
     });
     Ok(Checked {
         pedestal_planned,

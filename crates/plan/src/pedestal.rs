@@ -284,6 +284,10 @@ pub struct Stood {
     pub volume: f64,
     /// The plate's normal (+Z).
     pub normal: [f64; 3],
+    /// The `filling_ratio` and `infill_density` it is laid with (the base feature's).
+    pub fill: f64,
+    /// See `fill`.
+    pub density: f64,
 }
 
 impl Stood {
@@ -310,6 +314,8 @@ impl Stood {
             print_length_mm: round(fig.print_length, 1e3),
             travel_length_mm: round(fig.travel_length, 1e3),
             extruded_volume_mm3: round(fig.filament * filament_area, 1e3),
+            expected_volume_mm3: round(self.planned(filament_area).expected(), 1e3),
+            sparse_volume_mm3: round(fig.sparse_volume, 1e3),
             widened_volume_mm3: 0.0,
             support_volume_mm3: 0.0,
             below_resolution: None,
@@ -335,14 +341,14 @@ impl Stood {
     /// What the self-check is asked of it: extruded within its tolerance of the prism's volume
     /// × `fill` (the base feature's `filling_ratio`), its sparse layers' volume at `density`
     /// (the base feature's `infill_density`).
-    pub fn planned(&self, filament_area: f64, fill: f64, density: f64) -> PlannedFeature {
+    pub fn planned(&self, filament_area: f64) -> PlannedFeature {
         PlannedFeature {
             id: self.id,
             kind: KIND.to_string(),
             volume: self.volume,
-            fill,
+            fill: self.fill,
             sparse: self.plan.figures.sparse_volume,
-            density: self.plan.figures.sparse_density(density),
+            density: self.plan.figures.sparse_density(self.density),
             layers: self.plan.figures.layers,
             extruded: self.plan.figures.filament * filament_area,
             tolerance: slicer::verify::VOLUME_TOLERANCE,
@@ -407,6 +413,8 @@ impl Stood {
             height,
             volume: o.area * height,
             normal: [o.plane.normal.x, o.plane.normal.y, o.plane.normal.z],
+            fill: ctx.params.filling_ratio,
+            density: ctx.params.infill_density,
             plan,
         }
     }

@@ -149,6 +149,13 @@ pub struct FeatureReport {
     /// Bead volume planned for the feature (Eq. 1 filament × filament area), mm³: what the
     /// self-check compares with the feature's volume.
     pub extruded_volume_mm3: f64,
+    /// What the self-check expects it to extrude, mm³: the volume laid solid × `filling_ratio`
+    /// and the volume of its layers laid sparse (issue 33) × the infill's density
+    /// (`slicer::verify::PlannedFeature::expected`); the check passes within ±3 %.
+    pub expected_volume_mm3: f64,
+    /// Volume of its layers laid as sparse infill, mm³ (each layer's sparse area × its
+    /// thickness, planar or curved); 0 when solid.
+    pub sparse_volume_mm3: f64,
     /// Bead volume added over that by widening beads narrower than the machine's
     /// `min_bead_width` to it, mm³ (the program lays both).
     pub widened_volume_mm3: f64,

@@ -220,7 +220,7 @@ fn gyroid_solve(t: f64, sz: f64, cz: f64, along_x: bool, branch: usize) -> f64 {
 /// The gyroid's period (mm) for beads `width` wide covering `density` of the area: each period
 /// square holds two lines, each `stretch` periods long ([`gyroid_stretch`]), so the beads
 /// cover `2·stretch·width / period` of it.
-fn gyroid_period(width: f64, density: f64) -> f64 {
+pub(crate) fn gyroid_period(width: f64, density: f64) -> f64 {
     2.0 * gyroid_stretch() * width / density
 }
 

@@ -7,6 +7,7 @@
 mod border;
 mod conserve;
 mod gap;
+pub(crate) mod sparse;
 mod spurs;
 #[cfg(test)]
 mod tests;
@@ -155,9 +156,32 @@ pub(crate) fn fill_region(
     spacing: f64,
     sliver_inset: f64,
 ) -> Vec<FillPath> {
+    fill_region_with(
+        chart,
+        region,
+        z,
+        params,
+        (layer, width, spacing, sliver_inset),
+        None,
+    )
+    .0
+}
+
+/// [`fill_region`], and with `sparse` (a curved layer of a feature with sparse infill,
+/// [`sparse::CurvedSparse`]) its infill lines solid on the layer's skin only and the sparse
+/// pattern's elsewhere, with the sparse volume that lays.
+pub(crate) fn fill_region_with(
+    chart: &Chart,
+    region: &Region,
+    z: f64,
+    params: &LayerParams,
+    (layer, width, spacing, sliver_inset): (usize, f64, f64, f64),
+    sparse: Option<&sparse::CurvedSparse>,
+) -> (Vec<FillPath>, sparse::SparseVolume) {
+    let none = sparse::SparseVolume::default();
     let mut out = vec![];
     let Some(lm) = lifted_mesh(chart, region, z, spacing) else {
-        return out;
+        return (out, none);
     };
     // Exact distances (to the lifted boundary) three spacings deep: the rings of the default
     // contour-zig-zag, the infill's edge and a thin blade's ridge all lie there, so they do
@@ -208,7 +232,7 @@ pub(crate) fn fill_region(
                 conserve::MAX_LAST_RING_SCALE,
                 |a, b| surface_length(chart, z, a, b),
             );
-            return out;
+            return (out, none);
         }
         // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
         // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
@@ -221,7 +245,7 @@ pub(crate) fn fill_region(
                 below: f64::INFINITY,
             };
             out.extend(core_fill(gap));
-            return out;
+            return (out, none);
         }
         None => 0.5 * width,
     };
@@ -240,10 +264,10 @@ pub(crate) fn fill_region(
         0.0
     };
     let Some((lo, hi)) = level_span(&lm, &phi, &db, edge) else {
-        return out;
+        return (out, none);
     };
     if (hi - lo) / spacing > 1e5 {
-        return out;
+        return (out, none);
     }
     // Lines a whole number of spacings across the infill area, centred on it: the spacing
     // and the bead width with it (Eq. 1 extrudes for that width) stretch or shrink so that
@@ -251,11 +275,12 @@ pub(crate) fn fill_region(
     // slicer's solid infill does. At the nominal spacing a region a few beads across kept a
     // strip up to a spacing wide unfilled beside its outer lines (7–10 % of a small boss's
     // layer).
+    let (width0, spacing0) = (width, spacing);
     let n = ((hi - lo) / spacing).round().max(1.0);
     let step = (hi - lo) / n;
     let width = width * step / spacing;
     if width < 0.2 * spacing {
-        return out;
+        return (out, none);
     }
     let spacing = step;
     let (j0, j1) = (0i64, n as i64 - 1);
@@ -291,7 +316,29 @@ pub(crate) fn fill_region(
             surface_length(chart, z, a, b)
         }));
     }
-    out
+    // Sparse infill (issue 33): the solid lines kept on the skin, the pattern's elsewhere.
+    let Some(sparse) = sparse.filter(|s| s.skin.is_some()) else {
+        return (out, none);
+    };
+    let frame = (lm.q[deep], raster_dir(params, false), spacing0);
+    match sparse::sparse_lines(
+        &lm,
+        chart,
+        z,
+        &db,
+        edge,
+        frame,
+        (params, layer, width0),
+        sparse,
+    ) {
+        None => (out, none),
+        Some((lines, volume)) => {
+            let solid = out.split_off(from);
+            out.extend(sparse::split_by(solid, |q| sparse.in_skin(q)).0);
+            out.extend(lines);
+            (out, volume)
+        }
+    }
 }
 
 /// The infill's pieces as paths onto `out`: zig-zag, each line's end joined to the nearest end
