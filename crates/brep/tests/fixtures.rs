@@ -73,6 +73,13 @@ fn fixtures_match_reference_figures() {
             }
         };
         let b = &part.brep;
+        // Every fixture's shells are consistent and its entities valid (issue 34): the reader
+        // turns no face round and warns of no entity as unknown.
+        for w in &b.warnings {
+            if w.contains("turned round") || w.contains("unknown entity") {
+                failures.push(format!("{name}: {w}"));
+            }
+        }
         let want_solids = r["solids"].as_u64().unwrap_or(0) as usize;
         if b.solids.len() != want_solids {
             failures.push(format!(
