@@ -2,10 +2,14 @@
 # Our estimated printing time against PrusaSlicer's for the same planar part: plans PART
 # (default fixtures/plate_boss_boss.step) for the built-in Marlin profile, meshes it
 # (`features mesh --tolerance 0.01`) and slices the STL with `prusa-slicer` ($PRUSA_SLICER)
-# at the same layers (0.2 mm), beads (0.45 mm), 2 perimeters, 100 % rectilinear fill, speeds,
+# at the same layers (0.2 mm), beads (0.45 mm apart, the same section: see w below), 2 perimeters, 100 % rectilinear fill, speeds,
 # retraction and motion limits as profiles/marlin.toml (40 mm/s printing, 20 on the first
 # layer, 120 travel; 1000 / 1500 mm/s^2, jerk 10 mm/s, 200 mm/s caps; cooling slow-downs
-# off), then prints each program's estimate and filament. Needs a release build of
+# off; support where overhangs pass 50 degrees from vertical, as ours: 0.2 mm contact gap,
+# 0.5 mm beside the part, lines 2.25 mm apart with 2 interface layers 0.64 mm apart, on both;
+# no skirt on either), then prints each program's estimate and the filament of the part and of its support
+# (scripts/filament_by_type.awk: by ;TYPE:, the skirt and the start G-code's purge line left out).
+# KEEP=DIR keeps both programs there. Needs a release build of
 # `features` ($FEATURES, else target/release/features).
 #
 # Sparse infill (issue 33): DENSITY (0-1, default 1: solid) and PATTERN (rectilinear, grid,
@@ -24,12 +28,17 @@ scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 density=${DENSITY:-1}
 pattern=${PATTERN:-rectilinear}
-set -- --set "infill_density=$density" --set "infill_pattern=$pattern"
+set -- --set "infill_density=$density" --set "infill_pattern=$pattern" --set skirt_loops=0
 [ -n "${SLICING:-}" ] && set -- "$@" --set "slicing=$SLICING"
 "$features" plan "$part" --machine marlin "$@" -o "$scratch/ours" >/dev/null
 percent=$(awk -v d="$density" 'BEGIN { printf "%g%%", 100 * d }')
 "$features" mesh "$part" --tolerance 0.01 -o "$scratch/part.stl" >/dev/null
-w=0.45
+# The same bead: ours is 0.45 mm wide, its lines 0.45 mm apart, its section 0.45 x 0.2 mm.
+# PrusaSlicer's extrusion width is the outer width of a section with rounded sides, its lines
+# (width - h (1 - pi/4)) apart, so 0.45 would lay its lines 0.407 mm apart and 11 % more of
+# them for the same filament. Given 0.45 + h (1 - pi/4) = 0.493 mm it lays ours: the same
+# spacing and section. PRUSA_WIDTH overrides it.
+w=${PRUSA_WIDTH:-$(awk 'BEGIN { printf "%.3f", 0.45 + 0.2 * (1 - atan2(1, 1)) }')}
 "$prusa" --export-gcode --loglevel 1 --gcode-flavor marlin2 \
     --layer-height 0.2 --first-layer-height 0.2 --fill-density "$percent" --fill-pattern "$pattern" \
     --top-solid-layers 4 --bottom-solid-layers 3 \
@@ -47,6 +56,11 @@ w=0.45
     --machine-max-acceleration-travel 1500 --machine-max-acceleration-x 1500 \
     --machine-max-acceleration-y 1500 --machine-max-jerk-x 10 --machine-max-jerk-y 10 \
     --machine-max-feedrate-x 200 --machine-max-feedrate-y 200 \
+    --support-material --support-material-auto --support-material-threshold 40 \
+    --support-material-contact-distance 0.2 --support-material-xy-spacing 0.5 \
+    --support-material-spacing 1.8 --support-material-interface-layers 2 \
+    --support-material-interface-spacing 0.19 --no-support-material-with-sheath \
+    --no-dont-support-bridges \
     --no-cooling --temperature 210 --bed-temperature 60 \
     -o "$scratch/prusa.gcode" "$scratch/part.stl" >/dev/null
 for who in ours prusa; do
@@ -55,6 +69,7 @@ for who in ours prusa; do
         prusa) g="$scratch/prusa.gcode" ;;
     esac
     t=$(grep -m1 '^; estimated printing time (normal mode)' "$g" | sed 's/.*= //')
-    f=$(grep -m1 '^; filament used \[mm\]' "$g" | sed 's/.*= //')
-    echo "$who: $t, filament $f mm"
+    f=$(awk -f scripts/filament_by_type.awk "$g" | tail -1 | sed 's/^ *//')
+    echo "$who: $t, filament: $f"
+    [ -n "${KEEP:-}" ] && mkdir -p "$KEEP" && cp "$g" "$KEEP/$who.gcode"
 done
