@@ -231,6 +231,14 @@ impl NurbsSurfaceData {
     }
 }
 
+/// Grid samples a B-spline projection starts from, nearest first, until one lands on the
+/// surface ([`Surface::project`]).
+const GRID_STARTS: usize = 8;
+/// The most grid samples of a B-spline's direction for [`GRID_STARTS`]: its spans × (degree
+/// + 1) up to this (64 left a helical flank of 13 turns sampled 7 mm apart along the helix, its
+/// turns 1.5 mm apart).
+const GRID_MAX: usize = 512;
+
 impl Surface {
     /// The point at `(u, v)`.
     pub fn eval(&self, u: f64, v: f64) -> P3 {
@@ -702,20 +710,31 @@ impl Surface {
                 self.polish(p, (u, v))
             }
             Surface::Nurbs(n) => {
-                let start = match hint {
-                    Some(h) => {
-                        let q = self.polish(p, h);
-                        // Points of other writers lie off the surface by their modelling tolerance.
-                        if (self.eval(q.0, q.1) - p).norm()
-                            < 1e-4f64.max(POINT_COINCIDENCE * (1.0 + p.coords.norm()))
-                        {
-                            return q;
-                        }
-                        self.grid_start(p, n)
+                // Points of other writers lie off the surface by their modelling tolerance.
+                let near = 1e-4f64.max(POINT_COINCIDENCE * (1.0 + p.coords.norm()));
+                let off = |q: (f64, f64)| (self.eval(q.0, q.1) - p).norm();
+                if let Some(h) = hint {
+                    let q = self.polish(p, h);
+                    if off(q) < near {
+                        return q;
                     }
-                    None => self.grid_start(p, n),
-                };
-                self.polish(p, start)
+                }
+                // From the nearest samples of a grid over the surface, the best foot: the
+                // nearest sample alone can lie on the wrong turn of a helical flank (turns
+                // 1.5 mm apart), where the search stops on a foot a turn away or on the
+                // surface's edge.
+                let mut best: Option<((f64, f64), f64)> = None;
+                for start in self.grid_starts(p, n, GRID_STARTS) {
+                    let q = self.polish(p, start);
+                    let d = off(q);
+                    if best.is_none_or(|(_, b)| d < b) {
+                        best = Some((q, d));
+                    }
+                    if d < near {
+                        break;
+                    }
+                }
+                best.map_or_else(|| self.polish(p, (n.u.0, n.v.0)), |(q, _)| q)
             }
             Surface::Offset { basis, .. } => {
                 let uv = basis.project(p, hint);
@@ -724,10 +743,12 @@ impl Surface {
         }
     }
 
-    fn grid_start(&self, p: &P3, n: &NurbsSurfaceData) -> (f64, f64) {
+    /// The `k` samples of a grid over the surface nearest to `p` (nearest first), as `(u, v)`:
+    /// starts for [`Surface::polish`].
+    fn grid_starts(&self, p: &P3, n: &NurbsSurfaceData, k: usize) -> Vec<(f64, f64)> {
         let (nu, nv, pts) = n.samples.get_or_init(|| {
-            let nu = (n.spans.0 * (n.degree.0 + 1)).clamp(8, 64);
-            let nv = (n.spans.1 * (n.degree.1 + 1)).clamp(8, 64);
+            let nu = (n.spans.0 * (n.degree.0 + 1)).clamp(8, GRID_MAX);
+            let nv = (n.spans.1 * (n.degree.1 + 1)).clamp(8, GRID_MAX);
             let mut pts = Vec::with_capacity((nu + 1) * (nv + 1));
             for i in 0..=nu {
                 let u = n.u.0 + (n.u.1 - n.u.0) * i as f64 / nu as f64;
@@ -738,17 +759,27 @@ impl Surface {
             }
             (nu, nv, pts)
         });
-        let best = pts
+        let mut by: Vec<(f64, usize)> = pts
             .iter()
             .enumerate()
             .map(|(k, q)| ((q - p).norm_squared(), k))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map_or(0, |x| x.1);
-        let (i, j) = (best / (nv + 1), best % (nv + 1));
-        (
-            n.u.0 + (n.u.1 - n.u.0) * i as f64 / *nu as f64,
-            n.v.0 + (n.v.1 - n.v.0) * j as f64 / *nv as f64,
-        )
+            .collect();
+        let k = k.min(by.len());
+        if k == 0 {
+            return vec![];
+        }
+        by.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+        by.truncate(k);
+        by.sort_by(|a, b| a.0.total_cmp(&b.0));
+        by.into_iter()
+            .map(|(_, best)| {
+                let (i, j) = (best / (nv + 1), best % (nv + 1));
+                (
+                    n.u.0 + (n.u.1 - n.u.0) * i as f64 / *nu as f64,
+                    n.v.0 + (n.v.1 - n.v.0) * j as f64 / *nv as f64,
+                )
+            })
+            .collect()
     }
 
     /// Gauss–Newton steps towards the foot point of `p`, staying inside bounded ranges.

@@ -29,7 +29,8 @@
 //! both processes use the threads they want.
 //!
 //! `cargo bench -p features-cli --bench plan_speed [-- [--runs N] PART[:MACHINE] ...]`: a PART is
-//! a fixture name or a `.step` path; the machine is `delta5`, `marlin` or `kuka` (default: the
+//! a fixture name or a `.step` path (relative to the workspace if not found where cargo runs it,
+//! e.g. `fixtures/big/block_5l.step`); the machine is `delta5`, `marlin` or `kuka` (default: the
 //! table below, else `delta5`). Default parts: impeller, fan, sphere_boss (delta5) and
 //! plate_boss_boss (marlin). Without `prusa-slicer` on the PATH (or `$PRUSA_SLICER`) ours alone
 //! is measured, and the output says so. Files are left in `target/tmp/plan_speed/`.
@@ -336,7 +337,14 @@ fn main() {
             _ => (a.as_str(), None),
         };
         let path = if part.ends_with(".step") || part.ends_with(".stp") {
-            PathBuf::from(part)
+            // Relative to where cargo was run, or else to the workspace (cargo runs benches
+            // in the crate's directory).
+            let given = PathBuf::from(part);
+            if given.is_relative() && !given.exists() {
+                root.join(given)
+            } else {
+                given
+            }
         } else {
             root.join("fixtures").join(format!("{part}.step"))
         };
