@@ -234,9 +234,9 @@ impl NurbsSurfaceData {
 /// Grid samples a B-spline projection starts from, nearest first, until one lands on the
 /// surface ([`Surface::project`]).
 const GRID_STARTS: usize = 8;
-/// The most grid samples of a B-spline's direction for [`GRID_STARTS`]: its spans × (degree
-/// + 1) up to this (64 left a helical flank of 13 turns sampled 7 mm apart along the helix, its
-/// turns 1.5 mm apart).
+/// The most grid samples of a B-spline's direction for [`GRID_STARTS`]: its spans times its
+/// degree plus one, up to this (64 left a helical flank of 13 turns sampled 7 mm apart along
+/// the helix, its turns 1.5 mm apart).
 const GRID_MAX: usize = 512;
 
 impl Surface {
