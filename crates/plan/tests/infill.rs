@@ -21,6 +21,11 @@ fn fixture(name: &str) -> brep::StepPart {
 
 /// `name` planned on Marlin with `[defaults]` set to `toml`; the plan must pass every gate.
 fn planned(name: &str, part: &brep::StepPart, toml: &str) -> plan::Plan {
+    planned_on(MachineKind::Marlin, name, part, toml)
+}
+
+/// `name` planned on the built-in profile `kind` with `[defaults]` set to `toml`.
+fn planned_on(kind: MachineKind, name: &str, part: &brep::StepPart, toml: &str) -> plan::Plan {
     let process = Process::from_toml(&format!("[defaults]\n{toml}"))
         .unwrap_or_else(|e| panic!("{toml}: {e}"));
     let options = Options {
@@ -28,7 +33,7 @@ fn planned(name: &str, part: &brep::StepPart, toml: &str) -> plan::Plan {
         stem: "part".into(),
         ..Default::default()
     };
-    let machine = MachineProfile::builtin(MachineKind::Marlin);
+    let machine = MachineProfile::builtin(kind);
     plan(part, &process, &machine, &options).unwrap_or_else(|e| panic!("{name} {toml}: {e}"))
 }
 
@@ -217,15 +222,7 @@ fn the_keys_are_checked() {
 
 /// `name` planned on the 5-axis printer with `[defaults]` set to `toml`.
 fn planned_delta5(name: &str, part: &brep::StepPart, toml: &str) -> plan::Plan {
-    let process = Process::from_toml(&format!("[defaults]\n{toml}"))
-        .unwrap_or_else(|e| panic!("{toml}: {e}"));
-    let options = Options {
-        source: name.into(),
-        stem: "part".into(),
-        ..Default::default()
-    };
-    let machine = MachineProfile::builtin(MachineKind::Delta5);
-    plan(part, &process, &machine, &options).unwrap_or_else(|e| panic!("{name} {toml}: {e}"))
+    planned_on(MachineKind::Delta5, name, part, toml)
 }
 
 /// Curved layers (issue 33 item 1, "the same rule along the layer stack"): sphere_boss's
