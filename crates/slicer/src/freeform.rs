@@ -35,16 +35,14 @@ use crate::feature_mesh::{feature_mesh, slicing_tolerance};
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FreeformFigures;
 use crate::figures::{FeatureFigures, LayerChart, Layering};
-use crate::fill::regions_from_loops;
 use crate::fold::{check_folds, fold_check};
-use crate::geom2d::{dist2, segment_foot, Point2, Region, RegionIndex};
+use crate::geom2d::{dist2, segment_foot, Point2, Region};
 use crate::lift::{lift, Lifted};
 use crate::params::{LayerParams, LayerStrategy, PathMode, WallOrientation};
-use crate::region_fill::sparse::{CurvedSparse, SparseVolume};
-use crate::region_fill::{corner_spurs_beside, fill_region_with, order_fill_paths, SLIVER_INSET};
+use crate::region_fill::order_fill_paths;
 use crate::sst::{Sides, WALL_REACH};
 use crate::support::{reach, sliver_area};
-use crate::tolerance::{FLAT_CURVATURE, HEIGHT_SLACK, MICROMETRE, SHORT_VECTOR};
+use crate::tolerance::{FLAT_CURVATURE, MICROMETRE, SHORT_VECTOR};
 use crate::toolpath::{Bead, MoveKind, PathPoint, Role};
 use crate::transition::{band, build_top_field, levels, top_faces, Levels, TopField};
 
@@ -115,10 +113,13 @@ fn clip_paths(paths: Vec<FillPath>, keep: impl Fn(Point2) -> bool) -> Vec<FillPa
 }
 use brep::math::{P3, V3};
 use brep::mesh::Mesh;
-use brep::section::{section, Plane};
+use brep::section::Plane;
 use brep::surface::Surface;
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
+
+mod layers;
+use layers::{fill_stack, LayerFill};
 
 pub use crate::chart::{Chart, ChartKind};
 pub use crate::region_fill::{fill_flat_region, Boundary, FillPath};
@@ -294,84 +295,17 @@ pub fn fill_freeform<'a>(
         }
         (chart.blended(field), m, field)
     });
-    // Each layer's regions: the section of its mesh at its middle.
-    let sections: Vec<Vec<Region>> = tops
-        .par_iter()
-        .enumerate()
-        .map(|(layer, &(mid, _))| {
-            let mesh = match &blended {
-                Some((_, m, _)) if layer >= offset_layers => m,
-                _ => &mapped,
-            };
-            layer_regions(mesh, &up, mid)
-        })
-        .collect();
-    // Sparse infill (issue 33): each layer's skin along the stack, as on planar layers.
-    let n = sections.len();
-    let skins = params.sparse_infill().then(|| {
-        let (top, bottom) = (params.top_solid_layers, params.bottom_solid_layers);
-        let same = vec![false; n];
-        crate::skins::skins(&sections, &same, top, bottom, bead.width, params.tolerance)
-    });
-    // Each layer's middle along the stack, mm (the gyroid's height).
-    let along: Vec<f64> = heights
-        .iter()
-        .scan(0.0, |z, &dl| {
-            *z += dl;
-            Some(*z - 0.5 * dl)
-        })
-        .collect();
-    let filled: Vec<(LayerFill, SparseVolume)> = sections
-        .into_par_iter()
-        .enumerate()
-        .map(|(layer, regions)| {
-            let (chart, clip) = match &blended {
-                Some((c, _, _)) if layer >= offset_layers => (c, None),
-                // Offset layers under a transition band: only where the band stays above.
-                Some((_, _, field)) => (&chart, Some((*field, tops[layer].1))),
-                None => (&chart, None),
-            };
-            let dl = heights[layer];
-            let thickness = |q: Point2| match (&blend, clip) {
-                (Some((field, k, _)), None) if layer >= offset_layers => {
-                    (field.height(q) - field.lower(q)) / *k as f64
-                }
-                (_, Some((field, z))) if field.lower(q) < z - HEIGHT_SLACK => 0.0,
-                _ => dl,
-            };
-            // Within the solid layers of the first or the last layer: all skin.
-            let all = layer < params.bottom_solid_layers || layer + params.top_solid_layers >= n;
-            let index: Option<Vec<RegionIndex>> = skins.as_ref().map(|s| match all {
-                true => vec![],
-                false => s[layer].iter().map(RegionIndex::new).collect(),
-            });
-            let sparse = index.as_ref().map(|i| CurvedSparse {
-                skin: (!all).then_some(i.as_slice()),
-                thickness: &thickness,
-                height: along[layer],
-            });
-            let at = (layer, n, tops[layer].1);
-            fill_layer(
-                chart,
-                regions,
-                clip,
-                at,
-                params,
-                (bead.width, spacing),
-                sparse.as_ref(),
-            )
-        })
-        .collect();
-    let mut sparse_total = SparseVolume::default();
-    let filled: Vec<LayerFill> = filled
-        .into_iter()
-        .map(|(f, v)| {
-            sparse_total += v;
-            f
-        })
-        .collect();
-    fig.sparse_volume = sparse_total.volume;
-    fig.sparse_laid = sparse_total.laid;
+    let (filled, sparse) = fill_stack(
+        (&chart, &mapped),
+        blended.as_ref(),
+        blend.as_ref(),
+        (&tops, &heights, offset_layers),
+        &up,
+        params,
+        (bead.width, spacing),
+    );
+    fig.sparse_volume = sparse.volume;
+    fig.sparse_laid = sparse.laid;
     drop(blended);
     Ok(FreeformFill {
         id,
@@ -511,62 +445,6 @@ fn choose_blend(
             }
         }
     })
-}
-
-/// One layer's regions and fill paths in the chart.
-type LayerFill = (Vec<Region>, Vec<FillPath>);
-
-/// One layer's regions: the section of its mapped mesh at `mid`.
-fn layer_regions(mapped: &Mesh, up: &Plane, mid: f64) -> Vec<Region> {
-    let loops: Vec<Vec<Point2>> = section(mapped, &up.offset(mid))
-        .iter()
-        .map(|l| l.iter().map(|p| [p.x, p.y]).collect())
-        .collect();
-    regions_from_loops(&loops)
-}
-
-/// One layer's fill paths at offset `z` (`at`: the layer, the number of layers and `z`) over
-/// its `regions`, clipped to where the transition band `clip` stays above, skins made solid;
-/// with `sparse`, its sparse infill and the volume laid sparse.
-fn fill_layer(
-    chart: &Chart,
-    regions: Vec<Region>,
-    clip: Option<(&TopField, f64)>,
-    (layer, layers, z): (usize, usize, f64),
-    params: &LayerParams,
-    (bead_width, spacing): (f64, f64),
-    sparse: Option<&CurvedSparse>,
-) -> (LayerFill, SparseVolume) {
-    let spacing = params
-        .spacing_for_layer(bead_width, layer)
-        .max(MICROMETRE)
-        .min(spacing.max(MICROMETRE) * 1e3);
-    let mut paths = vec![];
-    let mut volume = SparseVolume::default();
-    for r in &regions {
-        let (fill, v) = fill_region_with(
-            chart,
-            r,
-            z,
-            params,
-            (layer, bead_width, spacing, SLIVER_INSET * bead_width),
-            sparse,
-        );
-        volume += v;
-        let spurs = corner_spurs_beside(chart, r, z, bead_width, &fill);
-        paths.extend(fill);
-        paths.extend(spurs);
-    }
-    if let Some((field, z)) = clip {
-        paths = clip_paths(paths, |q| field.lower(q) >= z - HEIGHT_SLACK);
-    }
-    (
-        (
-            regions,
-            crate::region_fill::solid_on_skins(paths, layer, layers),
-        ),
-        volume,
-    )
 }
 
 impl FreeformFill<'_> {

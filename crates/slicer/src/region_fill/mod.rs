@@ -212,42 +212,13 @@ pub(crate) fn fill_region_with(
     // from the edge of the last ring's bead instead, filling the gap.
     // The gap fill of all that is left farther in than `gap.edge` (no ring or line beyond
     // it), within what that core holds.
-    let core_fill = |gap: Gap| core_fill(&lm, &db, chart, z, gap, width);
-    let inner = match last_ring {
-        Some(c) if dmax > c + 1.5 * spacing => c + spacing,
-        Some(c) => {
-            // The strip along the ridge that the last ring's bead leaves.
-            let edge = c + 0.5 * width;
-            let gap = Gap {
-                edge,
-                inset: GAP_INSET * width,
-                min_width: GAP_MIN_WIDTH_SHARE * width,
-                below: f64::INFINITY,
-            };
-            out.extend(core_fill(gap));
-            conserve::conserve_core(
-                &mut out[last_ring_from..],
-                lm.area_above(&db, c - 0.5 * width),
-                width,
-                conserve::MAX_LAST_RING_SCALE,
-                |a, b| surface_length(chart, z, a, b),
-            );
-            return (out, none);
-        }
-        // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
-        // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
-        // inside it, down to a fifth of a bead wide.
-        None if rings > 0 || dmax <= 0.5 * width => {
-            let gap = Gap {
-                edge: 0.0,
-                inset: sliver_inset,
-                min_width: SLIVER_MIN_WIDTH_SHARE * width,
-                below: f64::INFINITY,
-            };
-            out.extend(core_fill(gap));
-            return (out, none);
-        }
-        None => 0.5 * width,
+    let Some(inner) = infill_start(
+        (&lm, &db, chart, z),
+        (last_ring, last_ring_from, rings, dmax),
+        (width, spacing, sliver_inset),
+        &mut out,
+    ) else {
+        return (out, none);
     };
     let zig = params.path_mode != PathMode::Raster;
     let infill = crate::fill::infill_role(width, spacing);
@@ -317,27 +288,63 @@ pub(crate) fn fill_region_with(
         }));
     }
     // Sparse infill (issue 33): the solid lines kept on the skin, the pattern's elsewhere.
-    let Some(sparse) = sparse.filter(|s| s.skin.is_some()) else {
-        return (out, none);
-    };
-    let frame = (lm.q[deep], raster_dir(params, false), spacing0);
-    match sparse::sparse_lines(
-        &lm,
-        chart,
-        z,
-        &db,
-        edge,
-        frame,
-        (params, layer, width0),
-        sparse,
-    ) {
+    match sparse.filter(|s| s.skin.is_some()) {
         None => (out, none),
-        Some((lines, volume)) => {
-            let solid = out.split_off(from);
-            out.extend(sparse::split_by(solid, |q| sparse.in_skin(q)).0);
-            out.extend(lines);
-            (out, volume)
+        Some(sparse) => {
+            let frame = (lm.q[deep], raster_dir(params, false), spacing0);
+            let at = (&lm, chart, z, db.as_slice(), edge);
+            sparse::lay(out, from, at, frame, (params, layer, width0), sparse)
         }
+    }
+}
+
+/// Where a region's infill lines start (the level of the distance `db` a spacing past the
+/// last ring, at `last_ring`, or half a bead in without rings); `None` where the region is too
+/// narrow for lines: then the gap fill of what is left is pushed onto `out` instead (the strip
+/// along the ridge that the last ring's bead leaves, conserved with the last ring from
+/// `last_ring_from`, or a region too thin for a ring filled from its boundary).
+fn infill_start(
+    (lm, db, chart, z): (&LayerMesh, &[f64], &Chart, f64),
+    (last_ring, last_ring_from, rings, dmax): (Option<f64>, usize, usize, f64),
+    (width, spacing, sliver_inset): (f64, f64, f64),
+    out: &mut Vec<FillPath>,
+) -> Option<f64> {
+    let core_fill = |gap: Gap| core_fill(lm, db, chart, z, gap, width);
+    match last_ring {
+        Some(c) if dmax > c + 1.5 * spacing => Some(c + spacing),
+        Some(c) => {
+            // The strip along the ridge that the last ring's bead leaves.
+            let edge = c + 0.5 * width;
+            let gap = Gap {
+                edge,
+                inset: GAP_INSET * width,
+                min_width: GAP_MIN_WIDTH_SHARE * width,
+                below: f64::INFINITY,
+            };
+            out.extend(core_fill(gap));
+            conserve::conserve_core(
+                &mut out[last_ring_from..],
+                lm.area_above(db, c - 0.5 * width),
+                width,
+                conserve::MAX_LAST_RING_SCALE,
+                |a, b| surface_length(chart, z, a, b),
+            );
+            None
+        }
+        // A region too thin for a ring (the sliver a curved layer cuts off a blade's tip or
+        // edge): the same gap fill from its boundary, the beads' middles a tenth of a bead
+        // inside it, down to a fifth of a bead wide.
+        None if rings > 0 || dmax <= 0.5 * width => {
+            let gap = Gap {
+                edge: 0.0,
+                inset: sliver_inset,
+                min_width: SLIVER_MIN_WIDTH_SHARE * width,
+                below: f64::INFINITY,
+            };
+            out.extend(core_fill(gap));
+            None
+        }
+        None => Some(0.5 * width),
     }
 }
 

@@ -274,6 +274,28 @@ fn strip_volume(
         .sum()
 }
 
+/// The paths `out` of a region with its solid infill lines (those from `from` on) kept on
+/// the layer's skin and its sparse lines laid elsewhere ([`sparse_lines`]), with the sparse
+/// volume; `out` as it is where the region's sparse part is too small for the pattern.
+pub(super) fn lay(
+    mut out: Vec<FillPath>,
+    from: usize,
+    (lm, chart, z, db, edge): (&LayerMesh, &Chart, f64, &[f64], f64),
+    frame: (Point2, [f64; 2], f64),
+    at: (&LayerParams, usize, f64),
+    sparse: &CurvedSparse,
+) -> (Vec<FillPath>, SparseVolume) {
+    match sparse_lines(lm, chart, z, db, edge, frame, at, sparse) {
+        None => (out, SparseVolume::default()),
+        Some((lines, volume)) => {
+            let solid = out.split_off(from);
+            out.extend(split_by(solid, |q| sparse.in_skin(q)).0);
+            out.extend(lines);
+            (out, volume)
+        }
+    }
+}
+
 /// Bisection steps that place a path's crossing of the skin's boundary (a segment is a
 /// lattice step or so long: 2⁻³⁰ of it).
 const CROSSING_STEPS: usize = 30;
