@@ -230,8 +230,8 @@ fn planned_delta5(name: &str, part: &brep::StepPart, toml: &str) -> plan::Plan {
 /// solid (no sparse line), the layers between sparse with no solid infill (the boss is a
 /// cylinder: each middle layer's section is the next's, so no skin), their sparse lines a
 /// fifth of what the solid bottom layer lays within the lines' reach; and it passes the
-/// self-check (which expects the sparse part at its density) with every pattern at 15 and
-/// 40 %, with less filament than solid.
+/// self-check (which expects the sparse part at its density) with every pattern (at 15 or
+/// 40 %), with less filament than solid.
 #[test]
 fn curved_layers_get_skins_and_sparse_infill() {
     let name = "sphere_boss.step";
@@ -279,16 +279,20 @@ fn curved_layers_get_skins_and_sparse_infill() {
             .sum()
     };
     let full = boss_filament(&solid, boss(&solid));
-    for pattern in ["rectilinear", "grid", "triangles", "gyroid"] {
-        for density in [0.15, 0.4] {
-            let toml = format!("infill_density = {density}\ninfill_pattern = \"{pattern}\"");
-            let p = planned_delta5(name, &part, &toml);
-            assert!(passed_first_time(&p), "{pattern} {density}");
-            let id = boss(&p);
-            let f = p.features().iter().find(|f| f.feature.id == id).cloned();
-            let f = f.expect("the boss");
-            assert!(f.sparse_volume_mm3 > 0.0, "{pattern} {density}");
-            assert!(boss_filament(&p, id) < full, "{pattern} {density}");
-        }
+    // Each pattern once, at 15 or 40 % (every pair was measured: docs/measurements.md).
+    for (pattern, density) in [
+        ("rectilinear", 0.15),
+        ("grid", 0.4),
+        ("triangles", 0.15),
+        ("gyroid", 0.4),
+    ] {
+        let toml = format!("infill_density = {density}\ninfill_pattern = \"{pattern}\"");
+        let p = planned_delta5(name, &part, &toml);
+        assert!(passed_first_time(&p), "{pattern} {density}");
+        let id = boss(&p);
+        let f = p.features().iter().find(|f| f.feature.id == id).cloned();
+        let f = f.expect("the boss");
+        assert!(f.sparse_volume_mm3 > 0.0, "{pattern} {density}");
+        assert!(boss_filament(&p, id) < full, "{pattern} {density}");
     }
 }
