@@ -295,13 +295,15 @@ fn curved_features_collide_only_where_the_head_leans_over_what_is_built() {
             // The impeller's blades: tilting the axis inside the cone clears the moves whose
             // body meets the hub (a few degrees suffice: the body's rim grazes the hub's top),
             // all but a few gap-fill moves per blade, on the slivers the offset layers cut at
-            // the hub's rim: their turn falls outside the search (named in the note). 3 to 11
-            // per blade (0 to 1 before the gap fill laid one bead on a sliver's ridge, issue 31
-            // item 4; 3 to 6 before a lifted path kept the points of a gap fill doubling back).
+            // the hub's rim: their turn falls outside the search (named in the note). 2 to 13
+            // per blade, 41 in all (0 to 1 before the gap fill laid one bead on a sliver's
+            // ridge, issue 31 item 4; 3 to 6 before a lifted path kept the points of a gap fill
+            // doubling back; 3 to 11, 43 in all, before the B-spline projection's finer grid
+            // moved the blades' trims by a hair, issue 34).
             if name == "impeller" && id > 0 {
                 assert!(cleared > 0, "{name}: feature {id}: nothing cleared");
                 assert!(
-                    n <= 12,
+                    n <= 14,
                     "{name}: feature {id}: {n} left ({cleared} cleared)"
                 );
                 let left = left_indices(&run.collisions, id);
