@@ -57,8 +57,8 @@ pub fn orient_shell_at(brep: &mut Brep, shell: ShellId, shares: [f64; 2]) -> Vec
 /// no two consistent sets.
 fn against_set(brep: &Brep, faces: &[FaceId], share: f64, void: bool) -> Option<Vec<FaceId>> {
     let bbox = crate::bbox::faces_rough_bbox(brep, faces);
-    // Coarse, but not so coarse that a face's triangles fold (then they run its edges both ways):
-    // only which way the triangles run along the edges is asked of this mesh.
+    // Only which way the triangles run along the edges is asked of this mesh: coarse is
+    // enough where a face's triangles do not fold (then they run its edges both ways).
     let opts = MeshOptions::with_tolerance((bbox.diagonal() * share).max(1e-4));
     let mesh = mesh_faces(brep, faces, &opts).ok()?;
     // Each mesh edge (low vertex first) with the faces (local index) that run it, and which way.

@@ -177,10 +177,14 @@ fn offset_if_transition_misses(
     }
     let f = extracted.feature(slot);
     let bead = machine.bead();
-    // What the self-check expects (slicer::verify::PlannedFeature::expected): the sparse part
-    // at its density, the rest at the fill ratio.
+    // What the self-check expects: the sparse part at its density, the rest at the fill ratio.
     let fig = &plan.figures;
-    let expected = (f.volume - fig.sparse_volume) * params.filling_ratio + fig.sparse_laid;
+    let expected = slicer::verify::expected_volume(
+        f.volume,
+        params.filling_ratio,
+        fig.sparse_volume,
+        fig.sparse_density(params.infill_density),
+    );
     let rel = plan.figures.filament * bead.filament_area()
         / expected.max(crate::tolerance::VOLUME_MM3)
         - 1.0;

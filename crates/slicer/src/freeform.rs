@@ -501,7 +501,7 @@ impl FreeformFill<'_> {
                 _ => base_chart,
             };
             let thick = |q: Point2, dl: f64| match levels {
-                Some((field, n)) => (field.height(q) - field.lower(q)) / n,
+                Some((field, n)) => field.layer_thickness(q, n),
                 None => dl,
             };
             if banded && layer < offset_layers {

@@ -169,6 +169,11 @@ impl TopField {
         self.bilinear(&self.h, q)
     }
 
+    /// The thickness over `q` of each of `n` transition layers, mm: `(h_T(q) − D(q)) / n`.
+    pub(crate) fn layer_thickness(&self, q: Point2, n: f64) -> f64 {
+        (self.height(q) - self.lower(q)) / n
+    }
+
     /// Grid values `v` interpolated bilinearly at `q`.
     fn bilinear(&self, v: &[f64], q: Point2) -> f64 {
         let fx = ((q[0] - self.origin[0]) / self.cell - 0.5).clamp(0.0, (self.nx - 1) as f64);

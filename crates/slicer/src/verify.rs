@@ -106,8 +106,15 @@ impl PlannedFeature {
     /// `(volume − sparse) × fill + sparse × density`. The volume is the solid's own (not the
     /// layers' areas summed), so a lost layer or feature still shows.
     pub fn expected(&self) -> f64 {
-        (self.volume - self.sparse) * self.fill + self.sparse * self.density
+        expected_volume(self.volume, self.fill, self.sparse, self.density)
     }
+}
+
+/// What a feature of `volume` mm³ laid at `fill` should put down, `sparse` mm³ of it as sparse
+/// infill at `density`: `(volume − sparse) × fill + sparse × density`
+/// ([`PlannedFeature::expected`]).
+pub fn expected_volume(volume: f64, fill: f64, sparse: f64, density: f64) -> f64 {
+    (volume - sparse) * fill + sparse * density
 }
 
 /// Checks one feature's plan: at least one layer, and extruded volume within its

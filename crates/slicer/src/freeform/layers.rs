@@ -68,9 +68,9 @@ pub(super) fn fill_stack(
             let dl = heights[layer];
             let thickness = |q: Point2| match (blend, clip) {
                 (Some((field, k, _)), None) if layer >= offset_layers => {
-                    (field.height(q) - field.lower(q)) / *k as f64
+                    field.layer_thickness(q, *k as f64)
                 }
-                (_, Some((field, z))) if field.lower(q) < z - HEIGHT_SLACK => 0.0,
+                (_, Some((field, z))) if !under_band(field, z, q) => 0.0,
                 _ => dl,
             };
             // Within the solid layers of the first or the last layer: all skin.
@@ -152,7 +152,7 @@ fn fill_layer(
         paths.extend(spurs);
     }
     if let Some((field, z)) = clip {
-        paths = clip_paths(paths, |q| field.lower(q) >= z - HEIGHT_SLACK);
+        paths = clip_paths(paths, |q| under_band(field, z, q));
     }
     (
         (
@@ -161,4 +161,10 @@ fn fill_layer(
         ),
         volume,
     )
+}
+
+/// Whether an offset layer topped at `z` is laid over chart point `q` under a transition band
+/// (`field`): where the band starts at or above it.
+fn under_band(field: &TopField, z: f64, q: Point2) -> bool {
+    field.lower(q) >= z - HEIGHT_SLACK
 }

@@ -60,11 +60,23 @@ impl FillPath {
     /// The area its beads cover, mm²: each segment's length by `len` (the chord on the layer
     /// surface, or in the plane) times its mean width; segments of no finite length count none.
     pub fn strip_area(&self, len: impl Fn(Point2, Point2) -> f64) -> f64 {
+        self.strip_weighted(len, |_| 1.0)
+    }
+
+    /// [`FillPath::strip_area`] with each segment's strip times `weight` at its middle (the
+    /// layer's thickness there: the volume its beads lay, mm³).
+    pub fn strip_weighted(
+        &self,
+        len: impl Fn(Point2, Point2) -> f64,
+        weight: impl Fn(Point2) -> f64,
+    ) -> f64 {
         (1..self.points.len())
             .map(|i| {
-                let l = len(self.points[i - 1], self.points[i]);
+                let (a, b) = (self.points[i - 1], self.points[i]);
+                let l = len(a, b);
                 if l.is_finite() {
-                    0.5 * (self.widths[i - 1] + self.widths[i]) * l
+                    let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+                    0.5 * (self.widths[i - 1] + self.widths[i]) * l * weight(mid)
                 } else {
                     0.0
                 }

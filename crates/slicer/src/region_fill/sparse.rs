@@ -208,13 +208,12 @@ pub(super) fn sparse_lines(
     // and its end's round half overlaps the ring it is anchored on.
     let reach = RunOn { width, edge };
     let len = |a, b| surface_length(chart, z, a, b);
-    let mut out = vec![];
-    for line in &iso {
-        for piece in clip_reaching(line, edge, reach, len) {
-            let path = FillPath::uniform(piece.body, width, Role::InternalInfill);
-            out.extend(split_by(vec![path], |q| sparse.in_skin(q)).1);
-        }
-    }
+    let pieces: Vec<FillPath> = iso
+        .iter()
+        .flat_map(|line| clip_reaching(line, edge, reach, len))
+        .map(|piece| FillPath::uniform(piece.body, width, Role::InternalInfill))
+        .collect();
+    let mut out = split_by(pieces, |q| sparse.in_skin(q)).1;
     let d = crate::fill::sparse::layer_density(params, sparse.height, width);
     let want = volume * d;
     // A region crossed by a few lines: where they fall on the pattern's fixed grid decides
@@ -225,7 +224,7 @@ pub(super) fn sparse_lines(
     if lines <= FEW_SPARSE_LINES {
         let laid: f64 = out
             .iter()
-            .map(|p| strip_volume(p, |a, b| surface_length(chart, z, a, b), sparse.thickness))
+            .map(|p| p.strip_weighted(|a, b| surface_length(chart, z, a, b), sparse.thickness))
             .sum();
         if laid > 0.0 {
             let k = (want / laid).clamp(1.0 / MAX_SPARSE_SCALE, MAX_SPARSE_SCALE);
@@ -252,27 +251,6 @@ fn sparse_thickness(volume: f64, area: f64) -> f64 {
 const FEW_SPARSE_LINES: f64 = 12.0;
 /// The most a sparse bead is widened or narrowed by for that ([`FEW_SPARSE_LINES`]).
 const MAX_SPARSE_SCALE: f64 = 1.25;
-
-/// The volume a path's beads lay, mm³: each segment's length by `len` × its mean width × the
-/// layer's thickness at its middle.
-fn strip_volume(
-    p: &FillPath,
-    len: impl Fn(Point2, Point2) -> f64,
-    thickness: &(dyn Fn(Point2) -> f64 + Sync),
-) -> f64 {
-    (1..p.points.len())
-        .map(|i| {
-            let (a, b) = (p.points[i - 1], p.points[i]);
-            let l = len(a, b);
-            let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-            if l.is_finite() {
-                0.5 * (p.widths[i - 1] + p.widths[i]) * l * thickness(mid)
-            } else {
-                0.0
-            }
-        })
-        .sum()
-}
 
 /// The paths `out` of a region with its solid infill lines (those from `from` on) kept on
 /// the layer's skin and its sparse lines laid elsewhere ([`sparse_lines`]), with the sparse
