@@ -22,7 +22,14 @@
 //!     uses (`common/prusa.rs`). Timed: the wall time of the process (reading the STL, slicing,
 //!     writing the G-code). A run counts only if it exits 0 and its G-code has G1 moves.
 //! - Printed: per part the medians of both times, their ratio (ours / PrusaSlicer: below 1 is
-//!   faster) and our largest peak RSS over the runs; then every run's figures.
+//!   faster) and our largest peak RSS over the runs; then every run's figures, with our CPU
+//!   utilisation (the child's user and system time over its wall time × the cores).
+//! - Then the stage split: each part planned once more in this process as `features plan
+//!   --allow-collisions` plans it (the placement search included), its stages timed by the
+//!   plan's progress reports: reading, extraction, the features' layers, smoothing, the print
+//!   head, the post; the time the refused placements took; the share of the plan after the
+//!   features; and the CPU utilisation of the whole and of the features' layers (issue 35:
+//!   "a part of N features uses both cores from the first feature to the last").
 //!
 //! Differences in what each side does are left as they are: ours starts from the STEP file and
 //! writes three or four files, PrusaSlicer starts from the STL mesh and writes one G-code file;
@@ -62,6 +69,8 @@ struct OursRun {
     seconds: f64,
     /// Peak resident set size of the child, MB (MiB).
     rss_mb: f64,
+    /// CPU seconds of the child, every thread's, user and system.
+    cpu: f64,
     /// `None` when it exited 0, else why not.
     error: Option<String>,
 }
@@ -76,8 +85,13 @@ struct PartResult {
 }
 
 /// Runs `cmd` as a child with its output into `log`, waits for that one child with `wait4` and
-/// returns its wall time, its peak RSS in KiB and its exit code (or the signal that ended it).
-fn run_measured(cmd: &mut Command, log: &Path) -> Result<(f64, i64, Result<i32, String>), String> {
+/// returns its wall time, its peak RSS in KiB, its CPU seconds (user and system, every thread)
+/// and its exit code (or the signal that ended it).
+#[allow(clippy::type_complexity)]
+fn run_measured(
+    cmd: &mut Command,
+    log: &Path,
+) -> Result<(f64, i64, f64, Result<i32, String>), String> {
     let out = std::fs::File::create(log).map_err(|e| format!("{}: {e}", log.display()))?;
     let err = out
         .try_clone()
@@ -112,8 +126,10 @@ fn run_measured(cmd: &mut Command, log: &Path) -> Result<(f64, i64, Result<i32, 
     } else {
         Err(format!("wait status {status:#x}"))
     };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    let cpu = s(usage.ru_utime) + s(usage.ru_stime);
     // Linux reports ru_maxrss in KiB.
-    Ok((seconds, usage.ru_maxrss, code))
+    Ok((seconds, usage.ru_maxrss, cpu, code))
 }
 
 /// The last lines of a log, joined.
@@ -134,9 +150,10 @@ fn run_ours(exe: &Path, step: &Path, machine: &str, dir: &Path) -> OursRun {
         .arg("-o")
         .arg(&out);
     match run_measured(&mut cmd, &log) {
-        Ok((seconds, rss_kib, code)) => OursRun {
+        Ok((seconds, rss_kib, cpu, code)) => OursRun {
             seconds,
             rss_mb: rss_kib as f64 / 1024.0,
+            cpu,
             error: match code {
                 Ok(0) => None,
                 Ok(c) => Some(format!("exited with {c}: {}", tail(&log, 3))),
@@ -146,6 +163,7 @@ fn run_ours(exe: &Path, step: &Path, machine: &str, dir: &Path) -> OursRun {
         Err(e) => OursRun {
             seconds: f64::NAN,
             rss_mb: f64::NAN,
+            cpu: f64::NAN,
             error: Some(e),
         },
     }
@@ -173,17 +191,64 @@ fn run_prusa(stl: &Path, gcode: &Path) -> prusa::Run {
     }
 }
 
-/// Wall seconds of a plan's stages.
+/// Seconds of a plan's stages, as `features plan` runs them: the part read, then each
+/// placement tried (the part as modelled first), each a whole plan of its own.
+#[derive(Default)]
 struct Stages {
-    features: f64,
-    smoothing: f64,
-    head: f64,
-    program: f64,
+    /// Reading the STEP file.
+    read: Span,
+    /// Extracting the features (each placement's).
+    extract: Span,
+    /// Every feature's layers and fills (each placement's).
+    features: Span,
+    /// Smoothing the tool axes.
+    smoothing: Span,
+    /// The print-head check (with its pedestal search).
+    head: Span,
+    /// The post and the report.
+    program: Span,
+    /// Of all of the above, what the placements refused before the chosen one took.
+    refused: Span,
+    /// Placements tried after the part as modelled.
+    tried: usize,
 }
 
-/// Plans `step` for `machine` in this process and times its stages by the plan's progress
-/// reports ([`plan::Progress`]): the features up to `Planned`, then each of [`plan::Stage::AFTER_FEATURES`]
-/// to the next (the last to the plan's return).
+/// Wall and CPU seconds of a stretch of the plan (CPU: every thread's, user and system).
+#[derive(Default, Clone, Copy)]
+struct Span {
+    wall: f64,
+    cpu: f64,
+}
+
+impl Span {
+    fn add(&mut self, o: Span) {
+        self.wall += o.wall;
+        self.cpu += o.cpu;
+    }
+
+    /// The share of the machine's cores this stretch kept busy, % (100: every core, all along).
+    fn utilisation(&self, cores: usize) -> f64 {
+        100.0 * self.cpu / (self.wall * cores as f64).max(1e-9)
+    }
+}
+
+/// CPU seconds this process has used so far, every thread's, user and system.
+fn cpu_now() -> f64 {
+    // SAFETY: `rusage` is plain old data, zeroes are a valid value, and `getrusage` only
+    // writes to it.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `u` is valid for writes.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
+}
+
+/// Plans `step` for `machine` in this process as `features plan --allow-collisions` does (the
+/// placement search included) and times its stages by the plan's progress reports
+/// ([`plan::Progress`]): a placement's extraction from its start (or `Trying`) to `Start`, its
+/// features to `Planned`, then each of [`plan::Stage::AFTER_FEATURES`] to the next (the last to
+/// the next `Trying` or the plan's return). What ran before the last `Trying` is also summed
+/// as `refused`.
 fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
     use plan::Progress;
     use std::sync::Mutex;
@@ -192,45 +257,79 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         "kuka" => robot_post::MachineKind::Kuka,
         _ => robot_post::MachineKind::Delta5,
     };
-    let part = brep::read_step(step).map_err(|e| format!("{}: {e}", step.display()))?;
     let machine = robot_post::MachineProfile::builtin(kind);
-    let marks: Mutex<Vec<(&'static str, Instant)>> = Mutex::new(vec![]);
+    let (w0, c0) = (Instant::now(), cpu_now());
+    let file = brep::StepFile::read(step).map_err(|e| format!("{}: {e}", step.display()))?;
+    let mut st = Stages {
+        read: Span {
+            wall: w0.elapsed().as_secs_f64(),
+            cpu: cpu_now() - c0,
+        },
+        ..Default::default()
+    };
+    let marks: Mutex<Vec<(&'static str, Instant, f64)>> = Mutex::new(vec![]);
     let mark = |p: Progress| {
         let label = match p {
+            Progress::Trying { .. } => Some("trying"),
             Progress::Start { .. } => Some("start"),
             Progress::Planned => Some("planned"),
             Progress::Stage(s) => Some(s.name()),
             _ => None,
         };
         if let (Some(l), Ok(mut m)) = (label, marks.lock()) {
-            m.push((l, Instant::now()));
+            m.push((l, Instant::now(), cpu_now()));
         }
     };
     let options = plan::Options {
         source: step.display().to_string(),
         stem: "part".into(),
         allow_collisions: true,
-        keep_going: true,
         progress: Some(&mark),
+        placement_time_limit: std::time::Duration::try_from_secs_f64(
+            plan::retry::DEFAULT_TIME_LIMIT_S,
+        )
+        .ok(),
         ..Default::default()
     };
-    let t0 = Instant::now();
-    plan::plan(&part, &plan::Process::default(), &machine, &options)
-        .map_err(|e| format!("plan failed: {e}"))?;
-    let end = Instant::now();
+    let mut out = robot_post::InMemory::default();
+    let begin = ("trying", Instant::now(), cpu_now());
+    plan::plan_file_to(
+        &file,
+        &plan::Process::default(),
+        &machine,
+        &options,
+        &mut out,
+    )
+    .map_err(|e| format!("plan failed: {e}"))?;
+    let end = ("end", Instant::now(), cpu_now());
     let marks = marks.into_inner().map_err(|e| e.to_string())?;
-    let at = |l: &str| marks.iter().find(|m| m.0 == l).map(|m| m.1);
-    let span = |a: Option<Instant>, b: Option<Instant>| match (a, b) {
-        (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
-        _ => 0.0,
-    };
+    let all: Vec<_> = std::iter::once(begin)
+        .chain(marks)
+        .chain(std::iter::once(end))
+        .collect();
+    let last_try = all.iter().rposition(|m| m.0 == "trying").unwrap_or(0);
     let [smooth, head, program] = plan::Stage::AFTER_FEATURES.map(plan::Stage::name);
-    Ok(Stages {
-        features: span(Some(t0), at("planned")),
-        smoothing: span(at(smooth), at(head)),
-        head: span(at(head), at(program)),
-        program: span(at(program), Some(end)),
-    })
+    for (i, w) in all.windows(2).enumerate() {
+        let span = Span {
+            wall: w[1].1.duration_since(w[0].1).as_secs_f64(),
+            cpu: w[1].2 - w[0].2,
+        };
+        let stage = match w[0].0 {
+            "trying" => &mut st.extract,
+            "start" => &mut st.features,
+            l if l == smooth => &mut st.smoothing,
+            l if l == head => &mut st.head,
+            l if l == program => &mut st.program,
+            // `planned` is followed by smoothing at once.
+            _ => &mut st.smoothing,
+        };
+        stage.add(span);
+        if i < last_try {
+            st.refused.add(span);
+        }
+    }
+    st.tried = all.iter().filter(|m| m.0 == "trying").count() - 1;
+    Ok(st)
 }
 
 fn median(v: &[f64]) -> Option<f64> {
@@ -441,7 +540,8 @@ fn main() {
     }
 
     println!();
-    println!("per run (s; ours peak RSS MB):");
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!("per run (s; ours: peak RSS MB, CPU % = CPU time over wall time x {cores} cores):");
     for r in &results {
         let mut line = format!("{:<16}", r.name);
         for (i, o) in r.ours.iter().enumerate() {
@@ -456,22 +556,33 @@ fn main() {
                 "failed".into()
             };
             line.push_str(&format!(
-                "  #{}: ours {ours} ({:.0} MB), prusa {p}",
+                "  #{}: ours {ours} ({:.0} MB, CPU {:.0} %), prusa {p}",
                 i + 1,
-                o.rss_mb
+                o.rss_mb,
+                100.0 * o.cpu / (o.seconds * cores as f64).max(1e-9)
             ));
         }
         println!("{line}");
     }
 
     // Where the time goes: each part planned once more in this process, its stages timed by the
-    // plan's progress reports.
+    // plan's progress reports, with the share of the cores each kept busy.
     println!();
     println!(
-        "{:<16} | {:>9} {:>9} {:>11} {:>9} | {:>7}",
-        "stages (1 run)", "features", "smoothing", "print head", "program", "head %"
+        "{:<16} | {:>6} {:>7} {:>8} {:>7} {:>7} {:>7} | {:>7} {:>7} | {:>7} {:>7}",
+        "stages (1 run)",
+        "read",
+        "extract",
+        "features",
+        "smooth",
+        "head",
+        "program",
+        "refused",
+        "after %",
+        "CPU %",
+        "feat. %"
     );
-    println!("{}", "-".repeat(72));
+    println!("{}", "-".repeat(106));
     for (step, machine) in &parts {
         let name = step
             .file_stem()
@@ -479,23 +590,45 @@ fn main() {
             .unwrap_or_default();
         match stage_times(step, machine) {
             Ok(t) => {
-                let rest = t.features + t.smoothing + t.program;
-                println!(
-                    "{name:<16} | {:>9.2} {:>9.2} {:>11.2} {:>9.2} | {:>6.1}%",
+                let mut all = Span::default();
+                for s in [
+                    t.read,
+                    t.extract,
                     t.features,
                     t.smoothing,
                     t.head,
                     t.program,
-                    100.0 * t.head / rest.max(1e-9)
+                ] {
+                    all.add(s);
+                }
+                let after = t.smoothing.wall + t.head.wall + t.program.wall;
+                println!(
+                    "{name:<16} | {:>6.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2} {:>7.2} | {:>4.2} ({}) {:>6.1}% | {:>6.0}% {:>6.0}%",
+                    t.read.wall,
+                    t.extract.wall,
+                    t.features.wall,
+                    t.smoothing.wall,
+                    t.head.wall,
+                    t.program.wall,
+                    t.refused.wall,
+                    t.tried,
+                    100.0 * after / all.wall.max(1e-9),
+                    all.utilisation(cores),
+                    t.features.utilisation(cores),
                 );
             }
             Err(e) => println!("{name:<16} | {e}"),
         }
     }
     println!(
-        "seconds of wall time in `plan::plan` (reading the part not included): features = \
-         extraction and every feature's layers; head % = the print-head check (issue 18) over \
-         the rest of the plan"
+        "wall seconds of `features plan --allow-collisions` run in this process, the placement \
+         search included (each stage summed over the placements tried): read = the STEP file; \
+         extract = the features; features = every feature's layers; head = the print-head \
+         check (issue 18) with its pedestal search; program = the post and the report; refused \
+         = the placements refused before the chosen one took (how many after the part as \
+         modelled); after % = smoothing, head and program over the whole; CPU % = CPU time of \
+         every thread over wall time x {cores} cores (100 %: every core busy all along), for the \
+         whole and for the features' layers"
     );
     println!("(files in {})", tmp.display());
     if failed {

@@ -41,6 +41,40 @@ pub struct Checked {
     pub part_warnings: Vec<Warning>,
 }
 
+/// The smoothed tool path as it is, the head not checked: for a plan that the support gate
+/// refuses already ([`unsupported`]), which no avoidance or pedestal could save. Its refusal
+/// lists no collisions (the head check's cost, several times the layers' on a part whose
+/// head meets the table, is spared each placement that fails for its overhangs).
+pub fn unchecked(smoothed: Smoothed) -> Checked {
+    let Smoothed {
+        toolpath,
+        orientation,
+        warnings,
+        ..
+    } = smoothed;
+    let avoided = Avoided::default();
+    Checked {
+        pedestal_planned: None,
+        collisions: collisions::entries(&avoided),
+        points: collisions::points(&toolpath),
+        toolpath,
+        avoided,
+        pedestal: None,
+        orientation,
+        warnings,
+        part_warnings: vec![],
+    }
+}
+
+/// Whether the support gate refuses these features whatever the head check finds: some
+/// layer is unsupported and `--keep-going` does not let that pass.
+pub fn unsupported(features: &[LaidFeature], options: &Options) -> bool {
+    !options.keep_going
+        && features
+            .iter()
+            .any(|f| f.held.as_ref().is_some_and(|h| h.support.worst.is_some()))
+}
+
 /// Checks the head along `smoothed`'s tool path on `machine`, avoiding what it can; sibling
 /// features (the same parents, from `features`) may be interleaved layer by layer; the part
 /// stands on the pedestal the process asks for (`auto`: the least that keeps the head off the

@@ -283,14 +283,18 @@ fn run(
     let smoothed = smooth::smooth(laid.toolpath, process, machine);
     options.in_time()?;
     tell(Progress::Stage(Stage::HeadCheck));
-    let mut checked = head::head_check(
-        smoothed,
-        &extracted,
-        process,
-        machine,
-        &laid.features,
-        options,
-    )?;
+    let mut checked = if head::unsupported(&laid.features, options) {
+        head::unchecked(smoothed)
+    } else {
+        head::head_check(
+            smoothed,
+            &extracted,
+            process,
+            machine,
+            &laid.features,
+            options,
+        )?
+    };
     let mut warnings = laid.warnings;
     let adhesion = adhesion::lay(
         &mut checked.toolpath,
