@@ -285,6 +285,7 @@ fn stage_times(step: &Path, machine: &str) -> Result<Stages, String> {
         stem: "part".into(),
         allow_collisions: true,
         progress: Some(&mark),
+        placement: plan::Placement::Find,
         placement_time_limit: std::time::Duration::try_from_secs_f64(
             plan::retry::DEFAULT_TIME_LIMIT_S,
         )
