@@ -376,6 +376,7 @@ fn refused_page(path: &ToolPath, marks: Vec<Mark>, machine: bool) -> String {
             body_radius: 20.0,
             body_length: 60.0,
         }),
+        simulation: None,
     })
 }
 
