@@ -243,13 +243,31 @@
     }
     S.dots = byKind.map(simDots);
     simList(listed);
-    range.addEventListener("input", function () { simShow(+range.value); });
+    range.addEventListener("input", function () { simStop(); simShow(+range.value); });
+    document.getElementById("simPlay").addEventListener("click", function () {
+      if (S.playing) { simStop(); return; }
+      if (S.cur >= S.n - 1) simShow(0);
+      S.playing = true; document.getElementById("simPlay").textContent = "pause";
+      window.requestAnimationFrame(simStep);
+    });
     document.getElementById("showSim").addEventListener("change", function () {
       S.on = document.getElementById("showSim").checked; draw();
     });
     var want = /(?:^#|&)sim=([0-9.]+)/.exec(location.hash);
     var at = want ? Math.round(Math.max(0, Math.min(1, +want[1])) * (S.n - 1)) : 0;
     simShow(isFinite(at) ? at : 0, true);
+  }
+
+  /* Play: through the moves in about 20 s, a frame at a time. */
+  function simStep() {
+    if (!S.playing) return;
+    var next = Math.min(S.n - 1, S.cur + Math.max(1, Math.round(S.n / 1200)));
+    simShow(next);
+    if (next >= S.n - 1) simStop(); else window.requestAnimationFrame(simStep);
+  }
+  function simStop() {
+    S.playing = false;
+    document.getElementById("simPlay").textContent = "play";
   }
 
   /* The "Machine" list: one line a flagged move; a click goes to it. */
@@ -265,7 +283,9 @@
     var box = document.getElementById("simflaggedlist"), frag = document.createDocumentFragment();
     listed.forEach(function (i) {
       var row = document.createElement("div"); row.setAttribute("data-sim", String(i));
-      var k = document.createElement("span"); k.className = "kind"; k.textContent = "move " + S.number[i].toLocaleString();
+      var k = document.createElement("span"), f = S.flags[i];
+      k.className = "kind " + ((f & 1) ? "collision" : (f & 2) ? "singular" : "limit");
+      k.textContent = "move " + S.number[i].toLocaleString();
       row.appendChild(k); row.appendChild(document.createTextNode(simFlagText(i)));
       frag.appendChild(row);
     });
@@ -300,6 +320,7 @@
       tip = a.tip; axis = [-a.z[0], -a.z[1], -a.z[2]]; x = a.x;
       S.headAt = simHeadMatrix(tip, x, [-a.y[0], -a.y[1], -a.y[2]], axis);
     }
+    if (S.dot) gl.deleteBuffer(S.dot.buf);
     S.dot = simDots([i]);
     var names = S.d.names, f = S.flags[i], tb = document.getElementById("simjoints");
     tb.textContent = "";
