@@ -222,6 +222,76 @@ mod tests {
         assert!(embedded(&[]).is_empty());
     }
 
+    /// The base64 text of `j[key]` as u32s.
+    fn u32s(j: &serde_json::Value, key: &str) -> Vec<u32> {
+        let text = j[key].as_str().unwrap_or_default();
+        let mut bits: Vec<u8> = vec![];
+        let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_";
+        let (mut acc, mut n) = (0u32, 0);
+        for c in text.bytes().filter(|&c| c != b'=') {
+            let v = alphabet.iter().position(|&a| a == c).unwrap_or(0) as u32;
+            acc = (acc << 6) | v;
+            n += 6;
+            if n >= 8 {
+                n -= 8;
+                bits.push((acc >> n) as u8);
+            }
+        }
+        bits.chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect()
+    }
+
+    #[test]
+    fn each_move_carries_its_flags_and_the_drawn_path_behind_it() {
+        let table = crate::simulation::SimTable {
+            centre: [0.0, 0.0],
+            z: 0.0,
+            radius: 100.0,
+            table_above_b_axis: 20.0,
+            b_limits_deg: [-90.0, 90.0],
+            c_limits_deg: Some([-360.0, 360.0]),
+        };
+        let head = crate::HeadSize {
+            tip_radius: 0.5,
+            half_angle_deg: 30.0,
+            cone_length: 8.0,
+            body_radius: 20.0,
+            body_length: 60.0,
+        };
+        let mv = |point: usize, b: f64, c: f64, collision: bool| SimMove {
+            point,
+            joints: vec![b, c],
+            flags: SimFlags {
+                collision,
+                ..SimFlags::default()
+            },
+        };
+        let sim = Simulation::new(
+            SimMachine::Table(table),
+            head,
+            vec![
+                mv(0, 0.0, 0.0, false),
+                mv(3, 88.0, 358.0, false),
+                mv(4, 10.0, 0.0, true),
+            ],
+            crate::SimMargins::default(),
+        );
+        let j = simulation_json(&sim, None, &[0, 2, 4]);
+        assert_eq!(j["names"], serde_json::json!(["B", "C"]));
+        assert_eq!(
+            (j["moves"].as_u64(), j["total"].as_u64()),
+            (Some(3), Some(3))
+        );
+        // B and C both near a limit at the second move (bits 2 and 3), a collision at the third.
+        assert_eq!(u32s(&j, "flags"), vec![0, 4 | 8, 1]);
+        assert_eq!(u32s(&j, "point"), vec![0, 3, 4]);
+        // Drawn points up to each move's point: 0; 0 and 2; all three.
+        assert_eq!(u32s(&j, "drawn_at"), vec![1, 2, 3]);
+        assert_eq!(j["flagged"]["any"], 2);
+        assert_eq!(j["machine"]["max"], serde_json::json!([90.0, 360.0]));
+    }
+
     #[test]
     fn the_part_frame_is_base_moved_by_the_offset_and_inverts() {
         let a = SimArm {
