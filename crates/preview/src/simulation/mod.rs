@@ -54,6 +54,10 @@ pub enum SimMachine {
 /// Angerer & Hofbaur 2014), as the KUKA post's `[kuka.arm]` and `[kuka]` frames describe it
 /// (`robot_post::kuka::ArmModel`, `KukaCell`): lengths in mm, angles in degrees, the zero
 /// pose with the arm straight up, θi = Ai·sign_i − offset_i.
+///
+/// From a `robot_post::KukaCell` `cell`: `a1`..`c4` and the joint figures are `cell.arm`'s,
+/// `base` is `cell.base.to_array()`, `tool` is `cell.tool.to_array()`, and `part_offset` the
+/// offset the post placed the part with (`tests/preview.rs` builds one so).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimArm {
     /// Shoulder offset from the A1 axis (mm).
