@@ -106,6 +106,8 @@
       model: null, on: true, orange: [1.0, 0.36, 0.0],
       /* Dots of collisions, near-singular wrists and joints near a limit. */
       flagColours: [[1, 0, 0, 1], [0.55, 0.1, 0.95, 1], [0.85, 0, 0.75, 1]] };
+    /* The part's size, before the machine's: the tool-axis ticks keep their length. */
+    S.partSize = lo3[0] <= hi3[0] ? Math.max(hi3[0] - lo3[0], hi3[1] - lo3[1], hi3[2] - lo3[2], 1e-3) : 1;
     if (S.m.kind === "table") {
       var t = S.m;
       S.thick = Math.max(0.04 * t.radius, 1);

@@ -118,7 +118,10 @@ pub struct SimTable {
 /// One move of the program.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SimMove {
-    /// The tool path's point the move goes to (an index into `ToolPath::points`).
+    /// The tool path's point the move goes to (an index into `ToolPath::points`); a move
+    /// between points (a post's retreat, travel or approach) names the point it leads to. The
+    /// point is where the move is dotted and up to where the path is drawn done; the machine
+    /// is drawn by the joints alone.
     pub point: usize,
     /// A1..A6 for an arm, B and C for a table (degrees).
     pub joints: Vec<f64>,
