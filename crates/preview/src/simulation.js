@@ -155,7 +155,7 @@
     simCylinder(out, a.elbow, a.elbow2, 0.9 * r);
     simCylinder(out, a.elbow2, a.wrist, 0.8 * r);
     simCylinder(out, a.wrist, a.flange, 0.55 * r);
-    var top = simAdd(a.tip, a.z, -S.bodyLength);
+    var top = simAdd(a.tip, a.z, -S.d.head_length);
     simCylinder(out, a.flange, top, 0.3 * r);
     return out;
   }
@@ -221,7 +221,6 @@
   /* WebGL buffers, the panel, its list and the scrubber. */
   function simSetup() {
     if (!S) return;
-    S.bodyLength = 0;
     S.head = overlay(S.d.head);
     document.getElementById("sim").style.display = "block";
     var range = document.getElementById("simMove");
@@ -234,8 +233,6 @@
     } else {
       S.links = simMesh({ pos: [], nrm: [] });
     }
-    var fd = S.d.head ? f32(S.d.head.tri) : [];
-    for (var z = 2; z < fd.length; z += 3) S.bodyLength = Math.max(S.bodyLength, fd[z]);
     var byKind = [[], [], []], listed = [];
     for (var i = 0; i < S.n; i++) {
       var f = S.flags[i];
@@ -315,7 +312,6 @@
       S.headAt = simHeadMatrix(simApply(S.model, tip), [1, 0, 0], [0, 1, 0], [0, 0, 1]);
     } else {
       var a = simArm(j);
-      S.links.n = 0;
       var solids = simArmSolids(a);
       simUpload(S.links.pos, new Float32Array(solids.pos)); simUpload(S.links.nrm, new Float32Array(solids.nrm));
       S.links.n = solids.pos.length / 3;

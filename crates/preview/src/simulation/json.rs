@@ -167,6 +167,8 @@ pub(crate) fn simulation_json(
         "machine": machine_json(&s.machine),
         "names": s.machine.joint_names(),
         "head": head_overlay(&s.head.at([0.0; 3], [0.0, 0.0, 1.0])).json(),
+        // Where the arm's tool holder meets the head, up the axis from the tip.
+        "head_length": s.head.body_length.max(s.head.cone_length).max(0.0),
         "moves": keep.len(),
         "total": s.moves.len(),
         "number": base64_u32(&number),
