@@ -608,7 +608,8 @@ fn arm_simulation() -> (ToolPath, Simulation) {
 
 /// Rings of a dome on the bundled delta5 table (radius 20 mm, 0.4 mm apart), their tool axes
 /// tilting out by 3° a ring up to 45°, with B and C by `Simulation::table_from_axes`, checked
-/// against the post's own `robot_post::delta5::inverse`.
+/// against the post's own `robot_post::delta5::inverse`; B is said to stop at 48° (the
+/// profile's 90° would flag nothing), so the last ring is near its limit.
 fn table_simulation() -> (ToolPath, Simulation) {
     let m = MachineProfile::builtin(MachineKind::Delta5);
     let g = m
@@ -634,7 +635,7 @@ fn table_simulation() -> (ToolPath, Simulation) {
         z: 0.0,
         radius: g.table_radius,
         table_above_b_axis: g.table_above_b_axis,
-        b_limits_deg: g.b_limits_deg,
+        b_limits_deg: [g.b_limits_deg[0], 48.0],
         c_limits_deg: (!g.c_continuous).then_some(g.c_limits_deg),
     };
     let sim = Simulation::table_from_axes(&points, table, sim_head(&m), SimMargins::default());
@@ -719,6 +720,14 @@ fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
                 "{name}: axis {axis:?}, path {:?}",
                 q.axis
             );
+            // So the panel says nothing of a tool tip off its point.
+            let text = dom
+                .split("id=\"simtext\">")
+                .nth(1)
+                .and_then(|t| t.split('<').next())
+                .expect("the panel's line");
+            assert!(text.starts_with("move "), "{name}: `{text}`");
+            assert!(!text.contains("tool tip"), "{name}: `{text}`");
             // Every flagged move is listed.
             assert_eq!(
                 body_attribute(&dom, "data-sim-flagged"),
@@ -728,11 +737,22 @@ fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
             let png = dir.join(format!("simulation_{name}_{at}.png"));
             orange.push(Shot::at(&browser, &url, &png).orange());
         }
+        // The Machine list: move 30 collides and the last few bend the wrist under 5° (the
+        // arm), the last ring's 37 moves need B within 5° of its limit (the table).
+        let dom = headless(&browser, &file, &["--dump-dom"]);
+        let dom = String::from_utf8_lossy(&dom.stdout);
+        let list = dom
+            .split("id=\"simflaggedlist\"")
+            .nth(1)
+            .and_then(|s| s.split("id=\"simflaggedleft\"").next())
+            .expect("a Machine list");
         if name == "arm" {
-            // Move 30 collides, the last few bend the wrist under 5°.
-            let dom = headless(&browser, &file, &["--dump-dom"]);
-            let dom = String::from_utf8_lossy(&dom.stdout);
-            assert!(dom.contains("the head collides") && dom.contains("near its singularity"));
+            assert!(list.contains("move 30</span>the head collides"), "{list}");
+            let singular = list.matches("wrist near its singularity").count();
+            assert_eq!(singular, flagged - 1, "{list}");
+        } else {
+            assert_eq!(flagged, 37);
+            assert_eq!(list.matches("B 45.0° within 5° of its limits").count(), 37);
         }
         // The machine is drawn at both moves, and differently: it moved.
         assert!(

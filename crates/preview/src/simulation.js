@@ -332,13 +332,22 @@
     });
     document.getElementById("simtext").textContent = "move " + S.number[i].toLocaleString() + " of " +
       S.d.total.toLocaleString() + " (tool path point " + S.point[i].toLocaleString() + ")" +
-      (S.n < S.d.total ? "; " + S.n.toLocaleString() + " of them embedded" : "");
+      (S.n < S.d.total ? "; " + S.n.toLocaleString() + " of them embedded" : "") + simOff(i, tip);
     document.getElementById("simflags").textContent = f ? simFlagText(i) : "";
     function fmt(v) { return v.map(function (x) { return x.toFixed(4); }).join(","); }
     document.body.setAttribute("data-sim-move", String(S.number[i]));
     document.body.setAttribute("data-sim-tip", fmt(tip));
     document.body.setAttribute("data-sim-axis", fmt(axis));
     if (!quiet) draw();
+  }
+
+  /* How far the arm's tool tip is from the move's point, when it is (a move between points, or
+     joints and frames that disagree with the path). */
+  function simOff(i, tip) {
+    var p = [S.xyz[3 * i], S.xyz[3 * i + 1], S.xyz[3 * i + 2]];
+    if (S.m.kind !== "arm" || !p.every(isFinite)) return "";
+    var d = Math.hypot(tip[0] - p[0], tip[1] - p[1], tip[2] - p[2]);
+    return d > 0.01 ? "; the tool tip is " + d.toFixed(2) + " mm from that point" : "";
   }
 
   /* The head's overlay (tip at 0, axis +Z) placed at tip with the axes u, v, a. */
