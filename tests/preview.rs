@@ -3,10 +3,16 @@
 //! when it is missing and sets `FEATURES_REQUIRE_BROWSER=1`, so there the browser must be
 //! found; elsewhere a machine without Chromium skips these tests and says so.
 //!
-//! A refused plan's page (issue 31) is built here directly with `preview::html`; set
-//! `FEATURES_KEEP_PREVIEW=DIR` to keep that page and its screenshot in `DIR` to look at.
+//! A refused plan's page (issue 31) and the simulation view's pages (issue 36 item 2) are built
+//! here directly with `preview::html`; set `FEATURES_KEEP_PREVIEW=DIR` to keep those pages and
+//! their screenshots in `DIR` to look at.
 
-use preview::{FeatureMesh, HeadShape, MachineShape, Mark, MarkKind, Preview};
+use preview::{
+    FeatureMesh, HeadShape, HeadSize, MachineShape, Mark, MarkKind, Preview, SimArm, SimFlags,
+    SimMachine, SimMargins, SimMove, SimTable, Simulation,
+};
+use robot_post::kuka::Pose;
+use robot_post::{MachineKind, MachineProfile};
 use slicer::toolpath::{MoveKind, PathPoint, Role, ToolPath};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -167,14 +173,14 @@ impl Shot {
         let file = dir.join(format!("{name}.html"));
         std::fs::write(&file, page).unwrap();
         let png = dir.join(format!("{name}.png"));
-        let out = headless(
-            browser,
-            &file,
-            &[&format!("--screenshot={}", png.display())],
-        );
+        Shot::at(browser, &format!("file://{}", file.display()), &png)
+    }
+
+    /// Takes the screenshot of the page at `url` into `png`, at 1000 × 700.
+    fn at(browser: &Path, url: &str, png: &Path) -> Shot {
+        let out = headless_url(browser, url, &[&format!("--screenshot={}", png.display())]);
         assert!(png.is_file(), "{}", String::from_utf8_lossy(&out.stderr));
-        let decoder =
-            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
         let mut reader = decoder.read_info().unwrap();
         let mut buf = vec![0; reader.output_buffer_size()];
         let info = reader.next_frame(&mut buf).unwrap();
@@ -201,6 +207,16 @@ impl Shot {
     /// Pure red pixels: the marks' colour, which nothing else on the page is drawn in.
     fn red(&self) -> usize {
         self.count(|c| c[0] >= 220 && c[1] <= 40 && c[2] <= 40)
+    }
+
+    /// The simulated machine's orange (1, 0.36, 0), shaded: green about 0.36 of red, no blue.
+    /// Neither a feature's colour nor the colour ramps have it (the palette's orange has green
+    /// half of red, the ramp's warm end some blue).
+    fn orange(&self) -> usize {
+        self.count(|c| {
+            let (r, g, b) = (f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
+            r >= 60.0 && b <= 0.04 * r && (0.3 * r..=0.42 * r).contains(&g)
+        })
     }
 
     /// Pixels off the view's background (245, 246, 249).
@@ -376,6 +392,7 @@ fn refused_page(path: &ToolPath, marks: Vec<Mark>, machine: bool) -> String {
             body_radius: 20.0,
             body_length: 60.0,
         }),
+        simulation: None,
     })
 }
 
@@ -447,6 +464,8 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
         "unmarked",
     );
     assert_eq!(without.red(), 0, "red drawn with no marks");
+    // The simulation's orange is nowhere else, not even in the boss's palette orange.
+    assert_eq!(full.orange(), 0, "orange drawn with no simulation");
     assert!(
         full.red() >= marks.len() * MIN_MARK_PIXELS,
         "{} red pixels",
@@ -480,6 +499,278 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
         std::fs::create_dir_all(&keep).unwrap();
         for f in ["refused.html", "refused.png"] {
             std::fs::copy(dir.join(f), keep.join(f)).unwrap();
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A path point of the simulation's paths: a print move of feature 0 (a travel first).
+fn sim_point(i: usize, layer: usize, p: [f64; 3], axis: [f64; 3]) -> PathPoint {
+    PathPoint {
+        feature: 0,
+        layer,
+        kind: if i == 0 {
+            MoveKind::Travel
+        } else {
+            MoveKind::Print
+        },
+        p,
+        axis,
+        e: 0.0,
+        thickness: 0.4,
+        width: 0.45,
+        role: Role::Perimeter,
+    }
+}
+
+/// The head of a bundled profile.
+fn sim_head(m: &MachineProfile) -> HeadSize {
+    HeadSize {
+        tip_radius: m.head.nozzle_tip_radius,
+        half_angle_deg: m.head.nozzle_cone_half_angle_deg,
+        cone_length: m.head.nozzle_length,
+        body_radius: m.head.body_radius,
+        body_length: m.head.body_length,
+    }
+}
+
+/// Moves of the arm simulation.
+const ARM_MOVES: usize = 121;
+
+/// The bundled KUKA cell's arm, its `$BASE` turned by 20° and the part offset, sweeping A1
+/// from -35° to 35° while the other joints move too (A5 from 70° to 2°: the wrist ends near its
+/// singularity); the tool path is where the post's forward kinematics
+/// (`robot_post::kuka::ArmModel::forward`) puts the tool tip, in the part's frame, and move 30
+/// is said to collide.
+fn arm_simulation() -> (ToolPath, Simulation) {
+    let m = MachineProfile::builtin(MachineKind::Kuka);
+    let cell = m
+        .kuka
+        .clone()
+        .expect("the bundled KUKA profile has its cell");
+    let mut base = cell.base.to_array();
+    base[3] = 20.0;
+    let offset = [3.0, -2.0, 1.5];
+    let part_in_robot = Pose::from_frame(base).compose(&Pose {
+        r: Pose::IDENTITY.r,
+        t: offset,
+    });
+    let robot_to_part = part_in_robot.inverse();
+    let tool = Pose::from_frame(cell.tool.to_array());
+    let mut points = vec![];
+    let mut moves = vec![];
+    for i in 0..ARM_MOVES {
+        let t = i as f64 / (ARM_MOVES - 1) as f64;
+        let joints = [
+            -35.0 + 70.0 * t,
+            -95.0 + 15.0 * t,
+            100.0 - 20.0 * t,
+            20.0 - 40.0 * t,
+            70.0 - 68.0 * t,
+            10.0 * t,
+        ];
+        let at = robot_to_part.compose(&cell.arm.forward(joints).compose(&tool));
+        let z = at.z_axis();
+        points.push(sim_point(i, i / 20, at.t, [-z[0], -z[1], -z[2]]));
+        moves.push(SimMove {
+            point: i,
+            joints: joints.to_vec(),
+            flags: SimFlags {
+                collision: i == 30,
+                ..SimFlags::default()
+            },
+        });
+    }
+    let a = &cell.arm;
+    let arm = SimArm {
+        a1: a.a1,
+        a2: a.a2,
+        b: a.b,
+        c1: a.c1,
+        c2: a.c2,
+        c3: a.c3,
+        c4: a.c4,
+        joint_offsets: a.joint_offsets,
+        joint_signs: a.joint_signs,
+        joint_min: a.joint_min,
+        joint_max: a.joint_max,
+        base,
+        part_offset: offset,
+        tool: cell.tool.to_array(),
+    };
+    let margins = SimMargins {
+        singularity_deg: cell.wrist_singularity_deg,
+        ..SimMargins::default()
+    };
+    let sim = Simulation::new(SimMachine::Arm(arm), sim_head(&m), moves, margins);
+    (ToolPath { points }, sim)
+}
+
+/// Rings of a dome on the bundled delta5 table (radius 20 mm, 0.4 mm apart), their tool axes
+/// tilting out by 3° a ring up to 45°, with B and C by `Simulation::table_from_axes`, checked
+/// against the post's own `robot_post::delta5::inverse`; B is said to stop at 48° (the
+/// profile's 90° would flag nothing), so the last ring is near its limit.
+fn table_simulation() -> (ToolPath, Simulation) {
+    let m = MachineProfile::builtin(MachineKind::Delta5);
+    let g = m
+        .delta5
+        .clone()
+        .expect("the bundled delta5 profile has its table");
+    let mut points = vec![];
+    for ring in 0..16 {
+        let (s, c) = (3.0 * ring as f64).to_radians().sin_cos();
+        for k in 0..=36 {
+            let t = std::f64::consts::TAU * k as f64 / 36.0;
+            let p = [20.0 * t.cos(), 20.0 * t.sin(), 0.4 * (ring + 1) as f64];
+            points.push(sim_point(
+                points.len(),
+                ring,
+                p,
+                [s * t.cos(), s * t.sin(), c],
+            ));
+        }
+    }
+    let table = SimTable {
+        centre: [0.0, 0.0],
+        z: 0.0,
+        radius: g.table_radius,
+        table_above_b_axis: g.table_above_b_axis,
+        b_limits_deg: [g.b_limits_deg[0], 48.0],
+        c_limits_deg: (!g.c_continuous).then_some(g.c_limits_deg),
+    };
+    let sim = Simulation::table_from_axes(&points, table, sim_head(&m), SimMargins::default());
+    assert_eq!(sim.moves.len(), points.len());
+    let mut previous = None;
+    for mv in &sim.moves {
+        let (b, c) = robot_post::delta5::inverse(points[mv.point].axis, previous, &g)
+            .expect("within the B limits");
+        assert!(
+            (b - mv.joints[0]).abs() < 1e-9 && (c - mv.joints[1]).abs() < 1e-9,
+            "move {}: the post says B {b} C {c}, the preview {:?}",
+            mv.point,
+            mv.joints
+        );
+        previous = Some(c);
+    }
+    (ToolPath { points }, sim)
+}
+
+/// Three numbers written `x,y,z`.
+fn triple(s: &str) -> [f64; 3] {
+    let v: Vec<f64> = s.split(',').filter_map(|x| x.parse().ok()).collect();
+    assert_eq!(v.len(), 3, "`{s}`");
+    [v[0], v[1], v[2]]
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Orange pixels the arm or the table covers at least in a screenshot.
+const MIN_MACHINE_PIXELS: usize = 2_000;
+
+#[test]
+fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
+    let Some(browser) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("features-simulation-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, (path, sim)) in [("arm", arm_simulation()), ("table", table_simulation())] {
+        let flagged = sim.moves.iter().filter(|m| m.flags.any()).count();
+        let page = preview::html(&Preview {
+            title: format!("simulated {name}"),
+            path: Some(&path),
+            figures: vec![("moves".into(), sim.moves.len().to_string())],
+            simulation: Some(sim.clone()),
+            ..Preview::default()
+        });
+        for bad in ["http:", "https:", "//"] {
+            assert!(!page.contains(bad), "the page refers to `{bad}`");
+        }
+        let file = dir.join(format!("simulation_{name}.html"));
+        std::fs::write(&file, &page).unwrap();
+        let mut orange = vec![];
+        for (at, f) in [("middle", "0.5"), ("end", "1")] {
+            let url = format!("file://{}#sim={f}", file.display());
+            let dom = headless_url(&browser, &url, &["--dump-dom"]);
+            let dom = String::from_utf8_lossy(&dom.stdout);
+            assert_eq!(
+                body_attribute(&dom, "data-error"),
+                None,
+                "{name}: script error"
+            );
+            // The scrubber's move: the fraction of the moves (all embedded, so the move itself).
+            let shown: usize = body_attribute(&dom, "data-sim-move")
+                .and_then(|s| s.parse().ok())
+                .expect("the page names the move shown");
+            let want = (f.parse::<f64>().unwrap() * (sim.moves.len() - 1) as f64).round();
+            assert_eq!(shown, want as usize, "{name} at the {at}");
+            // The head's tip and axis as the viewer's kinematics put them (an arm's by the OPW
+            // chain, a table's by B and C): on the path's point, along its axis.
+            let q = &path.points[sim.moves[shown].point];
+            let tip = triple(&body_attribute(&dom, "data-sim-tip").expect("a tip"));
+            let axis = triple(&body_attribute(&dom, "data-sim-axis").expect("an axis"));
+            assert!(
+                distance(tip, q.p) < 0.01,
+                "{name}: tip {tip:?}, path {:?}",
+                q.p
+            );
+            assert!(
+                distance(axis, q.axis) < 1e-3,
+                "{name}: axis {axis:?}, path {:?}",
+                q.axis
+            );
+            // So the panel says nothing of a tool tip off its point.
+            let text = dom
+                .split("id=\"simtext\">")
+                .nth(1)
+                .and_then(|t| t.split('<').next())
+                .expect("the panel's line");
+            assert!(text.starts_with("move "), "{name}: `{text}`");
+            assert!(!text.contains("tool tip"), "{name}: `{text}`");
+            // Every flagged move is listed.
+            assert_eq!(
+                body_attribute(&dom, "data-sim-flagged"),
+                (flagged > 0).then(|| flagged.to_string()),
+                "{name}"
+            );
+            let png = dir.join(format!("simulation_{name}_{at}.png"));
+            orange.push(Shot::at(&browser, &url, &png).orange());
+        }
+        // The Machine list: move 30 collides and the last few bend the wrist under 5° (the
+        // arm), the last ring's 37 moves need B within 5° of its limit (the table).
+        let dom = headless(&browser, &file, &["--dump-dom"]);
+        let dom = String::from_utf8_lossy(&dom.stdout);
+        let list = dom
+            .split("id=\"simflaggedlist\"")
+            .nth(1)
+            .and_then(|s| s.split("id=\"simflaggedleft\"").next())
+            .expect("a Machine list");
+        if name == "arm" {
+            assert!(list.contains("move 30</span>the head collides"), "{list}");
+            let singular = list.matches("wrist near its singularity").count();
+            assert_eq!(singular, flagged - 1, "{list}");
+        } else {
+            assert_eq!(flagged, 37);
+            assert_eq!(list.matches("B 45.0° within 5° of its limits").count(), 37);
+        }
+        // The machine is drawn at both moves, and differently: it moved.
+        assert!(
+            orange.iter().all(|&n| n >= MIN_MACHINE_PIXELS),
+            "{name}: {orange:?} orange pixels"
+        );
+        let (a, b) = (orange[0] as f64, orange[1] as f64);
+        assert!(
+            (a - b).abs() > 0.05 * a.max(b),
+            "{name}: {orange:?} orange pixels at the middle and the end"
+        );
+        eprintln!("{name}: {orange:?} orange pixels at the middle and the end");
+    }
+    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
+        let keep = PathBuf::from(keep);
+        std::fs::create_dir_all(&keep).unwrap();
+        for e in std::fs::read_dir(&dir).unwrap().flatten() {
+            std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -14,6 +14,14 @@
 //! ([`MachineShape`]) and the head at the first failure ([`HeadShape`]), and a "refused" line
 //! over the figures. Red is kept for them: no feature colour or colour ramp is red.
 //!
+//! With a [`Simulation`] the page has a simulation view (issue 36 item 2): a scrubber over the
+//! program's moves that draws, at each, the head at the tool tip and the machine around it (a
+//! KUKA arm by its OPW forward kinematics, delta5's table tilted by B and turned by C), the
+//! joints and the move's number in a panel, and the moves near a joint limit, near the wrist
+//! singularity or in collision marked on the path and listed ("Machine"). The machine is orange,
+//! a colour nothing else is drawn in. `preview.html#sim=F` opens it at the fraction F (0 to 1)
+//! of the moves.
+//!
 //! What is drawn is decimated, never what is printed: at most [`MAX_DRAWN_POINTS`] path points
 //! (every k-th point of a long run, the ends of every path kept) and the meshes as the caller
 //! gives them (coarse).
@@ -23,11 +31,16 @@
 mod encode;
 mod machine;
 mod marks;
+mod simulation;
 mod tolerance;
 
 use encode::{base64_f32, base64_u32};
-pub use machine::{HeadShape, MachineShape};
+pub use machine::{HeadShape, HeadSize, MachineShape};
 pub use marks::{Mark, MarkKind, MAX_MARKS, MAX_MARK_POINTS};
+pub use simulation::{
+    SimArm, SimFlags, SimMachine, SimMargins, SimMove, SimTable, Simulation, MAX_SIM_FLAGGED,
+    MAX_SIM_MOVES, NEAR_LIMIT_DEG, NEAR_SINGULARITY_DEG,
+};
 use std::fmt::Write as _;
 use toolpath::{MoveKind, ToolPath};
 
@@ -36,6 +49,9 @@ pub const MAX_DRAWN_POINTS: usize = 400_000;
 
 /// The viewer (styles and script), inlined into every preview.
 const VIEWER_HTML: &str = include_str!("viewer.html");
+
+/// The simulation view's script, inlined into the viewer's at its `/*__SIMULATION__*/`.
+const SIMULATION_JS: &str = include_str!("simulation.js");
 
 /// One feature's surface, triangulated for the view.
 #[derive(Debug, Clone, Default)]
@@ -74,6 +90,9 @@ pub struct Preview<'a> {
     /// The print head (at the first failure), in the tool path's frame, drawn red and
     /// translucent with a wire frame.
     pub head: Option<HeadShape>,
+    /// The machine's moves for the simulation view (a scrubber over them), if the caller
+    /// computed its joints.
+    pub simulation: Option<Simulation>,
 }
 
 /// The preview as one HTML document.
@@ -81,6 +100,7 @@ pub fn html(p: &Preview) -> String {
     let data = data_json(p);
     let title = escape(&p.title);
     VIEWER_HTML
+        .replace("/*__SIMULATION__*/", SIMULATION_JS)
         .replace("__TITLE__", &title)
         .replace("__DATA__", &data)
 }
@@ -113,16 +133,19 @@ fn data_json(p: &Preview) -> String {
         (None, false) => serde_json::json!("see Problems"),
         (None, true) => serde_json::Value::Null,
     };
+    // The path's points drawn, which the simulation's moves refer to as well.
+    let drawn_points = p.path.map(drawn).unwrap_or_default();
     let json = serde_json::json!({
         "title": p.title,
         "features": meshes_json(&p.features),
-        "path": p.path.map_or(serde_json::Value::Null, path_json),
+        "path": p.path.map_or(serde_json::Value::Null, |tp| path_json(tp, &drawn_points)),
         "figures": figures,
         "max_drawn_points": MAX_DRAWN_POINTS,
         "refusal": refusal,
         "marks": marks::marks_json(&p.marks),
         "machine": p.machine.as_ref().map_or(serde_json::Value::Null, |m| machine::machine_overlay(m).json()),
         "head": p.head.as_ref().map_or(serde_json::Value::Null, head_json),
+        "simulation": p.simulation.as_ref().map_or(serde_json::Value::Null, |s| simulation::json::simulation_json(s, p.path, &drawn_points)),
     });
     // Inside a <script> element: no `</` may close it early.
     json.to_string().replace("</", "<\\/")
@@ -155,8 +178,7 @@ fn meshes_json(features: &[FeatureMesh]) -> Vec<serde_json::Value> {
 }
 
 /// The drawn points of the path as the viewer reads them.
-fn path_json(tp: &ToolPath) -> serde_json::Value {
-    let keep = drawn(tp);
+fn path_json(tp: &ToolPath, keep: &[usize]) -> serde_json::Value {
     // A layer number over the whole build order: it counts up where the feature or its
     // layer changes.
     let mut count = 0u32;
@@ -178,7 +200,7 @@ fn path_json(tp: &ToolPath) -> serde_json::Value {
     let mut axis = Vec::with_capacity(3 * keep.len());
     let mut thick = Vec::with_capacity(keep.len());
     let mut info = Vec::with_capacity(3 * keep.len());
-    for &i in &keep {
+    for &i in keep {
         let q = &tp.points[i];
         xyz.extend(q.p.map(|x| x as f32));
         axis.extend(q.axis.map(|x| x as f32));

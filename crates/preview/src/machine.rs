@@ -64,6 +64,37 @@ pub struct HeadShape {
     pub body_length: f64,
 }
 
+/// The print head's figures, without a pose (as the machine profile's `[head]` table): a
+/// [`HeadShape`] once placed at a tip along an axis ([`HeadSize::at`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadSize {
+    /// Radius of the cone at the tip, mm.
+    pub tip_radius: f64,
+    /// Half-angle of the cone, degrees.
+    pub half_angle_deg: f64,
+    /// Length of the cone up the axis from the tip, mm.
+    pub cone_length: f64,
+    /// Radius of the body cylinder, mm.
+    pub body_radius: f64,
+    /// The body's top, measured from the tip up the axis, mm.
+    pub body_length: f64,
+}
+
+impl HeadSize {
+    /// The head with its tip at `tip` and its axis (tip towards body) along `axis`.
+    pub fn at(&self, tip: [f64; 3], axis: [f64; 3]) -> HeadShape {
+        HeadShape {
+            tip,
+            axis,
+            tip_radius: self.tip_radius,
+            half_angle_deg: self.half_angle_deg,
+            cone_length: self.cone_length,
+            body_radius: self.body_radius,
+            body_length: self.body_length,
+        }
+    }
+}
+
 /// Triangles (9 floats each) and line segments (6 floats each) to draw.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct Overlay {
