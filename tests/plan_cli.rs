@@ -1464,3 +1464,96 @@ fn a_plate_printed_on_its_boss_is_refused_and_orient_auto_stands_it_on_the_plate
         assert_eq!(f["unsupported_area_mm2"], 0.0);
     }
 }
+
+/// Support as a feature of the model (issue 37 item 3, the seed's `support_structure`):
+/// `extract --json` lists one `support` feature for each feature that support material
+/// carries, that feature its child, numbered after every feature of the file; `plan.json`
+/// lists one for each feature the plan laid support under, its volume that feature's support
+/// material, the same children as `extract` where the part stands as modelled. A part that
+/// needs no support lists none.
+#[test]
+fn support_material_is_a_feature_of_the_model() {
+    let ids_of = |v: &Value, key: &str| -> Vec<u64> {
+        v[key]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|f| f["id"].as_u64())
+            .collect()
+    };
+    let children_of = |v: &Value| -> Vec<u64> {
+        let mut c: Vec<u64> = v["support_features"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .flat_map(|s| s["children"].as_array().cloned().unwrap_or_default())
+            .filter_map(|c| c.as_u64())
+            .collect();
+        c.sort();
+        c
+    };
+    for (name, needs) in [
+        ("overhang_60", true),
+        ("bridge", true),
+        ("plate_boss_boss", false),
+    ] {
+        let step = fixture(&format!("{name}.step"));
+        let o = Command::new(BIN)
+            .args(["extract", "--json"])
+            .arg(&step)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let x: Value = serde_json::from_slice(&o.stdout).expect("extract --json");
+        let ids = ids_of(&x, "features");
+        let top = ids.iter().max().copied().unwrap_or(0);
+        let sup = x["support_features"].as_array().expect("support_features");
+        assert_eq!(!sup.is_empty(), needs, "{name}: {sup:?}");
+        for s in sup {
+            assert_eq!(s["kind"], "support", "{name}");
+            let id = s["id"].as_u64().expect("id");
+            assert!(id > top, "{name}: support id {id} among the features'");
+            let children = s["children"].as_array().expect("children");
+            assert!(!children.is_empty(), "{name}");
+            for c in children {
+                assert!(ids.contains(&c.as_u64().expect("id")), "{name}: child {c}");
+            }
+            assert!(s["layers"].as_u64().unwrap_or(0) > 0, "{name}: {s}");
+            assert!(s["area_mm2"].as_f64().unwrap_or(0.0) > 0.0, "{name}: {s}");
+        }
+        let scratch = Scratch::new(&format!("support-feature-{name}"));
+        let out = scratch.path("out");
+        let o = plan(
+            &format!("{name}.step"),
+            &["--machine", "marlin", "-o", out.to_str().expect("utf-8")],
+        );
+        assert_eq!(o.status.code(), Some(0), "{name}: {}", stderr(&o));
+        let text = std::fs::read_to_string(out.join("plan.json")).expect("plan.json");
+        let p: Value = serde_json::from_str(&text).expect("plan.json");
+        let carried: Vec<(u64, f64)> = p["features"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|f| {
+                let v = f["support_volume_mm3"].as_f64()?;
+                (v > 0.0).then_some((f["id"].as_u64()?, v))
+            })
+            .collect();
+        let plan_ids = ids_of(&p, "features");
+        let sup = p["support_features"].as_array().expect("support_features");
+        assert_eq!(sup.len(), carried.len(), "{name}: {sup:?}");
+        for (s, (child, volume)) in sup.iter().zip(&carried) {
+            assert_eq!(s["kind"], "support", "{name}");
+            let id = s["id"].as_u64().expect("id");
+            assert!(
+                !plan_ids.contains(&id),
+                "{name}: support id {id} is a feature's"
+            );
+            assert_eq!(s["children"], serde_json::json!([child]), "{name}");
+            assert_eq!(s["volume_mm3"].as_f64(), Some(*volume), "{name}");
+        }
+        if p["placement"].is_null() {
+            assert_eq!(children_of(&x), children_of(&p), "{name}");
+        }
+    }
+}

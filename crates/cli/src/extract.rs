@@ -31,6 +31,11 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
         .chain(&assembly.warnings)
         .cloned()
         .collect();
+    let support = if args.json {
+        support_json(&assembly).map_err(|e| Failure::new(path, e))?
+    } else {
+        vec![]
+    };
     let mut solids = vec![];
     let mut offset = 0;
     for tree in assembly.trees {
@@ -49,7 +54,7 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     }
     let source = path.display().to_string();
     let text = if args.json {
-        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids, warnings))
+        let mut t = serde_json::to_string_pretty(&to_json(&source, &solids, support, warnings))
             .map_err(|e| Failure::new(path, e))?;
         t.push('\n');
         t
@@ -59,7 +64,39 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     emit(&text)
 }
 
-fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
+/// Support material as features of the model (issue 37 item 3, the seed's
+/// `support_structure`): for each two5d feature whose planar layers need support material
+/// under the default process and the Marlin profile's bead, as the part is modelled
+/// ([`plan::support::planar`], what `plan` lays), one feature of kind `support` with that
+/// feature as its child, numbered after every feature of the file: the layers it is laid in
+/// and their area summed.
+fn support_json(assembly: &features::Assembly) -> Result<Vec<Value>, plan::PlanError> {
+    let bead = robot_post::MachineProfile::builtin(robot_post::MachineKind::Marlin).bead();
+    let (_, columns) =
+        plan::support::planar(assembly, &plan::Process::default(), bead.width, true)?;
+    let next: usize = assembly.trees.iter().map(|t| t.features.len()).sum();
+    Ok(columns
+        .iter()
+        .enumerate()
+        .map(|(k, (&child, regions))| {
+            let layers = regions
+                .sparse
+                .iter()
+                .zip(&regions.interface)
+                .filter(|(s, i)| !s.is_empty() || !i.is_empty())
+                .count();
+            json!({
+                "id": next + k,
+                "kind": "support",
+                "children": [child],
+                "layers": layers,
+                "area_mm2": round(regions.area(), 1e3),
+            })
+        })
+        .collect())
+}
+
+fn to_json(source: &str, solids: &[Solid], support: Vec<Value>, warnings: Vec<String>) -> Value {
     let volume: f64 = solids.iter().map(|s| s.tree.part_volume).sum();
     let area: f64 = solids.iter().map(|s| s.tree.part_area).sum();
     let faces: usize = solids.iter().map(|s| s.tree.part_faces).sum();
@@ -90,6 +127,7 @@ fn to_json(source: &str, solids: &[Solid], warnings: Vec<String>) -> Value {
         "units": "mm",
         "part": {"volume_mm3": round(volume, 1e3), "area_mm2": round(area, 1e3), "faces": faces, "genus": genus},
         "features": features,
+        "support_features": support,
         "build_order": order,
         "depth": solids.iter().map(|s| s.tree.depth).max().unwrap_or(0),
         "concave_loops": roots,

@@ -64,7 +64,7 @@ impl Stages {
         let program = posted.map(|p| p.program);
         let filament_area = machine.bead().filament_area();
         // The pedestal first (printed first), then the part's features in build order.
-        let reports = checked
+        let reports: Vec<FeatureReport> = checked
             .pedestal
             .as_ref()
             .map(|p| pedestal_report(p.report(filament_area), &checked, program))
@@ -101,6 +101,7 @@ impl Stages {
             machine: machine.name.clone(),
             slicing: extracted.slicing.as_str(),
             complete: passed.complete,
+            support_features: crate::report::support_features(&reports),
             features: reports,
             skirt_brim: adhesion,
             warnings: texts(&all),

@@ -340,6 +340,37 @@ pub struct AdhesionEntry {
     pub volume_mm3: f64,
 }
 
+/// A support feature (issue 37 item 3): the support material under one feature, which is its
+/// child (built on it, layer by layer with it).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SupportFeatureEntry {
+    /// File-wide id: after the part's features and the pedestal.
+    pub id: usize,
+    /// `support`.
+    pub kind: &'static str,
+    /// The features it carries (file-wide ids).
+    pub children: Vec<usize>,
+    /// Its bead volume, mm³ (the children's `support_volume_mm3`).
+    pub volume_mm3: f64,
+}
+
+/// A support feature for each feature of `features` with support material, numbered after
+/// the highest of their ids.
+pub fn support_features(features: &[FeatureReport]) -> Vec<SupportFeatureEntry> {
+    let next = features.iter().map(|f| f.feature.id + 1).max().unwrap_or(0);
+    features
+        .iter()
+        .filter(|f| f.support_volume_mm3 > 0.0)
+        .enumerate()
+        .map(|(k, f)| SupportFeatureEntry {
+            id: next + k,
+            kind: "support",
+            children: vec![f.feature.id],
+            volume_mm3: f.support_volume_mm3,
+        })
+        .collect()
+}
+
 /// `plan.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -356,6 +387,10 @@ pub struct PlanReport {
     pub complete: bool,
     /// Every feature, in build order.
     pub features: Vec<FeatureReport>,
+    /// Support material as features of the model (issue 37, the seed's `support_structure`):
+    /// one for each feature support material carries, with that feature as its child; laid
+    /// with it, layer by layer ([`SupportFeatureEntry`]).
+    pub support_features: Vec<SupportFeatureEntry>,
     /// The skirt and brim laid before the part (Marlin; absent when none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub skirt_brim: Option<AdhesionEntry>,
