@@ -55,6 +55,9 @@ pub struct KrlMove {
     pub motion: Motion,
     /// The target.
     pub target: Target,
+    /// KUKA's Status and Turn of a Cartesian `PTP` (`{.., S 'B010', T 'B000010'}`), when
+    /// given.
+    pub status_turn: Option<(u8, u8)>,
     /// Ends with `C_DIS`.
     pub approximated: bool,
     /// The extruder output's state during the motion.
@@ -365,20 +368,63 @@ fn parse_offset(s: &str) -> Option<[f64; 3]> {
 const FRAME_KEYS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
 const AXIS_KEYS: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
 
-/// A KRL aggregate `{K v, K v, ...}` (upper case) with exactly `keys`, each once, as numbers
-/// in `keys`' order.
-fn aggregate(s: &str, keys: &[&str; 6]) -> Result<[f64; 6], String> {
+/// The components `K v` of a KRL aggregate `{K v, K v, ...}` (upper case), in order.
+fn components(s: &str) -> Result<Vec<(&str, &str)>, String> {
     let inner = s
         .strip_prefix('{')
         .and_then(|r| r.strip_suffix('}'))
         .ok_or_else(|| format!("`{s}` is not an aggregate {{...}}"))?;
+    inner
+        .split(',')
+        .map(|part| {
+            let mut words = part.split_whitespace();
+            match (words.next(), words.next(), words.next()) {
+                (Some(key), Some(value), None) => Ok((key, value)),
+                _ => Err(format!("`{}` is not `KEY value` in {s}", part.trim())),
+            }
+        })
+        .collect()
+}
+
+/// A KRL aggregate `{K v, K v, ...}` (upper case) with exactly `keys`, each once, as numbers
+/// in `keys`' order.
+fn aggregate(s: &str, keys: &[&str; 6]) -> Result<[f64; 6], String> {
+    let (v, st) = pos_aggregate(s, keys)?;
+    match st {
+        None => Ok(v),
+        Some(_) => Err(format!("unexpected component `S` or `T` in {s}")),
+    }
+}
+
+/// An aggregate's six numbers, with the Status and Turn when given.
+type Pos = ([f64; 6], Option<(u8, u8)>);
+
+/// A KRL aggregate with exactly `keys`, each once, and optionally the Status `S` and Turn `T`
+/// of a POS (both or neither, as binary `'B..'` or decimal integers of 3 and 6 bits).
+fn pos_aggregate(s: &str, keys: &[&str; 6]) -> Result<Pos, String> {
     let mut v = [f64::NAN; 6];
     let mut seen = [false; 6];
-    for part in inner.split(',') {
-        let mut words = part.split_whitespace();
-        let (Some(key), Some(value), None) = (words.next(), words.next(), words.next()) else {
-            return Err(format!("`{}` is not `KEY value` in {s}", part.trim()));
-        };
+    let (mut status, mut turn) = (None, None);
+    for (key, value) in components(s)? {
+        if key == "S" || key == "T" {
+            let (slot, bits) = if key == "S" {
+                (&mut status, 3)
+            } else {
+                (&mut turn, 6)
+            };
+            if slot.is_some() {
+                return Err(format!("component `{key}` twice in {s}"));
+            }
+            let n = match value.strip_prefix("'B").and_then(|b| b.strip_suffix('\'')) {
+                Some(b) => u8::from_str_radix(b, 2).ok(),
+                None => value.parse::<u8>().ok(),
+            };
+            match n {
+                Some(n) if u32::from(n) < 1 << bits => *slot = Some(n),
+                _ => return Err(format!("`{value}` is not a {bits}-bit {key} in {s}")),
+            }
+            continue;
+        }
         let k = keys
             .iter()
             .position(|&x| x == key)
@@ -398,7 +444,11 @@ fn aggregate(s: &str, keys: &[&str; 6]) -> Result<[f64; 6], String> {
     if let Some(k) = seen.iter().position(|s| !s) {
         return Err(format!("component `{}` missing in {s}", keys[k]));
     }
-    Ok(v)
+    match (status, turn) {
+        (Some(s), Some(t)) => Ok((v, Some((s, t)))),
+        (None, None) => Ok((v, None)),
+        _ => Err(format!("`S` without `T` or `T` without `S` in {s}")),
+    }
 }
 
 /// `$OUT[n]=TRUE` → `(n, true)`.
@@ -595,6 +645,7 @@ impl Run<'_> {
             return Err(err(file, line, "a motion before BAS (#INITMOV,0 )"));
         }
         let rest = rest.trim();
+        let mut status_turn = None;
         let (target, tail) = if rest.starts_with('{') {
             let close = rest
                 .find('}')
@@ -603,7 +654,12 @@ impl Run<'_> {
             let target = if agg.contains("A1 ") {
                 Target::Axis(aggregate(agg, &AXIS_KEYS).map_err(|r| err(file, line, r))?)
             } else {
-                Target::Frame(aggregate(agg, &FRAME_KEYS).map_err(|r| err(file, line, r))?)
+                let (f, st) = pos_aggregate(agg, &FRAME_KEYS).map_err(|r| err(file, line, r))?;
+                if st.is_some() && motion != Motion::Ptp {
+                    return Err(err(file, line, "Status and Turn on a LIN"));
+                }
+                status_turn = st;
+                Target::Frame(f)
             };
             (target, rest[close + 1..].trim())
         } else {
@@ -645,6 +701,7 @@ impl Run<'_> {
         self.out.moves.push(KrlMove {
             motion,
             target,
+            status_turn,
             approximated,
             extruder: self.extruder,
             vel_cp: self.vel,

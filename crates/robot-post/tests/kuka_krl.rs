@@ -1109,3 +1109,149 @@ fn print_points_that_go_nowhere_have_no_motion() {
     let src = &program.files[0].1;
     assert_eq!(src.matches("$OUT[1]=TRUE").count(), 1);
 }
+
+/// The flange pose of a Cartesian motion read back, in the robot's base frame.
+fn flange_of(read: &KrlRead, f: [f64; 6]) -> Pose {
+    let base = Pose::from_frame(read.base.expect("$BASE"));
+    let tool_inv = Pose::from_frame(read.tool.expect("$TOOL")).inverse();
+    base.compose(&Pose::from_frame(f)).compose(&tool_inv)
+}
+
+#[test]
+fn every_ptp_carries_the_status_and_turn_of_a_solution() {
+    let m = profile();
+    let cell = m.kuka.as_ref().expect("kuka");
+    let program = kuka(&all_shapes(), &m, "shapes", "shapes.step").expect("program");
+    let read = krl::read(&program.files).expect("reads");
+    let ptps: Vec<&KrlMove> = read
+        .moves
+        .iter()
+        .filter(|mv| mv.motion == Motion::Ptp && matches!(mv.target, Target::Frame(_)))
+        .collect();
+    assert!(!ptps.is_empty());
+    let home_status = cell.arm.configuration(&cell.home);
+    for mv in ptps {
+        let (s, t) = mv
+            .status_turn
+            .unwrap_or_else(|| panic!("{}:{} has no S and T", mv.file, mv.line));
+        // S and T pick a solution of the pose within the joint limits: one whose
+        // configuration is S and whose joints' signs are T.
+        let flange = flange_of(&read, frame_of(mv));
+        let picked: Vec<[f64; 6]> = cell
+            .arm
+            .inverse(&flange)
+            .into_iter()
+            .flat_map(|j| {
+                // Each joint also taken ±360° where its limits allow.
+                let mut all = vec![j];
+                for i in 0..6 {
+                    let more: Vec<[f64; 6]> = all
+                        .iter()
+                        .flat_map(|a| {
+                            [-360.0, 360.0].map(|d| {
+                                let mut b = *a;
+                                b[i] += d;
+                                b
+                            })
+                        })
+                        .collect();
+                    all.extend(more);
+                }
+                all
+            })
+            .filter(|j| cell.arm.within_limits(j))
+            .filter(|j| cell.arm.configuration(j) == s)
+            // The frame is written rounded: a joint within 0.01° of 0 may read either side.
+            .filter(|j| (0..6).all(|n| j[n].abs() < 0.01 || (t >> n & 1 == 1) == (j[n] < 0.0)))
+            .collect();
+        assert!(
+            !picked.is_empty(),
+            "{}:{}: no solution with S {s:03b} T {t:06b}",
+            mv.file,
+            mv.line
+        );
+        // The arm stays in the configuration it starts in at home.
+        assert_eq!(s, home_status, "{}:{}", mv.file, mv.line);
+    }
+    // The text is KRL's binary form.
+    let src = &program.files[0].1;
+    let ptp = src
+        .lines()
+        .find(|l| l.starts_with("PTP {X"))
+        .expect("a Cartesian PTP");
+    assert!(
+        ptp.contains(", S 'B") && ptp.contains(", T 'B") && ptp.ends_with("'}"),
+        "{ptp}"
+    );
+    assert!(program
+        .warnings
+        .iter()
+        .all(|w| !w.contains("changes configuration")));
+}
+
+#[test]
+fn a_change_of_configuration_is_warned_naming_the_motion() {
+    let m = profile();
+    let cell = m.kuka.as_ref().expect("kuka");
+    // Two tool axes either side of the forearm's line: with A4 held within ±30° the wrist
+    // can only reach the second by flipping A5's sign.
+    let mut m2 = m.clone();
+    let k = m2.kuka.as_mut().expect("kuka");
+    k.arm.joint_min[3] = -30.0;
+    k.arm.joint_max[3] = 30.0;
+    k.home[3] = 0.0;
+    let tcp = |j: [f64; 6]| cell.arm.forward(j).compose(&cell.tool.pose());
+    let (p1, p2) = (
+        tcp([0.0, -80.0, 100.0, 0.0, 25.0, 0.0]),
+        tcp([0.0, -80.0, 100.0, 0.0, -25.0, 0.0]),
+    );
+    // The table's origin under the path's XY middle and its lowest point, so that the post
+    // places the part's points back on those poses.
+    let b = [
+        (p1.t[0] + p2.t[0]) / 2.0,
+        (p1.t[1] + p2.t[1]) / 2.0,
+        p1.t[2].min(p2.t[2]) - T,
+    ];
+    k.base = KrlFrame {
+        x: b[0],
+        y: b[1],
+        z: b[2],
+        a: 0.0,
+        b: 0.0,
+        c: 0.0,
+    };
+    let mut path = ToolPath::default();
+    let mut pts = Vec::new();
+    for k in 0..=20 {
+        let s = f64::from(k) / 20.0;
+        let p: [f64; 3] = std::array::from_fn(|i| p1.t[i] + s * (p2.t[i] - p1.t[i]) - b[i]);
+        let a1 = p1.z_axis().map(|v| -v);
+        let a2 = p2.z_axis().map(|v| -v);
+        let axis: [f64; 3] = std::array::from_fn(|i| (1.0 - s) * a1[i] + s * a2[i]);
+        pts.push((p, axis));
+    }
+    // The travel to the start, then print points from it (the first goes nowhere).
+    pts.insert(0, pts[0]);
+    push_path(&mut path, 9, 0, &pts);
+    let program = kuka(&path, &m2, "flip", "flip.step").expect("program");
+    let f = &program.figures[&9];
+    assert!(f.configuration_changes >= 1, "{f:?}");
+    let w = program
+        .warnings
+        .iter()
+        .find(|w| w.contains("changes configuration"))
+        .expect("a warning");
+    // It names the motion by its file and line, and that line is a motion.
+    let at = w.split("(flip.src:").nth(1).expect("file named");
+    let line: usize = at
+        .split(',')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .expect("line");
+    let src = &program.files[0].1;
+    let text = src.lines().nth(line - 1).expect("line in the file");
+    assert!(
+        text.starts_with("LIN ") || text.starts_with("PTP "),
+        "{w}: {text}"
+    );
+}

@@ -4,6 +4,7 @@
 use super::cell::{ExtruderSwitch, KukaCell};
 use super::checks::{KukaFigures, Reach};
 use super::motion::Step;
+use super::opw::bits_text;
 use crate::gcode::{comment_text, push_line};
 use crate::machine::MachineProfile;
 use crate::sink::{insert_notes, write_file, Chunked, ProgramSink};
@@ -144,6 +145,19 @@ pub fn frame_text(f: &[f64; 6]) -> String {
     )
 }
 
+/// A KRL POS aggregate `{X .., Y .., Z .., A .., B .., C .., S 'B..', T 'B..'}`: the frame of
+/// [`frame_text`] with KUKA's Status (3 bits) and Turn (6 bits) of the joints it is reached
+/// with, in binary as KRL writes them.
+pub fn pos_text(f: &[f64; 6], status: u8, turn: u8) -> String {
+    let frame = frame_text(f);
+    format!(
+        "{}, S {}, T {}}}",
+        &frame[..frame.len() - 1],
+        bits_text(status, 3),
+        bits_text(turn, 6)
+    )
+}
+
 /// The program's lines, one per step ([`Steps::push`]), and what writing them finds.
 struct Steps<'a> {
     cell: &'a KukaCell,
@@ -155,6 +169,9 @@ struct Steps<'a> {
     /// Print LINs whose feed ratio is beyond the analog output's full scale, and the largest
     /// such ratio.
     beyond: (usize, f64),
+    /// The file being written and the lines written into it so far.
+    file: String,
+    line: usize,
 }
 
 impl Steps<'_> {
@@ -189,19 +206,22 @@ impl Steps<'_> {
             }
             Step::Move { ptp, pose, point } => {
                 let feature = self.path.points[*point].feature;
-                let (f, note) = self.reach.motion(pose, *point, feature);
-                let mut line = if *ptp {
-                    format!("PTP {}", frame_text(&f))
-                } else {
-                    format!("LIN {} C_DIS", frame_text(&f))
+                let at = (self.file.as_str(), self.line + 1);
+                let solved = self.reach.motion(pose, *point, feature, at);
+                let f = solved.frame;
+                let mut line = match (*ptp, solved.joints) {
+                    (true, Some((_, s, t))) => format!("PTP {}", pos_text(&f, s, t)),
+                    (true, None) => format!("PTP {}", frame_text(&f)),
+                    (false, _) => format!("LIN {} C_DIS", frame_text(&f)),
                 };
-                if let Some(note) = note {
+                if let Some(note) = solved.note {
                     line.push_str(" ; ");
                     line.push_str(note);
                 }
                 line
             }
         };
+        self.line += 1 + line.matches('\n').count();
         push_line(out, &line);
     }
 
@@ -218,6 +238,8 @@ impl Steps<'_> {
         name: &str,
     ) -> Result<(), PostError> {
         let mut file = Chunked::open(sink, name)?;
+        self.file = name.to_string();
+        self.line = text.matches('\n').count();
         let mut seen = 0;
         for step in steps {
             self.push(&step, &mut text);
@@ -300,6 +322,8 @@ pub(super) fn write_files(
         reach,
         vel: None,
         beyond: (0, 0.0),
+        file: String::new(),
+        line: 0,
     };
     let main_src = format!("{name}.src");
     let mut steps = steps;

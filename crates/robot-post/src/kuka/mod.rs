@@ -62,6 +62,13 @@
 //!   nearest the previous pose's, in the same configuration when there is one. Unreachable
 //!   poses and poses within `wrist_singularity_deg` of a stretched wrist (|A5| small) are
 //!   reported ([`KukaFigures`], warnings, and a comment on the LIN), not refused.
+//! - **Status and Turn.** The configuration is KUKA's Status S: bit 0 the wrist centre behind
+//!   A1 (overhead area), bit 1 A3 at or past the stretched arm's angle (elbow up), bit 2 A5 ≤ 0
+//!   (wrist flipped); the Turn T has bit n set where A(n+1) < 0. Every Cartesian `PTP` carries
+//!   the S and T of the solution the reach check followed (`PTP {X .., ..., C .., S 'B010', T
+//!   'B000010'}`), so the controller takes that solution; LINs keep the configuration they
+//!   start in. The program keeps home's configuration throughout: a motion on which it would
+//!   change is a warning naming the motion (its number, file and line, and the two S).
 
 pub(crate) mod cell;
 mod checks;
@@ -74,8 +81,9 @@ use std::collections::BTreeMap;
 
 pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KukaCell};
 pub use checks::KukaFigures;
-pub use krl_text::{frame_text, krl_name, HOME_NAME, KRL_NAME_MAX};
+pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
 pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
+pub use opw::{bits_text, turn};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 
 use crate::machine::MachineProfile;
