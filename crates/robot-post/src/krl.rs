@@ -84,6 +84,11 @@ pub struct KrlRead {
     pub base: Option<[f64; 6]>,
     /// `$TOOL` as last set.
     pub tool: Option<[f64; 6]>,
+    /// The base number of `BAS (#BASE, n)`, when the program selects one (`base` is then the
+    /// frame its comment `; assumed BASE_DATA[n] = {..}` states).
+    pub base_index: Option<u32>,
+    /// The tool number of `BAS (#TOOL, n)`, as `base_index`.
+    pub tool_index: Option<u32>,
     /// The main program's `; part offset X.. Y.. Z..` comment.
     pub offset: Option<[f64; 3]>,
     /// `$APO.CDIS` as last set (mm).
@@ -113,6 +118,9 @@ struct Module {
     /// `DECL AXIS` of the `.dat`, by lower-case name.
     axes: BTreeMap<String, [f64; 6]>,
     offset: Option<[f64; 3]>,
+    /// The frames the comments `; assumed BASE_DATA[n] = {..}` (`TOOL_DATA`) state, by
+    /// (`BASE` or `TOOL`, n).
+    assumed: BTreeMap<(String, u32), [f64; 6]>,
 }
 
 fn err(file: &str, line: usize, reason: impl Into<String>) -> KrlError {
@@ -265,6 +273,10 @@ fn read_src(file: &str, stem: &str, text: &str) -> Result<Module, KrlError> {
             if let Some(rest) = c.strip_prefix("part offset ") {
                 module.offset = parse_offset(rest);
             }
+            if let Some(rest) = c.strip_prefix("assumed ") {
+                let (key, frame) = assumed_frame(rest).map_err(|r| err(file, line, r))?;
+                module.assumed.insert(key, frame);
+            }
         }
         if stmt.is_empty() {
             continue;
@@ -363,6 +375,18 @@ fn parse_offset(s: &str) -> Option<[f64; 3]> {
         v[k] = words.next()?.strip_prefix(letter)?.parse().ok()?;
     }
     Some(v)
+}
+
+/// `BASE_DATA[n] = {X .., ...} (...)` → `(("BASE", n), frame)`.
+fn assumed_frame(s: &str) -> Result<((String, u32), [f64; 6]), String> {
+    let bad = || format!("`assumed {s}` is not `assumed BASE_DATA[n] = {{..}}`");
+    let (what, rest) = s.split_once("_DATA[").ok_or_else(bad)?;
+    let (n, rest) = rest.split_once(']').ok_or_else(bad)?;
+    let n: u32 = n.trim().parse().map_err(|_| bad())?;
+    let rest = rest.trim().strip_prefix('=').ok_or_else(bad)?.trim();
+    let close = rest.find('}').ok_or_else(bad)?;
+    let frame = aggregate(&rest[..=close].to_ascii_uppercase(), &FRAME_KEYS)?;
+    Ok(((what.trim().to_ascii_uppercase(), n), frame))
 }
 
 const FRAME_KEYS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
@@ -542,8 +566,37 @@ impl Run<'_> {
         if upper.starts_with("GLOBAL INTERRUPT DECL ") || upper.starts_with("INTERRUPT ON ") {
             return Ok(());
         }
-        if upper.replace(' ', "") == "BAS(#INITMOV,0)" {
+        let compact = upper.replace(' ', "");
+        if compact == "BAS(#INITMOV,0)" {
             self.initialised = true;
+            return Ok(());
+        }
+        for what in ["BASE", "TOOL"] {
+            let Some(n) = compact
+                .strip_prefix(&format!("BAS(#{what},"))
+                .and_then(|r| r.strip_suffix(')'))
+            else {
+                continue;
+            };
+            let n: u32 = n
+                .parse()
+                .ok()
+                .filter(|n| (1..=32).contains(n))
+                .ok_or_else(|| err(file, line, format!("bad {what} number `{n}`")))?;
+            let frame = m.assumed.get(&(what.to_string(), n)).ok_or_else(|| {
+                err(
+                    file,
+                    line,
+                    format!("BAS (#{what}, {n}) without `; assumed {what}_DATA[{n}] = {{..}}`"),
+                )
+            })?;
+            if what == "BASE" {
+                self.out.base = Some(*frame);
+                self.out.base_index = Some(n);
+            } else {
+                self.out.tool = Some(*frame);
+                self.out.tool_index = Some(n);
+            }
             return Ok(());
         }
         if let Some((lhs, rhs)) = upper.split_once('=') {

@@ -1255,3 +1255,68 @@ fn a_change_of_configuration_is_warned_naming_the_motion() {
         "{w}: {text}"
     );
 }
+
+#[test]
+fn base_and_tool_numbers_select_the_controllers_frames() {
+    let m = profile();
+    let path = tilted_planes(1);
+    let raw = kuka(&path, &m, "planes", "planes.step").expect("program");
+    let mut numbered = m.clone();
+    let k = numbered.kuka.as_mut().expect("kuka");
+    k.base_index = Some(3);
+    k.tool_index = Some(7);
+    let program = kuka(&path, &numbered, "planes", "planes.step").expect("program");
+    let src = &program.files[0].1;
+    // The frames are selected, not assigned, and the frames assumed are stated.
+    assert!(src.lines().any(|l| l == "BAS (#BASE, 3)"), "{src}");
+    assert!(src.lines().any(|l| l == "BAS (#TOOL, 7)"), "{src}");
+    assert!(!src
+        .lines()
+        .any(|l| l.starts_with("$BASE") || l.starts_with("$TOOL")));
+    let cell = m.kuka.as_ref().expect("kuka");
+    let read = round_trip(&path, &program.files);
+    assert_eq!((read.base_index, read.tool_index), (Some(3), Some(7)));
+    for k in 0..6 {
+        assert!((read.base.expect("base")[k] - cell.base.to_array()[k]).abs() < 1e-3);
+        assert!((read.tool.expect("tool")[k] - cell.tool.to_array()[k]).abs() < 1e-3);
+    }
+    // The motions are the raw program's: only the frames' lines differ.
+    let raw_read = krl::read(&raw.files).expect("reads");
+    assert_eq!(raw_read.base_index, None);
+    assert_eq!(raw_read.moves.len(), read.moves.len());
+    for (a, b) in raw_read.moves.iter().zip(&read.moves) {
+        assert_eq!(a.target, b.target);
+    }
+    // A BAS call the program does not state its frame for is refused.
+    let bare: Vec<(String, String)> = program
+        .files
+        .iter()
+        .map(|(n, t)| {
+            let t = t
+                .lines()
+                .filter(|l| !l.starts_with("; assumed BASE_DATA"))
+                .collect::<Vec<_>>()
+                .join("\n");
+            (n.clone(), t)
+        })
+        .collect();
+    let e = krl::read(&bare).expect_err("refused").to_string();
+    assert!(e.contains("BAS (#BASE, 3) without"), "{e}");
+    // Numbers outside 1..32 are refused in the profile.
+    for (from, to, needle) in [
+        (
+            "part_position = [0.0, 0.0]",
+            "part_position = [0.0, 0.0]\nbase_index = 0",
+            "kuka.base_index",
+        ),
+        (
+            "part_position = [0.0, 0.0]",
+            "part_position = [0.0, 0.0]\ntool_index = 33",
+            "kuka.tool_index",
+        ),
+    ] {
+        let text = robot_post::machine::KUKA_TOML.replacen(from, to, 1);
+        let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+    }
+}

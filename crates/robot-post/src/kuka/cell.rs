@@ -97,6 +97,17 @@ pub struct KukaCell {
     pub part_position: [f64; 2],
     /// `$TOOL`: the nozzle tip in the flange frame, Z along the nozzle.
     pub tool: KrlFrame,
+    /// The controller's base number n (1..32) that holds `base`: when given, the program
+    /// selects it with `BAS (#BASE, n)` instead of assigning `$BASE`, and states the frame it
+    /// assumes `BASE_DATA[n]` holds in a comment, for the integrator to check. Optional: the
+    /// frame is assigned to `$BASE` when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_index: Option<u32>,
+    /// The controller's tool number n (1..32) that holds `tool`, as `base_index`:
+    /// `BAS (#TOOL, n)` and a comment stating the assumed `TOOL_DATA[n]`. Optional: `$TOOL` is
+    /// assigned when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_index: Option<u32>,
     /// Home position A1..A6 (degrees), where the program starts and ends (`PTP`).
     pub home: [f64; 6],
     /// `$VEL.CP` of print moves (m/s); 0 derives it from `print_speed` and
@@ -164,6 +175,14 @@ impl KukaCell {
             }
             if let Some(x) = v[3..].iter().find(|x| x.abs() > 360.0) {
                 return Err(bad(field, format!("A, B, C must be within ±360°, got {x}")));
+            }
+        }
+        for (field, n) in [
+            ("kuka.base_index", self.base_index),
+            ("kuka.tool_index", self.tool_index),
+        ] {
+            if let Some(n) = n.filter(|n| !(1..=32).contains(n)) {
+                return Err(bad(field, format!("must be a number 1..32, got {n}")));
             }
         }
         if let Some(x) = self

@@ -1,7 +1,7 @@
 //! The KRL text of a program: the `.src` and `.dat` files (split into parts when long), KRL
 //! names and frame aggregates.
 
-use super::cell::{ExtruderSwitch, KukaCell};
+use super::cell::{ExtruderSwitch, KrlFrame, KukaCell};
 use super::checks::{KukaFigures, Reach};
 use super::motion::Step;
 use super::opw::bits_text;
@@ -402,7 +402,7 @@ fn main_header(
         ExtruderSwitch::Trigger => format!("$OUT[{out}] by TRIGGER at the motion's start"),
     };
 
-    vec![
+    let mut lines = vec![
         "&ACCESS RVP".into(),
         "&REL 1".into(),
         format!("DEF {name}( )"),
@@ -442,14 +442,31 @@ fn main_header(
         "  ;ENDFOLD (BASISTECH INI)".into(),
         ";ENDFOLD (INI)".into(),
         ";FOLD FRAMES AND SPEEDS".into(),
-        format!("$BASE = {}", frame_text(&cell.base.to_array())),
-        format!("$TOOL = {}", frame_text(&cell.tool.to_array())),
+    ];
+    lines.extend(frame_lines("BASE", &cell.base, cell.base_index));
+    lines.extend(frame_lines("TOOL", &cell.tool, cell.tool_index));
+    lines.extend([
         "$ADVANCE = 3".into(),
         format!("$APO.CDIS = {}", fixed(cell.apo_cdis, 3)),
         ";ENDFOLD (FRAMES AND SPEEDS)".into(),
         format!("$OUT[{out}] = FALSE"),
         format!("PTP {HOME_NAME}"),
-    ]
+    ]);
+    lines
+}
+
+/// The lines that set `$BASE` or `$TOOL` (`what`, `BASE` or `TOOL`) to `frame`: with the
+/// controller's number `index`, `BAS (#BASE, n)` after a comment stating the frame assumed to
+/// be in `BASE_DATA[n]` (`TOOL_DATA[n]`); without, the assignment of the frame itself.
+fn frame_lines(what: &str, frame: &KrlFrame, index: Option<u32>) -> Vec<String> {
+    let text = frame_text(&frame.to_array());
+    match index {
+        Some(n) => vec![
+            format!("; assumed {what}_DATA[{n}] = {text} (check it on the controller)"),
+            format!("BAS (#{what}, {n})"),
+        ],
+        None => vec![format!("${what} = {text}")],
+    }
 }
 
 /// Lines joined with `\n`, ending with one.

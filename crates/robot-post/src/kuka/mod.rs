@@ -50,7 +50,9 @@
 //!   mm of filament per mm the tool moves (the impeller's blades need about 0.0286, its base
 //!   0.0374; one ratio for the whole program over-extruded the blades by 26 %).
 //! - **Files.** `<name>.src` holds header comments (source, machine, part offset, tool and
-//!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE`, `$TOOL`,
+//!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE` and `$TOOL`
+//!   (or, with the cell's `base_index`/`tool_index`, `BAS (#BASE, n)`/`BAS (#TOOL, n)` after a
+//!   comment `; assumed BASE_DATA[n] = {..}` stating the frame the program was planned for),
 //!   `$ADVANCE`, `$APO.CDIS`, extruder off and `PTP` home (`DECL AXIS XHOME_PRINT` in
 //!   `<name>.dat`), the motions (`$VEL.CP` in m/s where the speed changes, `LIN {X, Y, Z, A,
 //!   B, C} C_DIS` per pose), then extruder off and `PTP` home. A program of more than
