@@ -614,7 +614,13 @@ fn far_away_poses_are_reported_not_refused() {
     let program = kuka(&path, &profile(), "far", "far.step").expect("written anyway");
     let near = &program.figures[&1];
     let far = &program.figures[&2];
-    assert_eq!(near.unreachable_points, 0, "{near:?}");
+    // Of the square's motions only the safe point, over the whole part's top (2 m up), is out
+    // of reach: its PTP is feature 1's first point's.
+    assert_eq!(
+        (near.unreachable_points, near.first_unreachable),
+        (1, Some(0)),
+        "{near:?}"
+    );
     assert_eq!(far.unreachable_points, far.points, "{far:?}");
     assert_eq!(far.first_unreachable, Some(first_high));
     assert!(
@@ -973,9 +979,19 @@ fn first_pose_is_a_ptp_and_numbers_are_fixed_point() {
     );
     assert_eq!(read.moves[1].motion, Motion::Ptp);
     assert!(matches!(read.moves[1].target, Target::Frame(_)));
-    assert!(read.moves[2..read.moves.len() - 1]
-        .iter()
-        .all(|m| m.motion == Motion::Lin));
+    // Then LINs, up to the PTP back to the safe point and the PTP home.
+    let n = read.moves.len();
+    assert!(read.moves[2..n - 2].iter().all(|m| m.motion == Motion::Lin));
+    assert_eq!(read.moves[n - 2].motion, Motion::Ptp);
+    // The program ends at the safe point it began at (A and C perhaps a turn further).
+    let (a, b) = (frame_of(&read.moves[1]), frame_of(&read.moves[n - 2]));
+    assert!((0..3).all(|k| (a[k] - b[k]).abs() < 1e-3), "{a:?} {b:?}");
+    let turned = rotation_between(&rebuild(a[3], a[4], a[5]), &rebuild(b[3], b[4], b[5]));
+    assert!(turned < 1e-3, "{a:?} {b:?}");
+    assert!(
+        matches!(read.moves[n - 1].target, Target::Axis(_)),
+        "home last"
+    );
     let src = &program.files[0].1;
     assert!(src
         .lines()
@@ -1319,4 +1335,61 @@ fn base_and_tool_numbers_select_the_controllers_frames() {
         let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
         assert!(e.contains(needle), "{e}");
     }
+}
+
+/// The safe point's checks: the program's first Cartesian motion is a PTP `height` over the
+/// part's top (`$BASE` Z), over the first path's start, the tool upright; its last is a PTP
+/// back to the same point.
+fn assert_safe_points(path: &ToolPath, read: &KrlRead, height: f64) {
+    let offset = read.offset.expect("offset");
+    let top = path
+        .points
+        .iter()
+        .filter(|q| q.kind == MoveKind::Print)
+        .map(|q| q.p[2])
+        .fold(f64::NEG_INFINITY, f64::max)
+        + offset[2];
+    let start = path.points[0].p;
+    let cart: Vec<&KrlMove> = read
+        .moves
+        .iter()
+        .filter(|mv| matches!(mv.target, Target::Frame(_)))
+        .collect();
+    let (first, last) = (cart[0], cart[cart.len() - 1]);
+    for mv in [first, last] {
+        assert_eq!(mv.motion, Motion::Ptp, "{}:{}", mv.file, mv.line);
+        assert!(mv.status_turn.is_some(), "{}:{}", mv.file, mv.line);
+        assert!(!mv.extruder);
+        let f = frame_of(mv);
+        assert!((f[2] - (top + height)).abs() < 2e-3, "{f:?}, top {top}");
+        assert!((f[0] - offset[0] - start[0]).abs() < 2e-3, "{f:?}");
+        assert!((f[1] - offset[1] - start[1]).abs() < 2e-3, "{f:?}");
+        let r = rebuild(f[3], f[4], f[5]);
+        assert!(angle_deg([-r[0][2], -r[1][2], -r[2][2]], [0.0, 0.0, 1.0]) < 1e-3);
+    }
+    // Home before and after.
+    let n = read.moves.len();
+    assert!(matches!(read.moves[0].target, Target::Axis(_)));
+    assert!(matches!(read.moves[n - 1].target, Target::Axis(_)));
+    // Nothing between home and the safe point, or after it.
+    assert!(std::ptr::eq(first, &read.moves[1]) && std::ptr::eq(last, &read.moves[n - 2]));
+}
+
+#[test]
+fn safe_points_open_and_close_the_program() {
+    let m = profile();
+    for path in [all_shapes(), long_path(1, 3), to_gimbal_lock(1)] {
+        let program = kuka(&path, &m, "safe", "safe.step").expect("program");
+        let read = round_trip(&path, &program.files);
+        assert_safe_points(&path, &read, 50.0);
+        let mut higher = m.clone();
+        higher.kuka.as_mut().expect("kuka").safe_height = 120.0;
+        let program = kuka(&path, &higher, "safe", "safe.step").expect("program");
+        let read = round_trip(&path, &program.files);
+        assert_safe_points(&path, &read, 120.0);
+    }
+    let text =
+        robot_post::machine::KUKA_TOML.replacen("safe_height = 50.0", "safe_height = -1.0", 1);
+    let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
+    assert!(e.contains("kuka.safe_height"), "{e}");
 }

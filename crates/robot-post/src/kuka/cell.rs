@@ -120,6 +120,11 @@ pub struct KukaCell {
     /// Retreat and approach distance along the tool axis, and the clearance of the travel
     /// height over everything visited so far (mm).
     pub travel_clearance: f64,
+    /// The safe point's height (mm) over the part's top (`$BASE` Z): the program goes there by
+    /// `PTP`, over the first path's start, before its first motion near the part, and back there
+    /// after the last. Optional: [`DEFAULT_SAFE_HEIGHT`] when left out.
+    #[serde(default = "default_safe_height")]
+    pub safe_height: f64,
     /// Number n of the digital output `$OUT[n]` that runs the extruder.
     pub extruder_output: u32,
     /// How the output is switched.
@@ -144,6 +149,14 @@ pub struct KukaCell {
 
 fn is_origin(p: &[f64; 2]) -> bool {
     *p == [0.0, 0.0]
+}
+
+/// The safe point's height over the part's top (mm) of a cell that does not say
+/// (`safe_height`).
+pub const DEFAULT_SAFE_HEIGHT: f64 = 50.0;
+
+fn default_safe_height() -> f64 {
+    DEFAULT_SAFE_HEIGHT
 }
 
 fn default_feed_output() -> u32 {
@@ -200,6 +213,7 @@ impl KukaCell {
             ("kuka.travel_vel_cp", self.travel_vel_cp, 3.0),
             ("kuka.apo_cdis", self.apo_cdis, 100.0),
             ("kuka.travel_clearance", self.travel_clearance, 1000.0),
+            ("kuka.safe_height", self.safe_height, 2000.0),
         ] {
             if !(v.is_finite() && (0.0..=max).contains(&v)) {
                 return Err(bad(field, format!("must be between 0 and {max}, got {v}")));

@@ -31,9 +31,13 @@
 //!   across at that height while the orientation turns to the next path's (slerp, at most
 //!   [`TRAVEL_ROTATION_STEP_DEG`] per LIN), go down to the approach point (`travel_clearance`
 //!   out along the next tool axis) and approach along the axis to the path's first point. The
-//!   first approach is a `PTP` from home; the program ends with the same retreat and a rise to
-//!   the clearance over the part's top, then `PTP` home. Rising straight up assumes no
-//!   material above the retreat point (no printing under an overhang).
+//!   program goes from home to the **safe point** by `PTP`: `safe_height` over the part's top
+//!   (`$BASE` Z), over the first path's start, the tool upright; from there LINs go down to the
+//!   first approach point while the tool turns to the path's orientation. It ends with the same
+//!   retreat, a rise (turning upright) to the safe point's height (or the clearance over the
+//!   part's top, if higher), a LIN across and a `PTP` to the safe point, then `PTP` home.
+//!   Rising straight up assumes no material above the retreat point (no printing under an
+//!   overhang); so does the way down from the safe point.
 //! - **Extruder.** One digital output, on for the LINs that print. With `extruder_switch =
 //!   "trigger"` a `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[n]=...` before the first print LIN
 //!   (on) and before the retreat (off) switches it where those motions start, without

@@ -148,6 +148,8 @@ impl<'a> Planner<'a> {
                 feed: None,
                 on: false,
                 clearance: cell.travel_clearance,
+                safe_z: part_top(path, offset) + cell.safe_height,
+                safe: None,
                 z_top: f64::NEG_INFINITY,
                 height: HeightMap {
                     cell: HEIGHT_CELL,
@@ -221,7 +223,7 @@ impl<'a> Planner<'a> {
                     r: start_frame(z, p, self.base),
                     t: p,
                 };
-                w.travel(self.cur.map(|c| c.0), pose, i, self.travel_v);
+                w.travel(self.cur.map(|c| c.0), pose, i, self.travel_v, self.base);
                 pose
             }
         };
@@ -247,6 +249,19 @@ impl Iterator for Planner<'_> {
             }
             self.advance();
         }
+    }
+}
+
+/// The part's top in `$BASE` (mm): the highest print point placed by `offset` (the highest
+/// point when none prints; 0 for an empty path).
+fn part_top(path: &ToolPath, offset: [f64; 3]) -> f64 {
+    let top = crate::placement::placed_points(path)
+        .map(|q| q.p[2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    if top.is_finite() {
+        top + offset[2]
+    } else {
+        0.0
     }
 }
 
@@ -339,6 +354,10 @@ pub(super) struct Motion {
     feed: Option<f64>,
     on: bool,
     clearance: f64,
+    /// The safe point's height ($BASE Z, mm): `safe_height` over the part's top.
+    safe_z: f64,
+    /// The safe point, over the first path's start at `safe_z`, once the program went there.
+    safe: Option<Pose>,
     /// Highest point of the path so far ($BASE Z, mm).
     z_top: f64,
     /// The points visited so far.
@@ -421,19 +440,23 @@ impl Motion {
     }
 
     /// Travel from `cur` (or from home) to the path start `to` (point `point`).
-    fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64) {
+    fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64, base: &Pose) {
         let c = self.clearance;
         let approach = add(to.t, scale(col(&to.r, 2), -c));
         let Some(from) = cur else {
+            // From home: to the safe point over the path's start (PTP, the tool upright), down
+            // to the approach point turning to the path's orientation, and along the axis to
+            // the start.
             self.vel(travel_v);
-            self.motion(
-                true,
-                Pose {
-                    r: to.r,
-                    t: approach,
-                },
-                point,
-            );
+            let safe = Pose {
+                r: start_frame([0.0, 0.0, -1.0], to.t, base),
+                t: [to.t[0], to.t[1], self.safe_z.max(approach[2])],
+            };
+            self.safe = Some(safe);
+            self.steps
+                .push_back(Step::Comment("safe point over the part".into()));
+            self.motion(true, safe, point);
+            self.turn_across(&safe, to.r, approach, point);
             self.motion(false, to, point);
             return;
         };
@@ -442,23 +465,9 @@ impl Motion {
             .max(retreat[2])
             .max(approach[2]);
         let up = [retreat[0], retreat[1], h];
-        self.motion(false, Pose { r: from.r, t: up }, point);
-        let over = [approach[0], approach[1], h];
-        let turn = log_rot(&mul(&transpose(&from.r), &to.r));
-        let angle = norm(turn).to_degrees();
-        let n = ((angle / TRAVEL_ROTATION_STEP_DEG).ceil() as usize).max(1);
-        for k in 1..=n {
-            let t = k as f64 / n as f64;
-            let pose = if k == n {
-                Pose { r: to.r, t: over }
-            } else {
-                Pose {
-                    r: mul(&from.r, &exp_rot(scale(turn, t))),
-                    t: add(scale(up, 1.0 - t), scale(over, t)),
-                }
-            };
-            self.motion(false, pose, point);
-        }
+        let up = Pose { r: from.r, t: up };
+        self.motion(false, up, point);
+        self.turn_across(&up, to.r, [approach[0], approach[1], h], point);
         self.motion(
             false,
             Pose {
@@ -470,18 +479,59 @@ impl Motion {
         self.motion(false, to, point);
     }
 
-    /// The end: extruder off, retreat along the tool axis and rise to the safe height.
+    /// LINs from `from` to `over` while the orientation turns to `r` (slerp, at most
+    /// [`TRAVEL_ROTATION_STEP_DEG`] a LIN).
+    fn turn_across(&mut self, from: &Pose, r: Mat3, over: V3, point: usize) {
+        let turn = log_rot(&mul(&transpose(&from.r), &r));
+        let angle = norm(turn).to_degrees();
+        let n = ((angle / TRAVEL_ROTATION_STEP_DEG).ceil() as usize).max(1);
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let pose = if k == n {
+                Pose { r, t: over }
+            } else {
+                Pose {
+                    r: mul(&from.r, &exp_rot(scale(turn, t))),
+                    t: add(scale(from.t, 1.0 - t), scale(over, t)),
+                }
+            };
+            self.motion(false, pose, point);
+        }
+    }
+
+    /// The end: extruder off, retreat along the tool axis, rise to the safe point's height
+    /// (or the clearance over the part's top, if higher) and go to the safe point (PTP).
     fn leave(&mut self, from: &Pose, point: usize, travel_v: f64) {
         let c = self.clearance;
         let retreat = self.retreat(from, point, travel_v);
-        let h = (self.z_top + c).max(retreat[2]);
+        let h = (self.z_top + c).max(self.safe_z).max(retreat[2]);
+        let up = [retreat[0], retreat[1], h];
+        let Some(safe) = self.safe else {
+            self.motion(false, Pose { r: from.r, t: up }, point);
+            return;
+        };
+        // Up, turning the tool upright, across, and the safe point by PTP.
+        let back = Pose {
+            r: from.r,
+            t: retreat,
+        };
+        self.turn_across(&back, safe.r, up, point);
         self.motion(
             false,
             Pose {
-                r: from.r,
-                t: [retreat[0], retreat[1], h],
+                r: safe.r,
+                t: [safe.t[0], safe.t[1], h],
             },
             point,
         );
+        self.steps
+            .push_back(Step::Comment("safe point over the part".into()));
+        // Always written, even where the LIN across ended there: the program ends at it.
+        self.last = Some((safe, point));
+        self.steps.push_back(Step::Move {
+            ptp: true,
+            pose: safe,
+            point,
+        });
     }
 }
