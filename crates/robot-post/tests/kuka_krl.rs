@@ -469,9 +469,15 @@ fn speeds_and_extruder_switching() {
     ] {
         assert!(src.contains(needle), "{needle}");
     }
+    // The main program ends at home; after it, the stop interrupt's routine.
     let lines: Vec<&str> = src.lines().collect();
     assert_eq!(lines.last().copied(), Some("END"));
-    assert_eq!(lines[lines.len() - 2], "PTP XHOME_PRINT");
+    let end = lines
+        .iter()
+        .position(|l| *l == "END")
+        .expect("the main program's END");
+    assert_eq!(lines[end - 1], "PTP XHOME_PRINT");
+    assert_eq!(lines[end + 2], "DEF EXTRUDER_STOP( )");
     assert!(lines
         .iter()
         .all(|l| !l.contains("NaN") && !l.contains("inf")));
@@ -1392,4 +1398,93 @@ fn safe_points_open_and_close_the_program() {
         robot_post::machine::KUKA_TOML.replacen("safe_height = 50.0", "safe_height = -1.0", 1);
     let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
     assert!(e.contains("kuka.safe_height"), "{e}");
+}
+
+/// The extruder's signals read back: the stop interrupt declared, on, and resetting the feed
+/// and the extruder before braking; both reset when the program ends; with `ready`, the wait
+/// for that input right after the safe point, before any print move.
+fn assert_signals(m: &MachineProfile, read: &KrlRead, ready: Option<u32>) {
+    let cell = m.kuka.as_ref().expect("kuka");
+    let stops: Vec<_> = read
+        .interrupts
+        .iter()
+        .filter(|i| i.condition == "$STOPMESS==TRUE")
+        .collect();
+    assert_eq!(stops.len(), 1, "{:?}", read.interrupts);
+    let irq = stops[0];
+    assert!(irq.on && irq.brakes, "{irq:?}");
+    assert_eq!(irq.analog, vec![(cell.feed_output, 0.0)]);
+    assert_eq!(irq.outputs, vec![(cell.extruder_output, false)]);
+    assert_eq!(read.end_feed, Some(0.0));
+    assert!(!read.end_extruder);
+    match (ready, &read.ready) {
+        (None, None) => {}
+        (Some(n), Some(r)) => {
+            assert_eq!(r.input, n);
+            assert!((r.timeout_s - cell.ready_timeout).abs() < 1e-9);
+            assert!(r.halts);
+            // Right after the safe point's PTP, before the first print move.
+            let safe = &read.moves[r.before_move - 1];
+            assert_eq!(safe.motion, Motion::Ptp);
+            assert!(matches!(safe.target, Target::Frame(_)));
+            let first_print = read.moves.iter().position(|mv| mv.extruder);
+            assert!(first_print.is_some_and(|i| i >= r.before_move));
+        }
+        (want, got) => panic!("ready input {want:?}, read {got:?}"),
+    }
+}
+
+#[test]
+fn handshake_resets_and_stop_interrupt() {
+    let m = profile();
+    let mut ready = m.clone();
+    ready.kuka.as_mut().expect("kuka").ready_input = Some(5);
+    let mut split = ready.clone();
+    split.kuka.as_mut().expect("kuka").max_moves_per_file = 40;
+    for path in [all_shapes(), long_path(1, 3)] {
+        for (profile, input) in [(&m, None), (&ready, Some(5)), (&split, Some(5))] {
+            let program = kuka(&path, profile, "sig", "sig.step").expect("program");
+            let read = round_trip(&path, &program.files);
+            assert_signals(profile, &read, input);
+            let src = &program.files[0].1;
+            assert!(src.contains("INTERRUPT DECL 10 WHEN $STOPMESS==TRUE DO EXTRUDER_STOP( )"));
+            assert!(src.contains("\nDEF EXTRUDER_STOP( )\n"));
+        }
+    }
+    // A wait that is not closed, or a routine that is missing, is refused.
+    let program = kuka(&long_path(1, 1), &ready, "sig", "sig.step").expect("program");
+    let without = |needle: &str| -> Vec<(String, String)> {
+        program
+            .files
+            .iter()
+            .map(|(n, t)| {
+                let t: Vec<&str> = t.lines().filter(|l| l.trim() != needle).collect();
+                (n.clone(), t.join("\n"))
+            })
+            .collect()
+    };
+    let e = krl::read(&without("ENDIF"))
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("IF without ENDIF"), "{e}");
+    let e = krl::read(&without("DEF EXTRUDER_STOP( )"))
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("after END"), "{e}");
+    for (from, to, needle) in [
+        (
+            "safe_height = 50.0",
+            "safe_height = 50.0\nready_input = 0",
+            "kuka.ready_input",
+        ),
+        (
+            "safe_height = 50.0",
+            "safe_height = 50.0\nready_timeout = 0.0",
+            "kuka.ready_timeout",
+        ),
+    ] {
+        let text = robot_post::machine::KUKA_TOML.replacen(from, to, 1);
+        let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+    }
 }

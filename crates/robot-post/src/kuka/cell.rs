@@ -129,6 +129,15 @@ pub struct KukaCell {
     pub extruder_output: u32,
     /// How the output is switched.
     pub extruder_switch: ExtruderSwitch,
+    /// Number n of the digital input `$IN[n]` on which the extruder reports it is ready (at
+    /// temperature): when given, the program waits for it before its first print move, at most
+    /// `ready_timeout` seconds, then halts. Optional: no handshake when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ready_input: Option<u32>,
+    /// The longest wait for `ready_input` (s) before the program halts. Optional:
+    /// [`DEFAULT_READY_TIMEOUT`] when left out.
+    #[serde(default = "default_ready_timeout")]
+    pub ready_timeout: f64,
     /// Number n of the analog output `$ANOUT[n]` that carries each print LIN's feed ratio
     /// (filament mm per mm of path). Optional: 1 when left out.
     #[serde(default = "default_feed_output")]
@@ -154,6 +163,14 @@ fn is_origin(p: &[f64; 2]) -> bool {
 /// The safe point's height over the part's top (mm) of a cell that does not say
 /// (`safe_height`).
 pub const DEFAULT_SAFE_HEIGHT: f64 = 50.0;
+
+/// The longest wait for the extruder's ready input (s) of a cell that does not say
+/// (`ready_timeout`).
+pub const DEFAULT_READY_TIMEOUT: f64 = 60.0;
+
+fn default_ready_timeout() -> f64 {
+    DEFAULT_READY_TIMEOUT
+}
 
 fn default_safe_height() -> f64 {
     DEFAULT_SAFE_HEIGHT
@@ -226,6 +243,19 @@ impl KukaCell {
                     "must be an output number 1..4096, got {}",
                     self.extruder_output
                 ),
+            ));
+        }
+        if let Some(n) = self.ready_input.filter(|n| !(1..=4096).contains(n)) {
+            return Err(bad(
+                "kuka.ready_input",
+                format!("must be an input number 1..4096, got {n}"),
+            ));
+        }
+        let t = self.ready_timeout;
+        if !(t.is_finite() && t > 0.0 && t <= 86400.0) {
+            return Err(bad(
+                "kuka.ready_timeout",
+                format!("must be above 0 and at most 86400 s, got {t}"),
             ));
         }
         if !(1..=4096).contains(&self.feed_output) {

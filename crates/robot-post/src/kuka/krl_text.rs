@@ -5,6 +5,7 @@ use super::cell::{ExtruderSwitch, KrlFrame, KukaCell};
 use super::checks::{KukaFigures, Reach};
 use super::motion::Step;
 use super::opw::bits_text;
+use super::signals::{interrupt_lines, ready_lines, reset_lines, stop_routine};
 use crate::gcode::{comment_text, push_line};
 use crate::machine::MachineProfile;
 use crate::sink::{insert_notes, write_file, Chunked, ProgramSink};
@@ -83,6 +84,7 @@ pub fn krl_name(s: &str, max: usize) -> String {
         "exor",
         "ext",
         "extfct",
+        "extruder_stop",
         "false",
         "for",
         "frame",
@@ -204,6 +206,7 @@ impl Steps<'_> {
                     fixed(v.clamp(0.0, 1.0), 5)
                 )
             }
+            Step::WaitReady => ready_lines(cell).join("\n"),
             Step::Move { ptp, pose, point } => {
                 let feature = self.path.points[*point].feature;
                 let at = (self.file.as_str(), self.line + 1);
@@ -275,7 +278,6 @@ pub(super) fn write_files(
 ) -> Result<BTreeMap<usize, KukaFigures>, PostError> {
     let (program_name, source, notes) = job;
     let cell = reach.cell;
-    let out = cell.extruder_output;
     let feed_out = cell.feed_output;
     let per = cell.max_moves_per_file.max(1);
     let parts = if moves > per { moves.div_ceil(per) } else { 0 };
@@ -294,11 +296,10 @@ pub(super) fn write_files(
     }
     let mut head = join(&main);
     insert_notes(&mut head, notes);
-    let tail = join(&[
-        format!("$OUT[{out}] = FALSE"),
-        format!("PTP {HOME_NAME}"),
-        "END".into(),
-    ]);
+    let mut tail: Vec<String> = reset_lines(cell).into();
+    tail.extend([format!("PTP {HOME_NAME}"), "END".into()]);
+    tail.extend(stop_routine(cell));
+    let tail = join(&tail);
     let h = cell.home;
     let dat = join(&[
         "&ACCESS RVP".into(),
@@ -440,9 +441,9 @@ fn main_header(
         "    INTERRUPT ON 3".into(),
         "    BAS (#INITMOV,0 )".into(),
         "  ;ENDFOLD (BASISTECH INI)".into(),
-        ";ENDFOLD (INI)".into(),
-        ";FOLD FRAMES AND SPEEDS".into(),
     ];
+    lines.extend(interrupt_lines());
+    lines.extend([";ENDFOLD (INI)".into(), ";FOLD FRAMES AND SPEEDS".into()]);
     lines.extend(frame_lines("BASE", &cell.base, cell.base_index));
     lines.extend(frame_lines("TOOL", &cell.tool, cell.tool_index));
     lines.extend([

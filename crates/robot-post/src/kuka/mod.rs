@@ -53,6 +53,14 @@
 //!   stopping the advance run. The extruder's controller feeds v × `feed_ratio_full_scale`
 //!   mm of filament per mm the tool moves (the impeller's blades need about 0.0286, its base
 //!   0.0374; one ratio for the whole program over-extruded the blades by 26 %).
+//! - **Signals.** The `INI` declares `INTERRUPT DECL 10 WHEN $STOPMESS==TRUE DO
+//!   EXTRUDER_STOP( )` and switches it on: when the robot stops on an error, the local
+//!   subroutine `EXTRUDER_STOP` (after the main program's `END`) sets the feed's
+//!   `$ANOUT[feed_output]` to 0 and `$OUT[extruder_output]` off, then `BRAKE`s. The program
+//!   resets both the same way after its last motion, before `PTP` home. With `ready_input`
+//!   set, the program waits at the safe point for `$IN[ready_input]` (the extruder at
+//!   temperature) at most `ready_timeout` s (`$TIMER[1]`), and `HALT`s if it is not on; on
+//!   the operator's start it waits for it without a limit.
 //! - **Files.** `<name>.src` holds header comments (source, machine, part offset, tool and
 //!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE` and `$TOOL`
 //!   (or, with the cell's `base_index`/`tool_index`, `BAS (#BASE, n)`/`BAS (#TOOL, n)` after a
@@ -82,6 +90,7 @@ mod krl_text;
 mod motion;
 mod opw;
 mod rotation;
+mod signals;
 
 use std::collections::BTreeMap;
 
@@ -91,6 +100,7 @@ pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
 pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
 pub use opw::{bits_text, turn};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
+pub use signals::{READY_TIMER, STOP_INTERRUPT, STOP_ROUTINE};
 
 use crate::machine::MachineProfile;
 use crate::sink::{InMemory, ProgramSink};

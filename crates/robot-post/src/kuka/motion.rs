@@ -30,6 +30,8 @@ pub(super) enum Step {
     Extruder(bool),
     /// The feed ratio (filament mm per mm of path) of the next motion, a print LIN.
     Feed(f64),
+    /// Wait for the extruder's ready input (the cell's `ready_input`).
+    WaitReady,
     /// A motion to a tool pose in `$BASE`, for path point `point`.
     Move {
         ptp: bool,
@@ -150,6 +152,7 @@ impl<'a> Planner<'a> {
                 clearance: cell.travel_clearance,
                 safe_z: part_top(path, offset) + cell.safe_height,
                 safe: None,
+                ready: cell.ready_input.is_some(),
                 z_top: f64::NEG_INFINITY,
                 height: HeightMap {
                     cell: HEIGHT_CELL,
@@ -358,6 +361,8 @@ pub(super) struct Motion {
     safe_z: f64,
     /// The safe point, over the first path's start at `safe_z`, once the program went there.
     safe: Option<Pose>,
+    /// The program waits for the extruder's ready input at the safe point.
+    ready: bool,
     /// Highest point of the path so far ($BASE Z, mm).
     z_top: f64,
     /// The points visited so far.
@@ -456,6 +461,9 @@ impl Motion {
             self.steps
                 .push_back(Step::Comment("safe point over the part".into()));
             self.motion(true, safe, point);
+            if self.ready {
+                self.steps.push_back(Step::WaitReady);
+            }
             self.turn_across(&safe, to.r, approach, point);
             self.motion(false, to, point);
             return;
