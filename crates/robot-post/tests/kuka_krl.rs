@@ -3,7 +3,9 @@
 //! tool axes (issue "KUKA robot holding the extruder").
 
 use robot_post::krl::{self, KrlMove, KrlRead, Motion, Target};
-use robot_post::kuka::{abc_from_matrix, matrix_from_abc, ExtruderSwitch, KrlFrame, Pose};
+use robot_post::kuka::{
+    abc_from_matrix, matrix_from_abc, ExtruderSwitch, KrlFrame, KrlMotion, Pose, SPLINE_MIN_SEGMENT,
+};
 use robot_post::{kuka, MachineKind, MachineProfile, MoveKind, PathPoint, PostError, ToolPath};
 
 const W: f64 = 0.45;
@@ -1486,5 +1488,321 @@ fn handshake_resets_and_stop_interrupt() {
         let text = robot_post::machine::KUKA_TOML.replacen(from, to, 1);
         let e = MachineProfile::from_toml(&text).unwrap_err().to_string();
         assert!(e.contains(needle), "{e}");
+    }
+}
+
+/// Layers of long straight lines finely divided and gentle arcs (radius 150 mm), the tool
+/// axis upright, filament 0.02 mm per mm: what a spline program writes with few points.
+fn lines_and_arcs(feature: usize) -> ToolPath {
+    let mut path = ToolPath::default();
+    for layer in 0..4 {
+        let z = T * (layer as f64 + 1.0);
+        let y0 = -20.0 + 10.0 * layer as f64;
+        let mut pts: Vec<([f64; 3], [f64; 3])> = (0..=160)
+            .map(|k| ([-30.0 + 0.25 * f64::from(k), y0, z], [0.0, 0.0, 1.0]))
+            .collect();
+        let r = 150.0;
+        for k in 1..=120 {
+            let t = f64::from(k) * 0.5 / r;
+            pts.push((
+                [10.0 + r * t.sin(), y0 + r * (1.0 - t.cos()), z],
+                [0.0, 0.0, 1.0],
+            ));
+        }
+        push_path(&mut path, feature, layer, &pts);
+    }
+    for i in 1..path.points.len() {
+        if path.points[i].kind == MoveKind::Print {
+            let (a, b) = (path.points[i - 1].p, path.points[i].p);
+            let d = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt();
+            path.points[i].e = 0.02 * d;
+        }
+    }
+    path
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn len3(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// The distance from `p` to the segment `a`-`b`, and where along it (0..1) the nearest point is.
+fn to_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> (f64, f64) {
+    let ab = sub3(b, a);
+    let l2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let ap = sub3(p, a);
+    let t = if l2 > 0.0 {
+        ((ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (
+        len3([ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2]]),
+        t,
+    )
+}
+
+/// The distance from `p` to a polyline.
+fn to_polyline(p: [f64; 3], line: &[[f64; 3]]) -> f64 {
+    line.windows(2)
+        .map(|w| to_segment(p, w[0], w[1]).0)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Reads a spline program back and checks it against the plan, path by path: each print run
+/// is a spline block's segments from the path's travel point; every point written is a
+/// planned point; every planned point lies within half the spline tolerance of the written
+/// polyline, its tool axis within 0.2° of the axis turned between the written ends; every
+/// `SPL` segment, drawn as a cubic whose end tangents bisect the turns at its ends, stays
+/// within the tolerance of the planned path; the filament fed over each run is the plan's.
+fn spline_round_trip(path: &ToolPath, m: &MachineProfile, files: &[(String, String)]) -> KrlRead {
+    let cell = m.kuka.as_ref().expect("kuka");
+    let tol = cell.spline_tolerance;
+    let read = krl::read(files).unwrap_or_else(|e| panic!("reader refused the program: {e}"));
+    let offset = read.offset.expect("part offset comment");
+    let moves = &read.moves;
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (i, mv) in moves.iter().enumerate() {
+        if mv.extruder && (i == 0 || !moves[i - 1].extruder) {
+            runs.push((i, i));
+        }
+        if mv.extruder {
+            runs.last_mut().expect("run").1 = i;
+            assert!(
+                matches!(mv.motion, Motion::Spl | Motion::Slin),
+                "{}:{}",
+                mv.file,
+                mv.line
+            );
+        }
+    }
+    // The planned paths: a travel point and its print points.
+    let mut paths: Vec<Vec<&PathPoint>> = Vec::new();
+    for (i, q) in path.points.iter().enumerate() {
+        let next_print = path
+            .points
+            .get(i + 1)
+            .is_some_and(|n| n.kind == MoveKind::Print);
+        if q.kind == MoveKind::Travel && next_print {
+            paths.push(vec![q]);
+        } else if q.kind == MoveKind::Print {
+            paths.last_mut().expect("a path").push(q);
+        }
+    }
+    assert_eq!(
+        runs.len(),
+        paths.len(),
+        "extruder switched on once per path"
+    );
+    let part = |f: [f64; 6]| [f[0] - offset[0], f[1] - offset[1], f[2] - offset[2]];
+    let axis = |f: [f64; 6]| {
+        let r = rebuild(f[3], f[4], f[5]);
+        [-r[0][2], -r[1][2], -r[2][2]]
+    };
+    for ((start, end), planned) in runs.iter().zip(&paths) {
+        let written: Vec<[f64; 6]> = (start - 1..=*end).map(|i| frame_of(&moves[i])).collect();
+        let line: Vec<[f64; 3]> = written.iter().map(|f| part(*f)).collect();
+        let plan: Vec<[f64; 3]> = planned.iter().map(|q| q.p).collect();
+        assert!(
+            len3(sub3(line[0], plan[0])) <= 0.01,
+            "starts at the travel point"
+        );
+        assert!(len3(sub3(line[line.len() - 1], plan[plan.len() - 1])) <= 0.01);
+        for p in &line {
+            assert!(
+                plan.iter().any(|q| len3(sub3(*p, *q)) <= 0.01),
+                "{p:?} is not a planned point"
+            );
+        }
+        for q in planned {
+            let (k, (d, t)) = line
+                .windows(2)
+                .map(|w| to_segment(q.p, w[0], w[1]))
+                .enumerate()
+                .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+                .expect("a segment");
+            assert!(d <= tol / 2.0 + 2e-3, "planned {:?} is {d} mm off", q.p);
+            let (a0, a1) = (axis(written[k]), axis(written[k + 1]));
+            let mix: [f64; 3] = std::array::from_fn(|i| (1.0 - t) * a0[i] + t * a1[i]);
+            let err = angle_deg(mix, q.axis);
+            assert!(err <= 0.2, "axis at {:?} off by {err}°", q.p);
+        }
+        // SPL segments drawn as cubics stay within the tolerance of the planned path.
+        for k in 1..line.len() {
+            if moves[start + k - 1].motion != Motion::Spl {
+                continue;
+            }
+            assert!(k >= 2 && k + 1 < line.len(), "an SPL at a block's end");
+            // Its neighbours have a direction.
+            for (a, b) in [(line[k - 2], line[k - 1]), (line[k], line[k + 1])] {
+                assert!(len3(sub3(b, a)) >= SPLINE_MIN_SEGMENT - 2e-3);
+            }
+            let unit = |v: [f64; 3]| {
+                let n = len3(v);
+                [v[0] / n, v[1] / n, v[2] / n]
+            };
+            let (p0, p1) = (line[k - 1], line[k]);
+            let l = len3(sub3(p1, p0));
+            let d_prev = unit(sub3(p0, line[k - 2]));
+            let d = unit(sub3(p1, p0));
+            let d_next = unit(sub3(line[k + 1], p1));
+            let m0 = unit(std::array::from_fn(|i| d_prev[i] + d[i]));
+            let m1 = unit(std::array::from_fn(|i| d[i] + d_next[i]));
+            for j in 1..16 {
+                let s = f64::from(j) / 16.0;
+                let (h00, h10, h01, h11) = (
+                    2.0 * s.powi(3) - 3.0 * s * s + 1.0,
+                    s.powi(3) - 2.0 * s * s + s,
+                    -2.0 * s.powi(3) + 3.0 * s * s,
+                    s.powi(3) - s * s,
+                );
+                let c: [f64; 3] = std::array::from_fn(|i| {
+                    h00 * p0[i] + h10 * l * m0[i] + h01 * p1[i] + h11 * l * m1[i]
+                });
+                let d = to_polyline(c, &plan);
+                assert!(
+                    d <= tol + 2e-3,
+                    "SPL {}:{} bulges {d} mm",
+                    moves[start + k - 1].file,
+                    moves[start + k - 1].line
+                );
+            }
+        }
+        // The filament: the feed in force over each segment's length.
+        let fed: f64 = (1..line.len())
+            .map(|k| {
+                let f = moves[start + k - 1].feed.expect("a feed");
+                f * cell.feed_ratio_full_scale * len3(sub3(line[k], line[k - 1]))
+            })
+            .sum();
+        let e: f64 = planned.iter().skip(1).map(|q| q.e).sum();
+        assert!(
+            (fed - e).abs() <= 1e-3 * e + 1e-4,
+            "fed {fed} mm of filament, planned {e}"
+        );
+    }
+    read
+}
+
+/// Every Cartesian PTP carries S and T.
+fn assert_status_turn(read: &KrlRead) {
+    for mv in &read.moves {
+        if mv.motion == Motion::Ptp && matches!(mv.target, Target::Frame(_)) {
+            assert!(mv.status_turn.is_some(), "{}:{}", mv.file, mv.line);
+        }
+    }
+}
+
+#[test]
+fn spline_mode_drops_points_and_reads_back_within_the_tolerance() {
+    let lin = profile();
+    let mut spline = lin.clone();
+    spline.kuka.as_mut().expect("kuka").motion = KrlMotion::Spline;
+    // The finely divided lines and gentle arcs lose most of their points, and keep SPL
+    // segments on the arcs.
+    let path = lines_and_arcs(1);
+    let pa = kuka(&path, &lin, "l", "f.step").expect("lin");
+    let pb = kuka(&path, &spline, "l", "f.step").expect("spline");
+    let a = round_trip(&path, &pa.files);
+    let b = spline_round_trip(&path, &spline, &pb.files);
+    assert_status_turn(&b);
+    let prints = |r: &KrlRead| r.moves.iter().filter(|m| m.extruder).count();
+    assert!(
+        prints(&b) * 4 < prints(&a),
+        "{} vs {}",
+        prints(&b),
+        prints(&a)
+    );
+    assert!(b.moves.iter().any(|m| m.motion == Motion::Spl));
+    let size =
+        |p: &robot_post::kuka::KrlProgram| -> usize { p.files.iter().map(|f| f.1.len()).sum() };
+    assert!(size(&pb) * 2 < size(&pa), "{} vs {}", size(&pb), size(&pa));
+    // Lin mode writes no spline.
+    assert!(pa.files.iter().all(|f| !f.1.contains("SPLINE")));
+}
+
+#[test]
+fn spline_blocks_split_across_parts_and_refused_when_broken() {
+    let mut m = profile();
+    let k = m.kuka.as_mut().expect("kuka");
+    k.motion = KrlMotion::Spline;
+    k.max_moves_per_file = 30;
+    let path = all_shapes();
+    let program = kuka(&path, &m, "parts", "f.step").expect("program");
+    assert!(program.files.len() > 4);
+    let read = spline_round_trip(&path, &m, &program.files);
+    assert_signals(&m, &read, None);
+    // Every part's blocks are closed in that part.
+    for (name, text) in &program.files {
+        let opened = text.lines().filter(|l| *l == "SPLINE").count();
+        let closed = text.lines().filter(|l| *l == "ENDSPLINE").count();
+        assert_eq!(opened, closed, "{name}");
+    }
+    // The reader refuses a block left open, an empty block, a LIN inside a block.
+    let (name, text) = program
+        .files
+        .iter()
+        .find(|(_, t)| t.contains("ENDSPLINE"))
+        .expect("a block")
+        .clone();
+    let with = |t: String| -> Vec<(String, String)> {
+        program
+            .files
+            .iter()
+            .map(|(n, old)| (n.clone(), if *n == name { t.clone() } else { old.clone() }))
+            .collect()
+    };
+    for (broken, needle) in [
+        (text.replacen("ENDSPLINE\n", "", 1), "SPLINE"),
+        (
+            text.replacen("SPLINE\n", "SPLINE\nENDSPLINE\nSPLINE\n", 1),
+            "empty SPLINE",
+        ),
+        (
+            text.replacen("\nSLIN ", "\nLIN ", 1),
+            "inside a SPLINE block",
+        ),
+    ] {
+        let e = krl::read(&with(broken)).expect_err("refused").to_string();
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+}
+
+/// The checks of [`every_fixture_in_lin_and_spline_mode`] on a planned part's tool path: the
+/// `toolpath.csv` named by `KRL_TOOLPATH` (`features plan PART --machine kuka` writes it), in
+/// lin and spline mode; prints the programs' sizes and motions. Ignored: run it with
+/// `KRL_TOOLPATH=... cargo test --release -p robot-post --test kuka_krl -- --ignored`.
+#[test]
+#[ignore]
+fn a_planned_toolpath_in_lin_and_spline_mode() {
+    let Ok(file) = std::env::var("KRL_TOOLPATH") else {
+        return;
+    };
+    let text = std::fs::read_to_string(&file).expect("toolpath.csv");
+    let path = ToolPath::from_csv(&text).expect("csv");
+    let mut lin = profile();
+    lin.kuka.as_mut().expect("kuka").ready_input = Some(3);
+    let mut spline = lin.clone();
+    spline.kuka.as_mut().expect("kuka").motion = KrlMotion::Spline;
+    for (mode, m) in [("lin", &lin), ("spline", &spline)] {
+        let program = kuka(&path, m, "part", "part.step").expect("program");
+        let read = if mode == "lin" {
+            round_trip(&path, &program.files)
+        } else {
+            spline_round_trip(&path, m, &program.files)
+        };
+        assert_status_turn(&read);
+        assert_safe_points(&path, &read, 50.0);
+        assert_signals(m, &read, Some(3));
+        let bytes: usize = program.files.iter().map(|f| f.1.len()).sum();
+        let prints = read.moves.iter().filter(|mv| mv.extruder).count();
+        println!(
+            "{file} {mode}: {bytes} bytes in {} files, {} motions ({prints} printing)",
+            program.files.len(),
+            read.moves.len()
+        );
     }
 }

@@ -52,6 +52,10 @@ pub enum Motion {
     Ptp,
     /// `LIN`.
     Lin,
+    /// `SPL`, a spline segment of a `SPLINE` block.
+    Spl,
+    /// `SLIN`, a straight segment of a `SPLINE` block.
+    Slin,
 }
 
 /// Where a motion goes.
@@ -255,6 +259,7 @@ pub fn read(files: &[(String, String)]) -> Result<KrlRead, KrlError> {
         vel: None,
         stack: Vec::new(),
         if_depth: 0,
+        block: None,
     };
     run.module(&main)?;
     if run.if_depth > 0 {

@@ -51,6 +51,8 @@ pub(super) struct Run<'a> {
     pub(super) stack: Vec<String>,
     /// `IF`s open.
     pub(super) if_depth: usize,
+    /// Inside a `SPLINE` block: the segments read so far.
+    pub(super) block: Option<usize>,
 }
 
 impl Run<'_> {
@@ -212,6 +214,9 @@ impl Run<'_> {
         for s in &m.body {
             self.statement(m, s)?;
         }
+        if self.block.is_some() {
+            return Err(err(&m.src_file, 0, "SPLINE without ENDSPLINE"));
+        }
         self.stack.pop();
         Ok(())
     }
@@ -230,10 +235,65 @@ impl Run<'_> {
         }
     }
 
+    /// A trigger's action (`rest`, after `DO`): the extruder's output or the feed's analog
+    /// output, set at the start of the next motion.
+    fn trigger(&mut self, file: &str, line: usize, rest: &str) -> Result<(), KrlError> {
+        if let Some((n, v)) = analog_assignment(rest) {
+            let v = v.map_err(|r| err(file, line, r))?;
+            self.feed_output(file, line, n)?;
+            self.pending_feed = Some(v);
+            return Ok(());
+        }
+        let Some((n, on)) = output_assignment(rest) else {
+            return Err(err(
+                file,
+                line,
+                format!("unexpected trigger action `{rest}`"),
+            ));
+        };
+        self.output(file, line, n)?;
+        self.pending = Some(on);
+        Ok(())
+    }
+
+    /// A statement inside a `SPLINE` block (`upper`, upper case): a segment, a trigger on its
+    /// path, or `ENDSPLINE`.
+    fn spline_statement(
+        &mut self,
+        m: &Module,
+        s: &Statement,
+        upper: &str,
+        segments: usize,
+    ) -> Result<(), KrlError> {
+        let (file, line) = (m.src_file.as_str(), s.line);
+        if upper.trim() == "ENDSPLINE" {
+            if segments == 0 {
+                return Err(err(file, line, "an empty SPLINE block"));
+            }
+            self.block = None;
+            return Ok(());
+        }
+        if let Some(rest) = upper.strip_prefix("TRIGGER WHEN PATH=0 ONSTART DELAY=0 DO ") {
+            return self.trigger(file, line, rest);
+        }
+        if let Some(rest) = upper.strip_prefix("SPL ").or(upper.strip_prefix("SLIN ")) {
+            self.block = Some(segments + 1);
+            return self.motion(m, s, upper, rest);
+        }
+        Err(err(
+            file,
+            line,
+            format!("`{}` inside a SPLINE block", s.text),
+        ))
+    }
+
     fn statement(&mut self, m: &Module, s: &Statement) -> Result<(), KrlError> {
         let file = m.src_file.as_str();
         let line = s.line;
         let upper = s.text.to_ascii_uppercase();
+        if let Some(segments) = self.block {
+            return self.spline_statement(m, s, &upper, segments);
+        }
         let number = |v: &str| -> Result<f64, KrlError> {
             let x: f64 = v
                 .trim()
@@ -324,25 +384,14 @@ impl Run<'_> {
             return Ok(());
         }
         if let Some(rest) = upper.strip_prefix("TRIGGER WHEN DISTANCE=0 DELAY=0 DO ") {
-            if let Some((n, v)) = analog_assignment(rest) {
-                let v = v.map_err(|r| err(file, line, r))?;
-                self.feed_output(file, line, n)?;
-                self.pending_feed = Some(v);
-                return Ok(());
-            }
-            let Some((n, on)) = output_assignment(rest) else {
-                return Err(err(
-                    file,
-                    line,
-                    format!("unexpected trigger action `{rest}`"),
-                ));
-            };
-            self.output(file, line, n)?;
-            self.pending = Some(on);
-            return Ok(());
+            return self.trigger(file, line, rest);
         }
         if let Some(rest) = upper.strip_prefix("PTP ").or(upper.strip_prefix("LIN ")) {
             return self.motion(m, s, &upper, rest);
+        }
+        if upper.trim() == "SPLINE" {
+            self.block = Some(0);
+            return Ok(());
         }
         if let Some(callee) = call_name(&s.text) {
             if self.stack.len() == 1 {
@@ -353,7 +402,7 @@ impl Run<'_> {
         Err(err(file, line, format!("unknown statement `{}`", s.text)))
     }
 
-    /// A `PTP` or `LIN` statement (`rest` after the keyword, `upper` the whole upper-cased):
+    /// A `PTP`, `LIN`, `SPL` or `SLIN` statement (`rest` after the keyword, `upper` the whole upper-cased):
     /// its target (an aggregate or a declared axis position), whether it is approximated, and
     /// the extruder, feed and speed in force, as a move of the program.
     fn motion(
@@ -365,10 +414,11 @@ impl Run<'_> {
     ) -> Result<(), KrlError> {
         let file = m.src_file.as_str();
         let line = s.line;
-        let motion = if upper.starts_with("PTP") {
-            Motion::Ptp
-        } else {
-            Motion::Lin
+        let motion = match upper.split_whitespace().next() {
+            Some("PTP") => Motion::Ptp,
+            Some("SPL") => Motion::Spl,
+            Some("SLIN") => Motion::Slin,
+            _ => Motion::Lin,
         };
         if !self.initialised {
             return Err(err(file, line, "a motion before BAS (#INITMOV,0 )"));

@@ -50,6 +50,18 @@ pub enum ExtruderSwitch {
     Trigger,
 }
 
+/// How the print paths are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KrlMotion {
+    /// One `LIN ... C_DIS` per path point.
+    #[default]
+    Lin,
+    /// `SPLINE` blocks of `SPL` and `SLIN` segments through the points left after dropping
+    /// those within `spline_tolerance` of the line through their neighbours.
+    Spline,
+}
+
 /// A 6-axis arm with an ortho-parallel base and a spherical wrist, in the parameters of
 /// Brandstötter, Angerer & Hofbaur 2014 ("An analytical solution of the inverse kinematics
 /// problem of industrial serial manipulators with an ortho-parallel basis and a spherical
@@ -146,6 +158,16 @@ pub struct KukaCell {
     /// the ratio over this. Optional: 0.1 when left out.
     #[serde(default = "default_feed_ratio_full_scale")]
     pub feed_ratio_full_scale: f64,
+    /// How the print paths are written: `lin` (one `LIN` per point) or `spline` (`SPLINE`
+    /// blocks through the points left after dropping those a straight run passes within
+    /// `spline_tolerance` of). Optional: `lin` when left out.
+    #[serde(default)]
+    pub motion: KrlMotion,
+    /// With `motion = "spline"`: how far (mm) the written path may pass from a planned point
+    /// (half of it for the points dropped, half for a spline segment's bulge). Optional:
+    /// [`DEFAULT_SPLINE_TOLERANCE`] when left out.
+    #[serde(default = "default_spline_tolerance")]
+    pub spline_tolerance: f64,
     /// Most motions per `.src` file; a longer program is split into parts called from the
     /// main program.
     pub max_moves_per_file: usize,
@@ -163,6 +185,14 @@ fn is_origin(p: &[f64; 2]) -> bool {
 /// The safe point's height over the part's top (mm) of a cell that does not say
 /// (`safe_height`).
 pub const DEFAULT_SAFE_HEIGHT: f64 = 50.0;
+
+/// The spline tolerance (mm) of a cell that does not say (`spline_tolerance`): the process's
+/// default chord tolerance.
+pub const DEFAULT_SPLINE_TOLERANCE: f64 = 0.05;
+
+fn default_spline_tolerance() -> f64 {
+    DEFAULT_SPLINE_TOLERANCE
+}
 
 /// The longest wait for the extruder's ready input (s) of a cell that does not say
 /// (`ready_timeout`).
@@ -265,6 +295,13 @@ impl KukaCell {
                     "must be an analog output number 1..4096, got {}",
                     self.feed_output
                 ),
+            ));
+        }
+        let t = self.spline_tolerance;
+        if !(t.is_finite() && t > 0.0 && t <= 1.0) {
+            return Err(bad(
+                "kuka.spline_tolerance",
+                format!("must be above 0 and at most 1 mm, got {t}"),
             ));
         }
         let f = self.feed_ratio_full_scale;

@@ -1,9 +1,9 @@
 //! The KRL text of a program: the `.src` and `.dat` files (split into parts when long), KRL
 //! names and frame aggregates.
 
-use super::cell::{ExtruderSwitch, KrlFrame, KukaCell};
+use super::cell::{ExtruderSwitch, KrlFrame, KrlMotion, KukaCell};
 use super::checks::{KukaFigures, Reach};
-use super::motion::Step;
+use super::motion::{Kind, Step};
 use super::opw::bits_text;
 use super::signals::{interrupt_lines, ready_lines, reset_lines, stop_routine};
 use crate::gcode::{comment_text, push_line};
@@ -174,6 +174,9 @@ struct Steps<'a> {
     /// The file being written and the lines written into it so far.
     file: String,
     line: usize,
+    /// Inside a `SPLINE` block; a block the last file ended is to go on in this one.
+    in_block: bool,
+    reopen: bool,
 }
 
 impl Steps<'_> {
@@ -181,7 +184,31 @@ impl Steps<'_> {
     fn push(&mut self, step: &Step, out: &mut String) {
         let cell = self.cell;
         let (out_n, feed_out) = (cell.extruder_output, cell.feed_output);
+        if std::mem::take(&mut self.reopen) {
+            // A block cut at the end of the last part goes on here, unless it ends at once.
+            if matches!(step, Step::SplineEnd) {
+                self.in_block = false;
+                return;
+            }
+            self.line += 1;
+            push_line(out, "SPLINE");
+            self.in_block = true;
+        }
+        // Inside a spline block a trigger refers to the path of its segments.
+        let trigger = if self.in_block {
+            "TRIGGER WHEN PATH=0 ONSTART DELAY=0 DO"
+        } else {
+            "TRIGGER WHEN DISTANCE=0 DELAY=0 DO"
+        };
         let line = match step {
+            Step::SplineStart => {
+                self.in_block = true;
+                "SPLINE".into()
+            }
+            Step::SplineEnd => {
+                self.in_block = false;
+                "ENDSPLINE".into()
+            }
             Step::Comment(c) => format!("; {}", comment_text(c)),
             Step::Vel(v) => {
                 self.vel = Some(*v);
@@ -191,9 +218,7 @@ impl Steps<'_> {
                 let state = if *on { "TRUE" } else { "FALSE" };
                 match cell.extruder_switch {
                     ExtruderSwitch::Out => format!("$OUT[{out_n}] = {state}"),
-                    ExtruderSwitch::Trigger => {
-                        format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out_n}]={state}")
-                    }
+                    ExtruderSwitch::Trigger => format!("{trigger} $OUT[{out_n}]={state}"),
                 }
             }
             Step::Feed(ratio) => {
@@ -202,20 +227,24 @@ impl Steps<'_> {
                     self.beyond = (self.beyond.0 + 1, self.beyond.1.max(*ratio));
                 }
                 format!(
-                    "TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[{feed_out}]={}",
+                    "{trigger} $ANOUT[{feed_out}]={}",
                     fixed(v.clamp(0.0, 1.0), 5)
                 )
             }
             Step::WaitReady => ready_lines(cell).join("\n"),
-            Step::Move { ptp, pose, point } => {
+            Step::Move {
+                kind, pose, point, ..
+            } => {
                 let feature = self.path.points[*point].feature;
                 let at = (self.file.as_str(), self.line + 1);
                 let solved = self.reach.motion(pose, *point, feature, at);
                 let f = solved.frame;
-                let mut line = match (*ptp, solved.joints) {
-                    (true, Some((_, s, t))) => format!("PTP {}", pos_text(&f, s, t)),
-                    (true, None) => format!("PTP {}", frame_text(&f)),
-                    (false, _) => format!("LIN {} C_DIS", frame_text(&f)),
+                let mut line = match (kind, solved.joints) {
+                    (Kind::Ptp, Some((_, s, t))) => format!("PTP {}", pos_text(&f, s, t)),
+                    (Kind::Ptp, None) => format!("PTP {}", frame_text(&f)),
+                    (Kind::Lin, _) => format!("LIN {} C_DIS", frame_text(&f)),
+                    (Kind::Spl, _) => format!("SPL {}", frame_text(&f)),
+                    (Kind::Slin, _) => format!("SLIN {}", frame_text(&f)),
                 };
                 if let Some(note) = solved.note {
                     line.push_str(" ; ");
@@ -253,6 +282,11 @@ impl Steps<'_> {
                     break;
                 }
             }
+        }
+        if std::mem::take(&mut self.in_block) {
+            // A part ends inside a block: it ends here and goes on in the next part.
+            push_line(&mut text, "ENDSPLINE");
+            self.reopen = true;
         }
         text.push_str(end);
         file.finish(&text)
@@ -325,6 +359,8 @@ pub(super) fn write_files(
         beyond: (0, 0.0),
         file: String::new(),
         line: 0,
+        in_block: false,
+        reopen: false,
     };
     let main_src = format!("{name}.src");
     let mut steps = steps;
@@ -427,6 +463,15 @@ fn main_header(
             fixed(cell.feed_ratio_full_scale, 5),
             fixed(cell.feed_ratio_full_scale, 5)
         ),
+    ];
+    if cell.motion == KrlMotion::Spline {
+        lines.push(format!(
+            "; print paths: SPLINE blocks through the points left once those within {} mm of a straight run are dropped; SPL where a cubic through the neighbours stays within {} mm of the plan, SLIN elsewhere; the feed set by TRIGGER WHEN PATH=0 ONSTART where a segment starts",
+            fixed(cell.spline_tolerance / 2.0, 3),
+            fixed(cell.spline_tolerance, 3)
+        ));
+    }
+    lines.extend([
         format!(
             "; {moves} motions{}",
             if parts > 0 {
@@ -441,7 +486,7 @@ fn main_header(
         "    INTERRUPT ON 3".into(),
         "    BAS (#INITMOV,0 )".into(),
         "  ;ENDFOLD (BASISTECH INI)".into(),
-    ];
+    ]);
     lines.extend(interrupt_lines());
     lines.extend([";ENDFOLD (INI)".into(), ";FOLD FRAMES AND SPEEDS".into()]);
     lines.extend(frame_lines("BASE", &cell.base, cell.base_index));

@@ -53,6 +53,13 @@
 //!   stopping the advance run. The extruder's controller feeds v × `feed_ratio_full_scale`
 //!   mm of filament per mm the tool moves (the impeller's blades need about 0.0286, its base
 //!   0.0374; one ratio for the whole program over-extruded the blades by 26 %).
+//! - **Spline.** With `motion = "spline"` each run of print moves (a path's, between changes of
+//!   speed) is a `SPLINE` ... `ENDSPLINE` block after its `$VEL.CP`, through fewer points
+//!   (`spline` module): points within half of `spline_tolerance` of the line through their
+//!   neighbours are dropped, `SPL` segments where a cubic through the neighbours stays within
+//!   the tolerance of the plan, `SLIN` elsewhere; the feed and the extruder by `TRIGGER WHEN
+//!   PATH=0 ONSTART DELAY=0 DO ...` inside the block. A block a part file ends inside goes on in
+//!   the next part (`ENDSPLINE` there, `SPLINE` again). Travels stay `LIN` and `PTP`.
 //! - **Signals.** The `INI` declares `INTERRUPT DECL 10 WHEN $STOPMESS==TRUE DO
 //!   EXTRUDER_STOP( )` and switches it on: when the robot stops on an error, the local
 //!   subroutine `EXTRUDER_STOP` (after the main program's `END`) sets the feed's
@@ -91,16 +98,21 @@ mod motion;
 mod opw;
 mod rotation;
 mod signals;
+mod spline;
 
 use std::collections::BTreeMap;
 
-pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KukaCell};
+pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KrlMotion, KukaCell};
 pub use checks::KukaFigures;
 pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
 pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
 pub use opw::{bits_text, turn};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 pub use signals::{READY_TIMER, STOP_INTERRUPT, STOP_ROUTINE};
+pub use spline::{
+    cubic_point, SPLINE_ANGLE_TOLERANCE_DEG, SPLINE_FEED_SHORT, SPLINE_FEED_TOLERANCE,
+    SPLINE_MAX_MERGED, SPLINE_MAX_SEGMENTS, SPLINE_MAX_TURN_DEG, SPLINE_MIN_SEGMENT,
+};
 
 use crate::machine::MachineProfile;
 use crate::sink::{InMemory, ProgramSink};
@@ -109,6 +121,7 @@ use checks::Reach;
 use krl_text::write_files;
 pub(crate) use motion::start_frame;
 use motion::{placement, Planner, Step};
+use spline::Splined;
 use toolpath::vec3::{norm, scale};
 use toolpath::ToolPath;
 
@@ -190,12 +203,12 @@ pub fn kuka_to(
     let base = cell.base.pose();
     // The header counts the motions: a first run of the planner counts them, the second
     // plans them again as they are checked and written.
-    let planner = || Planner::new(path, &axes, offset, m, cell, &base);
-    let moves = planner().filter(|s| matches!(s, Step::Move { .. })).count();
+    let steps = || Splined::new(Planner::new(path, &axes, offset, m, cell, &base), cell);
+    let moves = steps().filter(|s| matches!(s, Step::Move { .. })).count();
     let figures = write_files(
         m,
         path,
-        planner(),
+        steps(),
         moves,
         Reach::new(path, cell, &base),
         offset,

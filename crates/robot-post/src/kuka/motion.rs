@@ -32,12 +32,31 @@ pub(super) enum Step {
     Feed(f64),
     /// Wait for the extruder's ready input (the cell's `ready_input`).
     WaitReady,
-    /// A motion to a tool pose in `$BASE`, for path point `point`.
+    /// A motion to a tool pose in `$BASE`, for path point `point`; `print` for the motions
+    /// that lay a bead.
     Move {
-        ptp: bool,
+        kind: Kind,
+        print: bool,
         pose: Pose,
         point: usize,
     },
+    /// `SPLINE`: a spline block opens (its segments, feed and extruder triggers follow).
+    SplineStart,
+    /// `ENDSPLINE`.
+    SplineEnd,
+}
+
+/// How a motion goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// `PTP` (with Status and Turn).
+    Ptp,
+    /// `LIN ... C_DIS`.
+    Lin,
+    /// `SPL`, a spline segment (in a spline block).
+    Spl,
+    /// `SLIN`, a straight segment in a spline block.
+    Slin,
 }
 
 /// The part offset (part + offset = `$BASE` coordinates): [`bed_offset`]'s placement moved
@@ -218,7 +237,7 @@ impl<'a> Planner<'a> {
                     w.extruder(true);
                 }
                 w.feed(path, &pose, i);
-                w.motion(false, pose, i);
+                w.step(Kind::Lin, true, pose, i);
                 pose
             }
             _ => {
@@ -417,11 +436,22 @@ impl Motion {
         })
     }
 
-    /// A motion, unless it would go nowhere.
+    /// A motion (`PTP` when `ptp`, else `LIN`), unless it would go nowhere.
     fn motion(&mut self, ptp: bool, pose: Pose, point: usize) {
+        let kind = if ptp { Kind::Ptp } else { Kind::Lin };
+        self.step(kind, false, pose, point);
+    }
+
+    /// A motion of `kind`, laying a bead when `print`, unless it would go nowhere.
+    fn step(&mut self, kind: Kind, print: bool, pose: Pose, point: usize) {
         if !self.goes_nowhere(&pose) {
             self.last = Some((pose, point));
-            self.steps.push_back(Step::Move { ptp, pose, point });
+            self.steps.push_back(Step::Move {
+                kind,
+                print,
+                pose,
+                point,
+            });
         }
     }
 
@@ -537,7 +567,8 @@ impl Motion {
         // Always written, even where the LIN across ended there: the program ends at it.
         self.last = Some((safe, point));
         self.steps.push_back(Step::Move {
-            ptp: true,
+            kind: Kind::Ptp,
+            print: false,
             pose: safe,
             point,
         });
