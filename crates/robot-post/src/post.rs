@@ -201,7 +201,10 @@ mod tests {
                 MachineKind::Delta5,
                 vec!["program.gcode", "kinematic_error.svg"],
             ),
-            (MachineKind::Kuka, vec!["part.src", "part.dat"]),
+            (
+                MachineKind::Kuka,
+                vec!["part.src", "part.dat", "joints.csv"],
+            ),
         ] {
             let m = MachineProfile::builtin(kind);
             let program = m.post().post(&path, &job).unwrap();

@@ -356,7 +356,8 @@ fn round_trip_on_varied_axes() {
     // The planner's CSV is what the post is given.
     let path = ToolPath::from_csv(&path.to_csv()).expect("csv");
     let program = kuka(&path, &m, "shapes", "shapes.step").expect("program");
-    assert_eq!(program.files.len(), 2, "one .src and one .dat");
+    assert_eq!(program.files.len(), 3, "one .src, one .dat and joints.csv");
+    assert_eq!(program.files[2].0, "joints.csv");
     assert_eq!(program.files[0].0, "shapes.src");
     assert_eq!(program.files[1].0, "shapes.dat");
     let read = round_trip(&path, &program.files);
@@ -518,7 +519,7 @@ fn long_program_is_split_into_called_parts() {
     // Splitting changes nothing the robot does.
     m.kuka.as_mut().expect("kuka").max_moves_per_file = 1_000_000;
     let whole = kuka(&path, &m, "Long Part!", "long.step").expect("program");
-    assert_eq!(whole.files.len(), 2);
+    assert_eq!(whole.files.len(), 3, "a .src, its .dat and joints.csv");
     let one = krl::read(&whole.files).expect("whole program");
     assert_eq!(one.moves.len(), read.moves.len());
     for (x, y) in one.moves.iter().zip(&read.moves) {
@@ -1617,19 +1618,22 @@ fn spline_round_trip(path: &ToolPath, m: &MachineProfile, files: &[(String, Stri
                 "{p:?} is not a planned point"
             );
         }
-        for q in planned {
-            let (k, (d, t)) = line
-                .windows(2)
-                .map(|w| to_segment(q.p, w[0], w[1]))
-                .enumerate()
-                .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
-                .expect("a segment");
+        // The written points are planned points in order: each planned point lies on the
+        // segment to the next written one, or is it.
+        let mut j = 0;
+        for q in planned.iter().skip(1) {
+            let k = j.min(line.len() - 2);
+            let (d, t) = to_segment(q.p, line[k], line[k + 1]);
             assert!(d <= tol / 2.0 + 2e-3, "planned {:?} is {d} mm off", q.p);
             let (a0, a1) = (axis(written[k]), axis(written[k + 1]));
             let mix: [f64; 3] = std::array::from_fn(|i| (1.0 - t) * a0[i] + t * a1[i]);
             let err = angle_deg(mix, q.axis);
             assert!(err <= 0.2, "axis at {:?} off by {err}°", q.p);
+            if j + 1 < line.len() && len3(sub3(q.p, line[j + 1])) <= 0.01 {
+                j += 1;
+            }
         }
+        assert_eq!(j, line.len() - 1, "every written point met in order");
         // SPL segments drawn as cubics stay within the tolerance of the planned path.
         for k in 1..line.len() {
             if moves[start + k - 1].motion != Motion::Spl {
@@ -1846,12 +1850,131 @@ fn a_planned_toolpath_in_lin_and_spline_mode() {
         assert_status_turn(&read);
         assert_safe_points(&path, &read, 50.0);
         assert_signals(m, &read, Some(3));
-        let bytes: usize = program.files.iter().map(|f| f.1.len()).sum();
+        let krl = program.files.iter().filter(|f| !f.0.ends_with(".csv"));
+        let bytes: usize = krl.clone().map(|f| f.1.len()).sum();
         let prints = read.moves.iter().filter(|mv| mv.extruder).count();
         println!(
-            "{file} {mode}: {bytes} bytes in {} files, {} motions ({prints} printing)",
-            program.files.len(),
+            "{file} {mode}: {bytes} bytes in {} KRL files, {} motions ({prints} printing)",
+            krl.count(),
             read.moves.len()
         );
     }
+}
+
+/// The rows of a program's `joints.csv`: the motion's number and its joints (none when out of
+/// reach).
+fn joint_rows(files: &[(String, String)]) -> Vec<(usize, Option<[f64; 6]>)> {
+    let (_, text) = files
+        .iter()
+        .find(|(n, _)| n == robot_post::kuka::JOINTS_CSV)
+        .expect("joints.csv");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(robot_post::kuka::JOINTS_HEADER));
+    lines
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            assert_eq!(cells.len(), 7, "{l}");
+            let n: usize = cells[0].parse().expect("move number");
+            let joints = if cells[1..].iter().all(|c| c.is_empty()) {
+                None
+            } else {
+                let v: Vec<f64> = cells[1..]
+                    .iter()
+                    .map(|c| c.parse().expect("a joint angle"))
+                    .collect();
+                Some([v[0], v[1], v[2], v[3], v[4], v[5]])
+            };
+            (n, joints)
+        })
+        .collect()
+}
+
+#[test]
+fn joints_csv_gives_every_motion_by_forward_kinematics() {
+    let m = profile();
+    let cell = m.kuka.as_ref().expect("kuka");
+    let mut spline = m.clone();
+    spline.kuka.as_mut().expect("kuka").motion = KrlMotion::Spline;
+    let home_status = cell.arm.configuration(&cell.home);
+    for profile in [&m, &spline] {
+        for path in [all_shapes(), long_path(1, 2), lines_and_arcs(1)] {
+            let program = kuka(&path, profile, "j", "j.step").expect("program");
+            let read = krl::read(&program.files).expect("reads");
+            let offset = read.offset.expect("offset");
+            let rows = joint_rows(&program.files);
+            let cart: Vec<&KrlMove> = read
+                .moves
+                .iter()
+                .filter(|mv| matches!(mv.target, Target::Frame(_)))
+                .collect();
+            assert_eq!(rows.len(), cart.len(), "one row per Cartesian motion");
+            let (base, tool) = (
+                Pose::from_frame(read.base.expect("base")),
+                Pose::from_frame(read.tool.expect("tool")),
+            );
+            let base_inv = base.inverse();
+            let prints: Vec<&PathPoint> = path
+                .points
+                .iter()
+                .filter(|q| q.kind == MoveKind::Print)
+                .collect();
+            for (k, ((n, joints), mv)) in rows.iter().zip(&cart).enumerate() {
+                assert_eq!(*n, k + 1);
+                let j = joints.unwrap_or_else(|| panic!("row {n} out of reach"));
+                assert!(cell.arm.within_limits(&j), "row {n}: {j:?}");
+                // The tool pose by forward kinematics, in $BASE: the motion's frame.
+                let tcp = base_inv.compose(&cell.arm.forward(j).compose(&tool));
+                let f = frame_of(mv);
+                let d = len3(sub3(tcp.t, [f[0], f[1], f[2]]));
+                assert!(d <= 0.05, "row {n}: {d} mm from {}:{}", mv.file, mv.line);
+                let turned = rotation_between(&tcp.r, &rebuild(f[3], f[4], f[5]));
+                assert!(
+                    turned <= 0.1,
+                    "row {n}: {turned}° from {}:{}",
+                    mv.file,
+                    mv.line
+                );
+                // A print motion's pose is a planned point's, with its tool axis.
+                if mv.extruder {
+                    let p = sub3(tcp.t, offset);
+                    let axis = tcp.z_axis().map(|v| -v);
+                    assert!(
+                        prints
+                            .iter()
+                            .any(|q| len3(sub3(p, q.p)) <= 0.05 && angle_deg(axis, q.axis) <= 0.1),
+                        "row {n}: {p:?} is no planned point"
+                    );
+                }
+                // The reach check's solution: the configuration kept, and a PTP's S and T.
+                assert_eq!(cell.arm.configuration(&j), home_status, "row {n}");
+                if let Some((s, t)) = mv.status_turn {
+                    assert_eq!(
+                        (s, t),
+                        (cell.arm.configuration(&j), robot_post::kuka::turn(&j)),
+                        "row {n}"
+                    );
+                }
+            }
+        }
+    }
+    // A motion out of reach has its row, without joints: the same motions the program marks.
+    let mut path = long_path(1, 1);
+    let high: Vec<_> = (0..5)
+        .map(|k| ([f64::from(k), 0.0, 2000.0], [0.0, 0.0, 1.0]))
+        .collect();
+    push_path(&mut path, 2, 0, &high);
+    let program = kuka(&path, &m, "far", "far.step").expect("written anyway");
+    let read = krl::read(&program.files).expect("reads");
+    let rows = joint_rows(&program.files);
+    let cart = read
+        .moves
+        .iter()
+        .filter(|mv| matches!(mv.target, Target::Frame(_)));
+    let mut empty = 0;
+    for ((n, joints), mv) in rows.iter().zip(cart) {
+        let marked = mv.note.as_deref() == Some("UNREACHABLE");
+        assert_eq!(joints.is_none(), marked, "row {n}");
+        empty += usize::from(marked);
+    }
+    assert!(empty >= 5);
 }

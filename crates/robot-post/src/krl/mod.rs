@@ -1,7 +1,8 @@
 //! A small reader of the KRL programs [`crate::kuka::kuka`] writes: it checks their structure
 //! and runs them symbolically, returning the motions in order with the extruder's state.
 //!
-//! Structure checked: every `.src` has its `.dat` and the other way round; a `.src` is
+//! Structure checked (`.csv` files beside the program, such as `joints.csv`, are passed
+//! over): every `.src` has its `.dat` and the other way round; a `.src` is
 //! optional `&` header lines, then `DEF <file name>( )` ... `END`, then local subroutines
 //! `DEF name( )` ... `END` (an interrupt's routine); a `.dat` is
 //! `DEFDAT <file name>` ... `ENDDAT` holding only `DECL AXIS` lines; `;FOLD`/`;ENDFOLD` are
@@ -191,7 +192,8 @@ pub fn read(files: &[(String, String)]) -> Result<KrlRead, KrlError> {
             if !dats.insert(stem.to_string()) {
                 return Err(err(name, 0, "a second .dat of the same module"));
             }
-        } else {
+        } else if !lower.ends_with(".csv") {
+            // A table beside the program (joints.csv) is not KRL.
             return Err(err(name, 0, "neither a .src nor a .dat file"));
         }
     }

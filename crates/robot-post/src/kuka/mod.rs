@@ -85,14 +85,17 @@
 //!   reported ([`KukaFigures`], warnings, and a comment on the LIN), not refused.
 //! - **Status and Turn.** The configuration is KUKA's Status S: bit 0 the wrist centre behind
 //!   A1 (overhead area), bit 1 A3 at or past the stretched arm's angle (elbow up), bit 2 A5 ≤ 0
-//!   (wrist flipped); the Turn T has bit n set where A(n+1) < 0. Every Cartesian `PTP` carries
-//!   the S and T of the solution the reach check followed (`PTP {X .., ..., C .., S 'B010', T
-//!   'B000010'}`), so the controller takes that solution; LINs keep the configuration they
-//!   start in. The program keeps home's configuration throughout: a motion on which it would
-//!   change is a warning naming the motion (its number, file and line, and the two S).
+//!   (wrist flipped); the Turn T has bit n set where A(n+1) < 0 (below [`TURN_ZERO`]). Every
+//!   Cartesian `PTP` carries the S and T of the solution the reach check followed (`PTP {X ..,
+//!   ..., C .., S 'B010', T 'B000010'}`), so the controller takes that solution; LINs keep the
+//!   configuration they start in. The program keeps home's configuration throughout: a motion
+//!   on which it would change is a warning naming the motion (its number, file and line, and
+//!   the two S). `joints.csv` ([`JOINTS_CSV`]) gives the joints of that solution for every
+//!   Cartesian motion, numbered as the warnings number them.
 
 pub(crate) mod cell;
 mod checks;
+mod joints;
 mod krl_text;
 mod motion;
 mod opw;
@@ -104,9 +107,10 @@ use std::collections::BTreeMap;
 
 pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KrlMotion, KukaCell};
 pub use checks::KukaFigures;
+pub use joints::{JOINTS_CSV, JOINTS_HEADER};
 pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
 pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
-pub use opw::{bits_text, turn};
+pub use opw::{bits_text, turn, TURN_ZERO};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
 pub use signals::{READY_TIMER, STOP_INTERRUPT, STOP_ROUTINE};
 pub use spline::{
@@ -118,6 +122,7 @@ use crate::machine::MachineProfile;
 use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
 use checks::Reach;
+use joints::write_joints;
 use krl_text::write_files;
 pub(crate) use motion::start_frame;
 use motion::{placement, Planner, Step};
@@ -132,7 +137,8 @@ pub const AXIS_LENGTH_TOLERANCE: f64 = 1e-3;
 #[derive(Debug, Clone, PartialEq)]
 pub struct KrlProgram {
     /// `(file name, text)`: the main `<name>.src` and `<name>.dat` first, then the parts
-    /// `<name>_p001.src`, `<name>_p001.dat`, ... when the program is split.
+    /// `<name>_p001.src`, `<name>_p001.dat`, ... when the program is split, then
+    /// [`JOINTS_CSV`].
     pub files: Vec<(String, String)>,
     /// Per feature id.
     pub figures: BTreeMap<usize, KukaFigures>,
@@ -216,6 +222,9 @@ pub fn kuka_to(
         sink,
         &mut warnings,
     )?;
+    // The joints of the solutions the check followed, from a third run of the planner and the
+    // same check again.
+    write_joints(path, steps(), Reach::new(path, cell, &base), sink)?;
     Ok(KrlProgram {
         files: vec![],
         figures,

@@ -186,13 +186,18 @@ impl ArmModel {
 }
 
 /// KUKA's Turn (T) of joint angles (degrees): bit n set where A(n+1) < 0, so that with the
-/// Status it picks one of the solutions of a pose whose joints may turn past ±180°.
+/// Status it picks one of the solutions of a pose whose joints may turn past ±180°. A joint
+/// within [`TURN_ZERO`] below 0 (0 as `joints.csv` writes it) counts as 0.
 pub fn turn(joints: &[f64; 6]) -> u8 {
     joints
         .iter()
         .enumerate()
-        .fold(0, |t, (n, a)| t | (u8::from(*a < 0.0) << n))
+        .fold(0, |t, (n, a)| t | (u8::from(*a < -TURN_ZERO) << n))
 }
+
+/// Half the step (degrees) joint angles are written in: a joint this close below 0 is 0 for
+/// its Turn bit.
+pub const TURN_ZERO: f64 = 5e-5;
 
 /// A Status or Turn as KRL writes it, binary with `bits` digits: `'B010'`.
 pub fn bits_text(v: u8, bits: usize) -> String {
@@ -207,6 +212,7 @@ mod tests {
     fn turn_bits_and_their_text() {
         assert_eq!(turn(&[0.0, -90.0, 90.0, 0.0, 90.0, 0.0]), 0b10);
         assert_eq!(turn(&[-1.0, -90.0, 90.0, 0.0, 90.0, -5.0]), 0b100011);
+        assert_eq!(turn(&[0.0, -90.0, 90.0, -1e-12, 90.0, -1e-6]), 0b10);
         assert_eq!(bits_text(2, 3), "'B010'");
         assert_eq!(bits_text(0b100010, 6), "'B100010'");
     }
