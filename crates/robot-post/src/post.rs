@@ -199,7 +199,7 @@ mod tests {
             (MachineKind::Marlin, vec!["program.gcode"]),
             (
                 MachineKind::Delta5,
-                vec!["program.gcode", "kinematic_error.svg"],
+                vec!["program.gcode", "kinematic_error.svg", "joints.csv"],
             ),
             (
                 MachineKind::Kuka,
