@@ -5,7 +5,7 @@ mod krl_common;
 use krl_common::*;
 
 use robot_post::krl::{self, KrlRead, Motion};
-use robot_post::kuka::KrlMotion;
+use robot_post::kuka::{ExtruderSwitch, KrlMotion};
 use robot_post::{kuka, ToolPath};
 
 #[test]
@@ -34,6 +34,23 @@ fn spline_mode_drops_points_and_reads_back_within_the_tolerance() {
     assert!(size(&pb) * 2 < size(&pa), "{} vs {}", size(&pb), size(&pa));
     // Lin mode writes no spline.
     assert!(pa.files.iter().all(|f| !f.1.contains("SPLINE")));
+    // Switched by $OUT (exact stops), the extruder goes on before the block and off after it,
+    // and the program reads back the same.
+    let mut out = spline.clone();
+    out.kuka.as_mut().expect("kuka").extruder_switch = ExtruderSwitch::Out;
+    let po = kuka(&path, &out, "l", "f.step").expect("spline, $OUT");
+    let o = spline_round_trip(&path, &out, &po.files);
+    assert_eq!(o.moves.len(), b.moves.len());
+    let src = &po.files[0].1;
+    assert!(
+        src.contains("$OUT[1] = TRUE\nSPLINE\n"),
+        "on before the block"
+    );
+    assert!(
+        src.contains("ENDSPLINE\n$VEL.CP"),
+        "the block ends before the travel"
+    );
+    assert!(!src.contains("PATH=0 ONSTART DELAY=0 DO $OUT"));
 }
 
 #[test]
@@ -83,9 +100,10 @@ fn spline_blocks_split_across_parts_and_refused_when_broken() {
     }
 }
 
-/// The checks of `every_fixture_in_lin_and_spline_mode` (kuka_krl.rs) on a planned part's tool path: the
-/// `toolpath.csv` named by `KRL_TOOLPATH` (`features plan PART --machine kuka` writes it), in
-/// lin and spline mode; prints the programs' sizes and motions. Ignored: run it with
+/// The checks of `every_fixture_in_lin_and_spline_mode` (kuka_krl.rs) on a planned part's
+/// tool path: the `toolpath.csv` named by `KRL_TOOLPATH` (`features plan PART --machine kuka`
+/// writes it), in lin and spline mode; prints the programs' sizes and motions. Ignored: run it
+/// with
 /// `KRL_TOOLPATH=... cargo test --release -p robot-post --test kuka_spline -- --ignored`.
 #[test]
 #[ignore]
