@@ -459,7 +459,7 @@ fn main_header(
             fixed(m.filament_diameter, 2)
         ),
         format!(
-            "; filament feed per print LIN: $ANOUT[{feed_out}] = feed ratio / {} (feed ratio = filament mm per mm of path, the plan's for that LIN), set by TRIGGER where the LIN starts; the extruder feeds $ANOUT[{feed_out}] x {} mm of filament per mm the tool moves",
+            "; filament feed per print motion: $ANOUT[{feed_out}] = feed ratio / {} (feed ratio = filament mm per mm of path, the plan's for that motion), set by TRIGGER where the motion starts; the extruder feeds $ANOUT[{feed_out}] x {} mm of filament per mm the tool moves",
             fixed(cell.feed_ratio_full_scale, 5),
             fixed(cell.feed_ratio_full_scale, 5)
         ),

@@ -44,8 +44,9 @@
 //!   stopping the advance run; with `"out"` a plain `$OUT[n]=...` between the motions stops
 //!   the robot there (exact stop) and switches. Temperatures are the extruder controller's;
 //!   the header states them.
-//! - **Filament feed.** One feed ratio per print LIN, following the plan: the planned E of
-//!   the path points the LIN reaches (a print move dropped as going nowhere hands its E on)
+//! - **Filament feed.** One feed ratio per print LIN (or spline segment, see below), following
+//!   the plan: the planned E of the path points the LIN reaches (a print move dropped as going
+//!   nowhere hands its E on)
 //!   over the LIN's length, in mm of filament per mm of path. It is written as the analog
 //!   output `$ANOUT[feed_output]` = ratio / `feed_ratio_full_scale` (5 decimals, held at 1.0
 //!   with a warning beyond full scale) by `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[n]=v`
