@@ -106,7 +106,10 @@ mod spline;
 
 use std::collections::BTreeMap;
 
-pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KrlMotion, KukaCell};
+pub use cell::{
+    ArmModel, ExtruderSwitch, KrlFrame, KrlMotion, KukaCell, DEFAULT_READY_TIMEOUT,
+    DEFAULT_SAFE_HEIGHT, DEFAULT_SPLINE_TOLERANCE,
+};
 pub use checks::KukaFigures;
 pub use joints::{JOINTS_CSV, JOINTS_HEADER};
 pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
