@@ -15,9 +15,10 @@ use robot_post::machine::MachineKind;
 use std::path::{Path, PathBuf};
 
 /// The fixed names of a plan's outputs (before a `-o` stem); KRL modules are named by the stem.
-const OUTPUT_NAMES: [&str; 6] = [
+const OUTPUT_NAMES: [&str; 7] = [
     "toolpath.csv",
     "program.gcode",
+    "joints.csv",
     "kinematic_error.svg",
     "preview.html",
     "collisions.csv",

@@ -199,9 +199,12 @@ mod tests {
             (MachineKind::Marlin, vec!["program.gcode"]),
             (
                 MachineKind::Delta5,
-                vec!["program.gcode", "kinematic_error.svg"],
+                vec!["program.gcode", "kinematic_error.svg", "joints.csv"],
             ),
-            (MachineKind::Kuka, vec!["part.src", "part.dat"]),
+            (
+                MachineKind::Kuka,
+                vec!["part.src", "part.dat", "joints.csv"],
+            ),
         ] {
             let m = MachineProfile::builtin(kind);
             let program = m.post().post(&path, &job).unwrap();

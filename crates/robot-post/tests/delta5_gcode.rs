@@ -1072,3 +1072,58 @@ fn delta5_type_comments_follow_the_roles() {
         }
     }
 }
+
+/// `joints.csv` gives, for every move from the path's first on, the B and C the program's
+/// line sets (modal), within the B limits (those B and C reproduce the planned axes:
+/// `delta5_program_reparsed_reproduces_toolpath_csv`).
+#[test]
+fn delta5_joints_csv_follows_the_moves() {
+    let m = profile();
+    let path = synthetic();
+    let program = delta5(&path, &m, "sphere.step").unwrap();
+    let mut rows = program.joints_csv.lines();
+    assert_eq!(rows.next(), Some(robot_post::delta5::DELTA5_JOINTS_HEADER));
+    let rows: Vec<Vec<&str>> = rows.map(|r| r.split(',').collect()).collect();
+    // The program's moves after the start G-code: the path starts at the first `;LAYER:`.
+    let start = program.gcode.find(";LAYER:").expect("a layer");
+    let (mut b, mut c) = (String::new(), String::new());
+    let mut n = 0;
+    for line in program.gcode[start..].lines() {
+        let code = line.split(';').next().unwrap_or_default();
+        let mut words = code.split_whitespace();
+        if !matches!(words.next(), Some("G0" | "G1")) {
+            continue;
+        }
+        let words: Vec<&str> = words.collect();
+        if !words
+            .iter()
+            .any(|w| w.starts_with(['X', 'Y', 'Z', 'B', 'C']))
+        {
+            continue;
+        }
+        for w in &words {
+            if let Some(v) = w.strip_prefix('B') {
+                b = v.to_string();
+            }
+            if let Some(v) = w.strip_prefix('C') {
+                c = v.to_string();
+            }
+        }
+        let row = &rows[n];
+        assert_eq!(row[0], (n + 1).to_string());
+        assert_eq!((row[1], row[2]), (b.as_str(), c.as_str()), "{line}");
+        n += 1;
+    }
+    assert_eq!(n, rows.len(), "one row per move");
+    assert!(n > path.points.len() / 2);
+    // B and C of the rows are within the machine's limits.
+    let g = m.delta5.as_ref().expect("delta5");
+    for row in &rows {
+        if let Ok(b) = row[1].parse::<f64>() {
+            assert!(
+                b >= g.b_limits_deg[0] - 1e-4 && b <= g.b_limits_deg[1] + 1e-4,
+                "{row:?}"
+            );
+        }
+    }
+}

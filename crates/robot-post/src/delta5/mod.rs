@@ -63,6 +63,7 @@
 
 mod figures;
 pub(crate) mod geometry;
+mod joints;
 mod kinematics;
 mod motion;
 mod text;
@@ -71,15 +72,18 @@ use std::collections::BTreeMap;
 
 pub use figures::KinematicFigures;
 pub use geometry::Delta5Geometry;
+pub use joints::DELTA5_JOINTS_HEADER;
 pub use kinematics::{forward, inverse, tilt_for, to_machine};
 pub use motion::MAX_SUBDIVISION;
 
+use crate::kuka::JOINTS_CSV;
 use crate::machine::MachineProfile;
 use crate::placement::table_offset;
 use crate::sink::{insert_notes, write_file, Chunked, InMemory, ProgramSink};
 use crate::PostError;
 use figures::error_plot;
 use geometry::FIT_TOLERANCE;
+use joints::JointRows;
 use kinematics::{plan_poses, Pose};
 use motion::{Pass, Writer};
 use text::header;
@@ -100,6 +104,8 @@ pub struct Delta5Program {
     /// The kinematic error along the printed path as a stand-alone SVG: one colour per
     /// feature, axes labelled, the goal as a dashed line.
     pub error_plot_svg: String,
+    /// `joints.csv`: the B and C after every move of the path ([`DELTA5_JOINTS_HEADER`]).
+    pub joints_csv: String,
     /// Things to know, one line each (feeds clamped to `max_feed_mm_min`, when more than
     /// [`FEED_CLAMP_WARN_SHARE`] of the print moves were).
     pub warnings: Vec<String>,
@@ -146,6 +152,7 @@ pub fn delta5(
         .map(|f| String::from_utf8(f.bytes).unwrap_or_default());
     program.gcode = texts.next().unwrap_or_default();
     program.error_plot_svg = texts.next().unwrap_or_default();
+    program.joints_csv = texts.next().unwrap_or_default();
     Ok(program)
 }
 
@@ -231,7 +238,10 @@ pub fn delta5_to(
         .collect();
 
     let mut file = Chunked::open(sink, "program.gcode")?;
-    let mut text = Writer::new(m, g, offset, safe_z, w.replay());
+    let replay = w.replay();
+    // The third run, for joints.csv, splits the print segments as the second.
+    let again = replay.again();
+    let mut text = Writer::new(m, g, offset, safe_z, replay);
     text.out = header(m, g, source, offset, safe_z, wanted_safe, &figures);
     insert_notes(&mut text.out, notes);
     walk(&mut text, path, &poses, g, |out| file.pass_on(out))?;
@@ -241,6 +251,19 @@ pub fn delta5_to(
 
     let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
     write_file(sink, "kinematic_error.svg", error_plot_svg.as_bytes())?;
+
+    // joints.csv: the moves of the path again, B and C read off each as it is made.
+    let mut file = Chunked::open(sink, JOINTS_CSV)?;
+    let mut rows = JointRows::new();
+    let mut moves = Writer::new(m, g, offset, safe_z, again);
+    walk(&mut moves, path, &poses, g, |out| {
+        rows.scan(out);
+        out.clear();
+        file.pass_on(&mut rows.text)
+    })?;
+    moves.footer()?;
+    rows.scan(&moves.out);
+    file.finish(&rows.text)?;
     let mut warnings = Vec::new();
     // A few clamped moves (the short ones B and C turn fast on, nearly every part has some)
     // are a figure; a warning only where a share the user would notice is slowed.
@@ -257,6 +280,7 @@ pub fn delta5_to(
         gcode: String::new(),
         figures,
         error_plot_svg: String::new(),
+        joints_csv: String::new(),
         warnings,
         feed_clamped_moves: w.clamped.0,
         offset,

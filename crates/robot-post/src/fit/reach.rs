@@ -79,10 +79,17 @@ pub fn unreachable_points(path: &ToolPath, m: &MachineProfile) -> Result<usize, 
 /// The tool poses the cheap reach test checks, part coordinates: each point the post visits
 /// with its unit tool axis (print points, and travel points where a path starts: the post
 /// passes over the others), and out along the axis by `travel_clearance` where a path starts
-/// and ends (the approach and the retreat).
-fn test_poses(path: &ToolPath, clearance: f64) -> Vec<([f64; 3], [f64; 3])> {
+/// and ends (the approach and the retreat); and the safe point, `safe_height` over the top
+/// of the print points over the first path's start, the tool upright.
+fn test_poses(path: &ToolPath, clearance: f64, safe_height: f64) -> Vec<([f64; 3], [f64; 3])> {
     let n = path.points.len();
     let mut out = Vec::with_capacity(n + n / 8);
+    let top = crate::placement::placed_points(path)
+        .map(|q| q.p[2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    if let Some(start) = path.points.first().filter(|_| top.is_finite()) {
+        out.push(([start.p[0], start.p[1], top + safe_height], [0.0, 0.0, 1.0]));
+    }
     for (i, q) in path.points.iter().enumerate() {
         let len = norm(q.axis);
         if len.is_nan() || len <= MIN_AXIS {
@@ -218,7 +225,7 @@ pub fn reach_shift(path: &ToolPath, m: &MachineProfile) -> Result<ReachShift, Fi
         cell,
         base: cell.base.pose(),
         tool_inv: cell.tool.pose().inverse(),
-        poses: test_poses(path, cell.travel_clearance),
+        poses: test_poses(path, cell.travel_clearance, cell.safe_height),
     };
     let n = tester.poses.len();
     let mut sample = first_tested(&tester, offset);

@@ -50,6 +50,18 @@ pub enum ExtruderSwitch {
     Trigger,
 }
 
+/// How the print paths are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KrlMotion {
+    /// One `LIN ... C_DIS` per path point.
+    #[default]
+    Lin,
+    /// `SPLINE` blocks of `SPL` and `SLIN` segments through the points left after dropping
+    /// those within `spline_tolerance` of the line through their neighbours.
+    Spline,
+}
+
 /// A 6-axis arm with an ortho-parallel base and a spherical wrist, in the parameters of
 /// Brandstötter, Angerer & Hofbaur 2014 ("An analytical solution of the inverse kinematics
 /// problem of industrial serial manipulators with an ortho-parallel basis and a spherical
@@ -97,6 +109,17 @@ pub struct KukaCell {
     pub part_position: [f64; 2],
     /// `$TOOL`: the nozzle tip in the flange frame, Z along the nozzle.
     pub tool: KrlFrame,
+    /// The controller's base number n (1..32) that holds `base`: when given, the program
+    /// selects it with `BAS (#BASE, n)` instead of assigning `$BASE`, and states the frame it
+    /// assumes `BASE_DATA[n]` holds in a comment, for the integrator to check. Optional: the
+    /// frame is assigned to `$BASE` when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_index: Option<u32>,
+    /// The controller's tool number n (1..32) that holds `tool`, as `base_index`:
+    /// `BAS (#TOOL, n)` and a comment stating the assumed `TOOL_DATA[n]`. Optional: `$TOOL` is
+    /// assigned when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_index: Option<u32>,
     /// Home position A1..A6 (degrees), where the program starts and ends (`PTP`).
     pub home: [f64; 6],
     /// `$VEL.CP` of print moves (m/s); 0 derives it from `print_speed` and
@@ -109,10 +132,24 @@ pub struct KukaCell {
     /// Retreat and approach distance along the tool axis, and the clearance of the travel
     /// height over everything visited so far (mm).
     pub travel_clearance: f64,
+    /// The safe point's height (mm) over the part's top (`$BASE` Z): the program goes there by
+    /// `PTP`, over the first path's start, before its first motion near the part, and back there
+    /// after the last. Optional: [`DEFAULT_SAFE_HEIGHT`] when left out.
+    #[serde(default = "default_safe_height")]
+    pub safe_height: f64,
     /// Number n of the digital output `$OUT[n]` that runs the extruder.
     pub extruder_output: u32,
     /// How the output is switched.
     pub extruder_switch: ExtruderSwitch,
+    /// Number n of the digital input `$IN[n]` on which the extruder reports it is ready (at
+    /// temperature): when given, the program waits for it before its first print move, at most
+    /// `ready_timeout` seconds, then halts. Optional: no handshake when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ready_input: Option<u32>,
+    /// The longest wait for `ready_input` (s) before the program halts. Optional:
+    /// [`DEFAULT_READY_TIMEOUT`] when left out.
+    #[serde(default = "default_ready_timeout")]
+    pub ready_timeout: f64,
     /// Number n of the analog output `$ANOUT[n]` that carries each print LIN's feed ratio
     /// (filament mm per mm of path). Optional: 1 when left out.
     #[serde(default = "default_feed_output")]
@@ -121,6 +158,16 @@ pub struct KukaCell {
     /// the ratio over this. Optional: 0.1 when left out.
     #[serde(default = "default_feed_ratio_full_scale")]
     pub feed_ratio_full_scale: f64,
+    /// How the print paths are written: `lin` (one `LIN` per point) or `spline` (`SPLINE`
+    /// blocks through the points left after dropping those a straight run passes within
+    /// `spline_tolerance` of). Optional: `lin` when left out.
+    #[serde(default)]
+    pub motion: KrlMotion,
+    /// With `motion = "spline"`: how far (mm) the written path may pass from a planned point
+    /// (half of it for the points dropped, half for a spline segment's bulge). Optional:
+    /// [`DEFAULT_SPLINE_TOLERANCE`] when left out.
+    #[serde(default = "default_spline_tolerance")]
+    pub spline_tolerance: f64,
     /// Most motions per `.src` file; a longer program is split into parts called from the
     /// main program.
     pub max_moves_per_file: usize,
@@ -133,6 +180,30 @@ pub struct KukaCell {
 
 fn is_origin(p: &[f64; 2]) -> bool {
     *p == [0.0, 0.0]
+}
+
+/// The safe point's height over the part's top (mm) of a cell that does not say
+/// (`safe_height`).
+pub const DEFAULT_SAFE_HEIGHT: f64 = 50.0;
+
+/// The spline tolerance (mm) of a cell that does not say (`spline_tolerance`): the process's
+/// default chord tolerance.
+pub const DEFAULT_SPLINE_TOLERANCE: f64 = 0.05;
+
+fn default_spline_tolerance() -> f64 {
+    DEFAULT_SPLINE_TOLERANCE
+}
+
+/// The longest wait for the extruder's ready input (s) of a cell that does not say
+/// (`ready_timeout`).
+pub const DEFAULT_READY_TIMEOUT: f64 = 60.0;
+
+fn default_ready_timeout() -> f64 {
+    DEFAULT_READY_TIMEOUT
+}
+
+fn default_safe_height() -> f64 {
+    DEFAULT_SAFE_HEIGHT
 }
 
 fn default_feed_output() -> u32 {
@@ -166,6 +237,14 @@ impl KukaCell {
                 return Err(bad(field, format!("A, B, C must be within ±360°, got {x}")));
             }
         }
+        for (field, n) in [
+            ("kuka.base_index", self.base_index),
+            ("kuka.tool_index", self.tool_index),
+        ] {
+            if let Some(n) = n.filter(|n| !(1..=32).contains(n)) {
+                return Err(bad(field, format!("must be a number 1..32, got {n}")));
+            }
+        }
         if let Some(x) = self
             .part_position
             .iter()
@@ -181,6 +260,7 @@ impl KukaCell {
             ("kuka.travel_vel_cp", self.travel_vel_cp, 3.0),
             ("kuka.apo_cdis", self.apo_cdis, 100.0),
             ("kuka.travel_clearance", self.travel_clearance, 1000.0),
+            ("kuka.safe_height", self.safe_height, 2000.0),
         ] {
             if !(v.is_finite() && (0.0..=max).contains(&v)) {
                 return Err(bad(field, format!("must be between 0 and {max}, got {v}")));
@@ -195,6 +275,19 @@ impl KukaCell {
                 ),
             ));
         }
+        if let Some(n) = self.ready_input.filter(|n| !(1..=4096).contains(n)) {
+            return Err(bad(
+                "kuka.ready_input",
+                format!("must be an input number 1..4096, got {n}"),
+            ));
+        }
+        let t = self.ready_timeout;
+        if !(t.is_finite() && t > 0.0 && t <= 86400.0) {
+            return Err(bad(
+                "kuka.ready_timeout",
+                format!("must be above 0 and at most 86400 s, got {t}"),
+            ));
+        }
         if !(1..=4096).contains(&self.feed_output) {
             return Err(bad(
                 "kuka.feed_output",
@@ -202,6 +295,13 @@ impl KukaCell {
                     "must be an analog output number 1..4096, got {}",
                     self.feed_output
                 ),
+            ));
+        }
+        let t = self.spline_tolerance;
+        if !(t.is_finite() && t > 0.0 && t <= 1.0) {
+            return Err(bad(
+                "kuka.spline_tolerance",
+                format!("must be above 0 and at most 1 mm, got {t}"),
             ));
         }
         let f = self.feed_ratio_full_scale;

@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 
 use super::cell::KukaCell;
+use super::opw::{bits_text, turn};
 use super::rotation::Pose;
 use toolpath::{fixed, ToolPath};
 
@@ -48,6 +49,22 @@ pub(super) struct Reach<'a> {
     /// The joints and configuration the arm is in.
     joints: [f64; 6],
     config: Option<u8>,
+    /// Motions checked so far.
+    motions: usize,
+    /// Per feature: where its first configuration change is, and the change.
+    first_change: BTreeMap<usize, String>,
+}
+
+/// What the check found for one motion.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Solved {
+    /// The KRL frame written (Euler angles unwrapped along the program).
+    pub(super) frame: [f64; 6],
+    /// `UNREACHABLE` or `WRIST SINGULAR`, for the motion's line.
+    pub(super) note: Option<&'static str>,
+    /// The joint angles A1..A6 (degrees) of the solution followed, with its Status and Turn;
+    /// `None` when out of reach.
+    pub(super) joints: Option<([f64; 6], u8, u8)>,
 }
 
 impl<'a> Reach<'a> {
@@ -68,19 +85,23 @@ impl<'a> Reach<'a> {
             prev_abc: None,
             joints: cell.home,
             config: Some(cell.arm.configuration(&cell.home)),
+            motions: 0,
+            first_change: BTreeMap::new(),
         }
     }
 
-    /// The next motion, to `pose` for path point `point` of `feature`: the KRL frame written,
-    /// and a note for its line when the arm cannot reach it or it is near the wrist
-    /// singularity.
+    /// The next motion, to `pose` for path point `point` of `feature`, written at `at` (file
+    /// and one-based line): the KRL frame written, the solution followed, and a note for its
+    /// line when the arm cannot reach it or it is near the wrist singularity.
     pub(super) fn motion(
         &mut self,
         pose: &Pose,
         point: usize,
         feature: usize,
-    ) -> ([f64; 6], Option<&'static str>) {
+        at: (&str, usize),
+    ) -> Solved {
         let (cell, arm) = (self.cell, &self.cell.arm);
+        self.motions += 1;
         let fig = self.figures.entry(feature).or_default();
         fig.moves += 1;
         let f = pose.to_frame(self.prev_abc);
@@ -91,6 +112,7 @@ impl<'a> Reach<'a> {
         }
         self.prev_abc = Some([f[3], f[4], f[5]]);
         let flange = self.base.compose(pose).compose(&self.tool_inv);
+        let mut joints = None;
         let note = match arm.nearest(&flange, &self.joints, self.config) {
             None => {
                 self.unreachable[point] = true;
@@ -100,9 +122,20 @@ impl<'a> Reach<'a> {
                 Some("UNREACHABLE")
             }
             Some((j, c)) => {
-                if self.config.is_some_and(|k| k != c) {
+                if let Some(k) = self.config.filter(|k| *k != c) {
                     fig.configuration_changes += 1;
+                    self.first_change.entry(feature).or_insert_with(|| {
+                        format!(
+                            "motion {} ({}:{}, point {point}), S {} to {}",
+                            self.motions,
+                            at.0,
+                            at.1,
+                            bits_text(k, 3),
+                            bits_text(c, 3)
+                        )
+                    });
                 }
+                joints = Some((j, c, turn(&j)));
                 self.joints = j;
                 self.config = Some(c);
                 let bend = arm.wrist_bend(&j);
@@ -119,7 +152,11 @@ impl<'a> Reach<'a> {
                 }
             }
         };
-        (f, note)
+        Solved {
+            frame: f,
+            note,
+            joints,
+        }
     }
 
     /// What the check found per feature, once every motion is checked; its warnings, one line
@@ -134,6 +171,7 @@ impl<'a> Reach<'a> {
             unreachable,
             singular,
             mut figures,
+            first_change,
             ..
         } = self;
         for (i, q) in path.points.iter().enumerate() {
@@ -170,8 +208,9 @@ impl<'a> Reach<'a> {
             }
             if fig.configuration_changes > 0 {
                 warnings.push(format!(
-                    "feature {id}: the arm changes configuration on {} motions (a LIN cannot)",
-                    fig.configuration_changes
+                    "feature {id}: the arm changes configuration on {} motions (a LIN cannot), first at {}",
+                    fig.configuration_changes,
+                    first_change.get(id).map_or("?", String::as_str)
                 ));
             }
             if fig.gimbal_crossings > 0 {

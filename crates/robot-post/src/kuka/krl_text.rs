@@ -1,9 +1,11 @@
 //! The KRL text of a program: the `.src` and `.dat` files (split into parts when long), KRL
 //! names and frame aggregates.
 
-use super::cell::{ExtruderSwitch, KukaCell};
+use super::cell::{ExtruderSwitch, KrlFrame, KrlMotion, KukaCell};
 use super::checks::{KukaFigures, Reach};
-use super::motion::Step;
+use super::motion::{Kind, Step};
+use super::opw::bits_text;
+use super::signals::{interrupt_lines, ready_lines, reset_lines, stop_routine};
 use crate::gcode::{comment_text, push_line};
 use crate::machine::MachineProfile;
 use crate::sink::{insert_notes, write_file, Chunked, ProgramSink};
@@ -82,6 +84,7 @@ pub fn krl_name(s: &str, max: usize) -> String {
         "exor",
         "ext",
         "extfct",
+        "extruder_stop",
         "false",
         "for",
         "frame",
@@ -144,6 +147,19 @@ pub fn frame_text(f: &[f64; 6]) -> String {
     )
 }
 
+/// A KRL POS aggregate `{X .., Y .., Z .., A .., B .., C .., S 'B..', T 'B..'}`: the frame of
+/// [`frame_text`] with KUKA's Status (3 bits) and Turn (6 bits) of the joints it is reached
+/// with, in binary as KRL writes them.
+pub fn pos_text(f: &[f64; 6], status: u8, turn: u8) -> String {
+    let frame = frame_text(f);
+    format!(
+        "{}, S {}, T {}}}",
+        &frame[..frame.len() - 1],
+        bits_text(status, 3),
+        bits_text(turn, 6)
+    )
+}
+
 /// The program's lines, one per step ([`Steps::push`]), and what writing them finds.
 struct Steps<'a> {
     cell: &'a KukaCell,
@@ -155,6 +171,12 @@ struct Steps<'a> {
     /// Print LINs whose feed ratio is beyond the analog output's full scale, and the largest
     /// such ratio.
     beyond: (usize, f64),
+    /// The file being written and the lines written into it so far.
+    file: String,
+    line: usize,
+    /// Inside a `SPLINE` block; a block the last file ended is to go on in this one.
+    in_block: bool,
+    reopen: bool,
 }
 
 impl Steps<'_> {
@@ -162,7 +184,31 @@ impl Steps<'_> {
     fn push(&mut self, step: &Step, out: &mut String) {
         let cell = self.cell;
         let (out_n, feed_out) = (cell.extruder_output, cell.feed_output);
+        if std::mem::take(&mut self.reopen) {
+            // A block cut at the end of the last part goes on here, unless it ends at once.
+            if matches!(step, Step::SplineEnd) {
+                self.in_block = false;
+                return;
+            }
+            self.line += 1;
+            push_line(out, "SPLINE");
+            self.in_block = true;
+        }
+        // Inside a spline block a trigger refers to the path of its segments.
+        let trigger = if self.in_block {
+            "TRIGGER WHEN PATH=0 ONSTART DELAY=0 DO"
+        } else {
+            "TRIGGER WHEN DISTANCE=0 DELAY=0 DO"
+        };
         let line = match step {
+            Step::SplineStart => {
+                self.in_block = true;
+                "SPLINE".into()
+            }
+            Step::SplineEnd => {
+                self.in_block = false;
+                "ENDSPLINE".into()
+            }
             Step::Comment(c) => format!("; {}", comment_text(c)),
             Step::Vel(v) => {
                 self.vel = Some(*v);
@@ -172,9 +218,7 @@ impl Steps<'_> {
                 let state = if *on { "TRUE" } else { "FALSE" };
                 match cell.extruder_switch {
                     ExtruderSwitch::Out => format!("$OUT[{out_n}] = {state}"),
-                    ExtruderSwitch::Trigger => {
-                        format!("TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[{out_n}]={state}")
-                    }
+                    ExtruderSwitch::Trigger => format!("{trigger} $OUT[{out_n}]={state}"),
                 }
             }
             Step::Feed(ratio) => {
@@ -183,25 +227,33 @@ impl Steps<'_> {
                     self.beyond = (self.beyond.0 + 1, self.beyond.1.max(*ratio));
                 }
                 format!(
-                    "TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[{feed_out}]={}",
+                    "{trigger} $ANOUT[{feed_out}]={}",
                     fixed(v.clamp(0.0, 1.0), 5)
                 )
             }
-            Step::Move { ptp, pose, point } => {
+            Step::WaitReady => ready_lines(cell).join("\n"),
+            Step::Move {
+                kind, pose, point, ..
+            } => {
                 let feature = self.path.points[*point].feature;
-                let (f, note) = self.reach.motion(pose, *point, feature);
-                let mut line = if *ptp {
-                    format!("PTP {}", frame_text(&f))
-                } else {
-                    format!("LIN {} C_DIS", frame_text(&f))
+                let at = (self.file.as_str(), self.line + 1);
+                let solved = self.reach.motion(pose, *point, feature, at);
+                let f = solved.frame;
+                let mut line = match (kind, solved.joints) {
+                    (Kind::Ptp, Some((_, s, t))) => format!("PTP {}", pos_text(&f, s, t)),
+                    (Kind::Ptp, None) => format!("PTP {}", frame_text(&f)),
+                    (Kind::Lin, _) => format!("LIN {} C_DIS", frame_text(&f)),
+                    (Kind::Spl, _) => format!("SPL {}", frame_text(&f)),
+                    (Kind::Slin, _) => format!("SLIN {}", frame_text(&f)),
                 };
-                if let Some(note) = note {
+                if let Some(note) = solved.note {
                     line.push_str(" ; ");
                     line.push_str(note);
                 }
                 line
             }
         };
+        self.line += 1 + line.matches('\n').count();
         push_line(out, &line);
     }
 
@@ -218,6 +270,8 @@ impl Steps<'_> {
         name: &str,
     ) -> Result<(), PostError> {
         let mut file = Chunked::open(sink, name)?;
+        self.file = name.to_string();
+        self.line = text.matches('\n').count();
         let mut seen = 0;
         for step in steps {
             self.push(&step, &mut text);
@@ -228,6 +282,11 @@ impl Steps<'_> {
                     break;
                 }
             }
+        }
+        if std::mem::take(&mut self.in_block) {
+            // A part ends inside a block: it ends here and goes on in the next part.
+            push_line(&mut text, "ENDSPLINE");
+            self.reopen = true;
         }
         text.push_str(end);
         file.finish(&text)
@@ -253,7 +312,6 @@ pub(super) fn write_files(
 ) -> Result<BTreeMap<usize, KukaFigures>, PostError> {
     let (program_name, source, notes) = job;
     let cell = reach.cell;
-    let out = cell.extruder_output;
     let feed_out = cell.feed_output;
     let per = cell.max_moves_per_file.max(1);
     let parts = if moves > per { moves.div_ceil(per) } else { 0 };
@@ -272,11 +330,10 @@ pub(super) fn write_files(
     }
     let mut head = join(&main);
     insert_notes(&mut head, notes);
-    let tail = join(&[
-        format!("$OUT[{out}] = FALSE"),
-        format!("PTP {HOME_NAME}"),
-        "END".into(),
-    ]);
+    let mut tail: Vec<String> = reset_lines(cell).into();
+    tail.extend([format!("PTP {HOME_NAME}"), "END".into()]);
+    tail.extend(stop_routine(cell));
+    let tail = join(&tail);
     let h = cell.home;
     let dat = join(&[
         "&ACCESS RVP".into(),
@@ -300,6 +357,10 @@ pub(super) fn write_files(
         reach,
         vel: None,
         beyond: (0, 0.0),
+        file: String::new(),
+        line: 0,
+        in_block: false,
+        reopen: false,
     };
     let main_src = format!("{name}.src");
     let mut steps = steps;
@@ -378,7 +439,7 @@ fn main_header(
         ExtruderSwitch::Trigger => format!("$OUT[{out}] by TRIGGER at the motion's start"),
     };
 
-    vec![
+    let mut lines = vec![
         "&ACCESS RVP".into(),
         "&REL 1".into(),
         format!("DEF {name}( )"),
@@ -398,10 +459,19 @@ fn main_header(
             fixed(m.filament_diameter, 2)
         ),
         format!(
-            "; filament feed per print LIN: $ANOUT[{feed_out}] = feed ratio / {} (feed ratio = filament mm per mm of path, the plan's for that LIN), set by TRIGGER where the LIN starts; the extruder feeds $ANOUT[{feed_out}] x {} mm of filament per mm the tool moves",
+            "; filament feed per print motion: $ANOUT[{feed_out}] = feed ratio / {} (feed ratio = filament mm per mm of path, the plan's for that motion), set by TRIGGER where the motion starts; the extruder feeds $ANOUT[{feed_out}] x {} mm of filament per mm the tool moves",
             fixed(cell.feed_ratio_full_scale, 5),
             fixed(cell.feed_ratio_full_scale, 5)
         ),
+    ];
+    if cell.motion == KrlMotion::Spline {
+        lines.push(format!(
+            "; print paths: SPLINE blocks through the points left once those within {} mm of a straight run are dropped; SPL where a cubic through the neighbours stays within {} mm of the plan, SLIN elsewhere; the feed set by TRIGGER WHEN PATH=0 ONSTART where a segment starts",
+            fixed(cell.spline_tolerance / 2.0, 3),
+            fixed(cell.spline_tolerance, 3)
+        ));
+    }
+    lines.extend([
         format!(
             "; {moves} motions{}",
             if parts > 0 {
@@ -416,16 +486,33 @@ fn main_header(
         "    INTERRUPT ON 3".into(),
         "    BAS (#INITMOV,0 )".into(),
         "  ;ENDFOLD (BASISTECH INI)".into(),
-        ";ENDFOLD (INI)".into(),
-        ";FOLD FRAMES AND SPEEDS".into(),
-        format!("$BASE = {}", frame_text(&cell.base.to_array())),
-        format!("$TOOL = {}", frame_text(&cell.tool.to_array())),
+    ]);
+    lines.extend(interrupt_lines());
+    lines.extend([";ENDFOLD (INI)".into(), ";FOLD FRAMES AND SPEEDS".into()]);
+    lines.extend(frame_lines("BASE", &cell.base, cell.base_index));
+    lines.extend(frame_lines("TOOL", &cell.tool, cell.tool_index));
+    lines.extend([
         "$ADVANCE = 3".into(),
         format!("$APO.CDIS = {}", fixed(cell.apo_cdis, 3)),
         ";ENDFOLD (FRAMES AND SPEEDS)".into(),
         format!("$OUT[{out}] = FALSE"),
         format!("PTP {HOME_NAME}"),
-    ]
+    ]);
+    lines
+}
+
+/// The lines that set `$BASE` or `$TOOL` (`what`, `BASE` or `TOOL`) to `frame`: with the
+/// controller's number `index`, `BAS (#BASE, n)` after a comment stating the frame assumed to
+/// be in `BASE_DATA[n]` (`TOOL_DATA[n]`); without, the assignment of the frame itself.
+fn frame_lines(what: &str, frame: &KrlFrame, index: Option<u32>) -> Vec<String> {
+    let text = frame_text(&frame.to_array());
+    match index {
+        Some(n) => vec![
+            format!("; assumed {what}_DATA[{n}] = {text} (check it on the controller)"),
+            format!("BAS (#{what}, {n})"),
+        ],
+        None => vec![format!("${what} = {text}")],
+    }
 }
 
 /// Lines joined with `\n`, ending with one.

@@ -31,17 +31,22 @@
 //!   across at that height while the orientation turns to the next path's (slerp, at most
 //!   [`TRAVEL_ROTATION_STEP_DEG`] per LIN), go down to the approach point (`travel_clearance`
 //!   out along the next tool axis) and approach along the axis to the path's first point. The
-//!   first approach is a `PTP` from home; the program ends with the same retreat and a rise to
-//!   the clearance over the part's top, then `PTP` home. Rising straight up assumes no
-//!   material above the retreat point (no printing under an overhang).
+//!   program goes from home to the **safe point** by `PTP`: `safe_height` over the part's top
+//!   (`$BASE` Z), over the first path's start, the tool upright; from there LINs go down to the
+//!   first approach point while the tool turns to the path's orientation. It ends with the same
+//!   retreat, a rise (turning upright) to the safe point's height (or the clearance over the
+//!   part's top, if higher), a LIN across and a `PTP` to the safe point, then `PTP` home.
+//!   Rising straight up assumes no material above the retreat point (no printing under an
+//!   overhang); so does the way down from the safe point.
 //! - **Extruder.** One digital output, on for the LINs that print. With `extruder_switch =
 //!   "trigger"` a `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $OUT[n]=...` before the first print LIN
 //!   (on) and before the retreat (off) switches it where those motions start, without
 //!   stopping the advance run; with `"out"` a plain `$OUT[n]=...` between the motions stops
 //!   the robot there (exact stop) and switches. Temperatures are the extruder controller's;
 //!   the header states them.
-//! - **Filament feed.** One feed ratio per print LIN, following the plan: the planned E of
-//!   the path points the LIN reaches (a print move dropped as going nowhere hands its E on)
+//! - **Filament feed.** One feed ratio per print LIN (or spline segment, see below), following
+//!   the plan: the planned E of the path points the LIN reaches (a print move dropped as going
+//!   nowhere hands its E on)
 //!   over the LIN's length, in mm of filament per mm of path. It is written as the analog
 //!   output `$ANOUT[feed_output]` = ratio / `feed_ratio_full_scale` (5 decimals, held at 1.0
 //!   with a warning beyond full scale) by `TRIGGER WHEN DISTANCE=0 DELAY=0 DO $ANOUT[n]=v`
@@ -49,8 +54,25 @@
 //!   stopping the advance run. The extruder's controller feeds v × `feed_ratio_full_scale`
 //!   mm of filament per mm the tool moves (the impeller's blades need about 0.0286, its base
 //!   0.0374; one ratio for the whole program over-extruded the blades by 26 %).
+//! - **Spline.** With `motion = "spline"` each run of print moves (a path's, between changes of
+//!   speed) is a `SPLINE` ... `ENDSPLINE` block after its `$VEL.CP`, through fewer points
+//!   (`spline` module): points within half of `spline_tolerance` of the line through their
+//!   neighbours are dropped, `SPL` segments where a cubic through the neighbours stays within
+//!   the tolerance of the plan, `SLIN` elsewhere; the feed and the extruder by `TRIGGER WHEN
+//!   PATH=0 ONSTART DELAY=0 DO ...` inside the block. A block a part file ends inside goes on in
+//!   the next part (`ENDSPLINE` there, `SPLINE` again). Travels stay `LIN` and `PTP`.
+//! - **Signals.** The `INI` declares `INTERRUPT DECL 10 WHEN $STOPMESS==TRUE DO
+//!   EXTRUDER_STOP( )` and switches it on: when the robot stops on an error, the local
+//!   subroutine `EXTRUDER_STOP` (after the main program's `END`) sets the feed's
+//!   `$ANOUT[feed_output]` to 0 and `$OUT[extruder_output]` off, then `BRAKE`s. The program
+//!   resets both the same way after its last motion, before `PTP` home. With `ready_input`
+//!   set, the program waits at the safe point for `$IN[ready_input]` (the extruder at
+//!   temperature) at most `ready_timeout` s (`$TIMER[1]`), and `HALT`s if it is not on; on
+//!   the operator's start it waits for it without a limit.
 //! - **Files.** `<name>.src` holds header comments (source, machine, part offset, tool and
-//!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE`, `$TOOL`,
+//!   extruder conventions), the `INI` fold with `BAS (#INITMOV,0 )`, `$BASE` and `$TOOL`
+//!   (or, with the cell's `base_index`/`tool_index`, `BAS (#BASE, n)`/`BAS (#TOOL, n)` after a
+//!   comment `; assumed BASE_DATA[n] = {..}` stating the frame the program was planned for),
 //!   `$ADVANCE`, `$APO.CDIS`, extruder off and `PTP` home (`DECL AXIS XHOME_PRINT` in
 //!   `<name>.dat`), the motions (`$VEL.CP` in m/s where the speed changes, `LIN {X, Y, Z, A,
 //!   B, C} C_DIS` per pose), then extruder off and `PTP` home. A program of more than
@@ -62,29 +84,53 @@
 //!   nearest the previous pose's, in the same configuration when there is one. Unreachable
 //!   poses and poses within `wrist_singularity_deg` of a stretched wrist (|A5| small) are
 //!   reported ([`KukaFigures`], warnings, and a comment on the LIN), not refused.
+//! - **Status and Turn.** The configuration is KUKA's Status S: bit 0 the wrist centre behind
+//!   A1 (overhead area), bit 1 A3 at or past the stretched arm's angle (elbow up), bit 2 A5 ≤ 0
+//!   (wrist flipped); the Turn T has bit n set where A(n+1) < 0 (below [`TURN_ZERO`]). Every
+//!   Cartesian `PTP` carries the S and T of the solution the reach check followed (`PTP {X ..,
+//!   ..., C .., S 'B010', T 'B000010'}`), so the controller takes that solution; LINs keep the
+//!   configuration they start in. The program keeps home's configuration throughout: a motion
+//!   on which it would change is a warning naming the motion (its number, file and line, and
+//!   the two S). `joints.csv` ([`JOINTS_CSV`]) gives the joints of that solution for every
+//!   Cartesian motion, numbered as the warnings number them.
 
 pub(crate) mod cell;
 mod checks;
+mod joints;
 mod krl_text;
 mod motion;
 mod opw;
 mod rotation;
+mod signals;
+mod spline;
 
 use std::collections::BTreeMap;
 
-pub use cell::{ArmModel, ExtruderSwitch, KrlFrame, KukaCell};
+pub use cell::{
+    ArmModel, ExtruderSwitch, KrlFrame, KrlMotion, KukaCell, DEFAULT_READY_TIMEOUT,
+    DEFAULT_SAFE_HEIGHT, DEFAULT_SPLINE_TOLERANCE,
+};
 pub use checks::KukaFigures;
-pub use krl_text::{frame_text, krl_name, HOME_NAME, KRL_NAME_MAX};
+pub use joints::{JOINTS_CSV, JOINTS_HEADER};
+pub use krl_text::{frame_text, krl_name, pos_text, HOME_NAME, KRL_NAME_MAX};
 pub use motion::{HEIGHT_CELL, TRAVEL_ROTATION_STEP_DEG};
+pub use opw::{bits_text, turn, TURN_ZERO};
 pub use rotation::{abc_from_matrix, matrix_from_abc, rotation_angle_deg, Mat3, Pose};
+pub use signals::{READY_TIMER, STOP_INTERRUPT, STOP_ROUTINE};
+pub use spline::{
+    cubic_point, SPLINE_ANGLE_TOLERANCE_DEG, SPLINE_FEED_SHORT, SPLINE_FEED_TOLERANCE,
+    SPLINE_MAX_MERGED, SPLINE_MAX_SEGMENTS, SPLINE_MAX_TURN_DEG, SPLINE_MIN_SEGMENT,
+};
 
 use crate::machine::MachineProfile;
 use crate::sink::{InMemory, ProgramSink};
 use crate::PostError;
 use checks::Reach;
+use joints::write_joints;
 use krl_text::write_files;
 pub(crate) use motion::start_frame;
 use motion::{placement, Planner, Step};
+use spline::Splined;
 use toolpath::vec3::{norm, scale};
 use toolpath::ToolPath;
 
@@ -95,7 +141,8 @@ pub const AXIS_LENGTH_TOLERANCE: f64 = 1e-3;
 #[derive(Debug, Clone, PartialEq)]
 pub struct KrlProgram {
     /// `(file name, text)`: the main `<name>.src` and `<name>.dat` first, then the parts
-    /// `<name>_p001.src`, `<name>_p001.dat`, ... when the program is split.
+    /// `<name>_p001.src`, `<name>_p001.dat`, ... when the program is split, then
+    /// [`JOINTS_CSV`].
     pub files: Vec<(String, String)>,
     /// Per feature id.
     pub figures: BTreeMap<usize, KukaFigures>,
@@ -166,12 +213,12 @@ pub fn kuka_to(
     let base = cell.base.pose();
     // The header counts the motions: a first run of the planner counts them, the second
     // plans them again as they are checked and written.
-    let planner = || Planner::new(path, &axes, offset, m, cell, &base);
-    let moves = planner().filter(|s| matches!(s, Step::Move { .. })).count();
+    let steps = || Splined::new(Planner::new(path, &axes, offset, m, cell, &base), cell);
+    let moves = steps().filter(|s| matches!(s, Step::Move { .. })).count();
     let figures = write_files(
         m,
         path,
-        planner(),
+        steps(),
         moves,
         Reach::new(path, cell, &base),
         offset,
@@ -179,6 +226,9 @@ pub fn kuka_to(
         sink,
         &mut warnings,
     )?;
+    // The joints of the solutions the check followed, from a third run of the planner and the
+    // same check again.
+    write_joints(path, steps(), Reach::new(path, cell, &base), sink)?;
     Ok(KrlProgram {
         files: vec![],
         figures,

@@ -30,12 +30,33 @@ pub(super) enum Step {
     Extruder(bool),
     /// The feed ratio (filament mm per mm of path) of the next motion, a print LIN.
     Feed(f64),
-    /// A motion to a tool pose in `$BASE`, for path point `point`.
+    /// Wait for the extruder's ready input (the cell's `ready_input`).
+    WaitReady,
+    /// A motion to a tool pose in `$BASE`, for path point `point`; `print` for the motions
+    /// that lay a bead.
     Move {
-        ptp: bool,
+        kind: Kind,
+        print: bool,
         pose: Pose,
         point: usize,
     },
+    /// `SPLINE`: a spline block opens (its segments, feed and extruder triggers follow).
+    SplineStart,
+    /// `ENDSPLINE`.
+    SplineEnd,
+}
+
+/// How a motion goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// `PTP` (with Status and Turn).
+    Ptp,
+    /// `LIN ... C_DIS`.
+    Lin,
+    /// `SPL`, a spline segment (in a spline block).
+    Spl,
+    /// `SLIN`, a straight segment in a spline block.
+    Slin,
 }
 
 /// The part offset (part + offset = `$BASE` coordinates): [`bed_offset`]'s placement moved
@@ -148,6 +169,9 @@ impl<'a> Planner<'a> {
                 feed: None,
                 on: false,
                 clearance: cell.travel_clearance,
+                safe_z: part_top(path, offset) + cell.safe_height,
+                safe: None,
+                ready: cell.ready_input.is_some(),
                 z_top: f64::NEG_INFINITY,
                 height: HeightMap {
                     cell: HEIGHT_CELL,
@@ -213,7 +237,7 @@ impl<'a> Planner<'a> {
                     w.extruder(true);
                 }
                 w.feed(path, &pose, i);
-                w.motion(false, pose, i);
+                w.step(Kind::Lin, true, pose, i);
                 pose
             }
             _ => {
@@ -221,7 +245,7 @@ impl<'a> Planner<'a> {
                     r: start_frame(z, p, self.base),
                     t: p,
                 };
-                w.travel(self.cur.map(|c| c.0), pose, i, self.travel_v);
+                w.travel(self.cur.map(|c| c.0), pose, i, self.travel_v, self.base);
                 pose
             }
         };
@@ -247,6 +271,19 @@ impl Iterator for Planner<'_> {
             }
             self.advance();
         }
+    }
+}
+
+/// The part's top in `$BASE` (mm): the highest print point placed by `offset` (the highest
+/// point when none prints; 0 for an empty path).
+fn part_top(path: &ToolPath, offset: [f64; 3]) -> f64 {
+    let top = crate::placement::placed_points(path)
+        .map(|q| q.p[2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    if top.is_finite() {
+        top + offset[2]
+    } else {
+        0.0
     }
 }
 
@@ -339,6 +376,12 @@ pub(super) struct Motion {
     feed: Option<f64>,
     on: bool,
     clearance: f64,
+    /// The safe point's height ($BASE Z, mm): `safe_height` over the part's top.
+    safe_z: f64,
+    /// The safe point, over the first path's start at `safe_z`, once the program went there.
+    safe: Option<Pose>,
+    /// The program waits for the extruder's ready input at the safe point.
+    ready: bool,
     /// Highest point of the path so far ($BASE Z, mm).
     z_top: f64,
     /// The points visited so far.
@@ -393,11 +436,22 @@ impl Motion {
         })
     }
 
-    /// A motion, unless it would go nowhere.
+    /// A motion (`PTP` when `ptp`, else `LIN`), unless it would go nowhere.
     fn motion(&mut self, ptp: bool, pose: Pose, point: usize) {
+        let kind = if ptp { Kind::Ptp } else { Kind::Lin };
+        self.step(kind, false, pose, point);
+    }
+
+    /// A motion of `kind`, laying a bead when `print`, unless it would go nowhere.
+    fn step(&mut self, kind: Kind, print: bool, pose: Pose, point: usize) {
         if !self.goes_nowhere(&pose) {
             self.last = Some((pose, point));
-            self.steps.push_back(Step::Move { ptp, pose, point });
+            self.steps.push_back(Step::Move {
+                kind,
+                print,
+                pose,
+                point,
+            });
         }
     }
 
@@ -421,19 +475,26 @@ impl Motion {
     }
 
     /// Travel from `cur` (or from home) to the path start `to` (point `point`).
-    fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64) {
+    fn travel(&mut self, cur: Option<Pose>, to: Pose, point: usize, travel_v: f64, base: &Pose) {
         let c = self.clearance;
         let approach = add(to.t, scale(col(&to.r, 2), -c));
         let Some(from) = cur else {
+            // From home: to the safe point over the path's start (PTP, the tool upright), down
+            // to the approach point turning to the path's orientation, and along the axis to
+            // the start.
             self.vel(travel_v);
-            self.motion(
-                true,
-                Pose {
-                    r: to.r,
-                    t: approach,
-                },
-                point,
-            );
+            let safe = Pose {
+                r: start_frame([0.0, 0.0, -1.0], to.t, base),
+                t: [to.t[0], to.t[1], self.safe_z.max(approach[2])],
+            };
+            self.safe = Some(safe);
+            self.steps
+                .push_back(Step::Comment("safe point over the part".into()));
+            self.motion(true, safe, point);
+            if self.ready {
+                self.steps.push_back(Step::WaitReady);
+            }
+            self.turn_across(&safe, to.r, approach, point);
             self.motion(false, to, point);
             return;
         };
@@ -442,23 +503,9 @@ impl Motion {
             .max(retreat[2])
             .max(approach[2]);
         let up = [retreat[0], retreat[1], h];
-        self.motion(false, Pose { r: from.r, t: up }, point);
-        let over = [approach[0], approach[1], h];
-        let turn = log_rot(&mul(&transpose(&from.r), &to.r));
-        let angle = norm(turn).to_degrees();
-        let n = ((angle / TRAVEL_ROTATION_STEP_DEG).ceil() as usize).max(1);
-        for k in 1..=n {
-            let t = k as f64 / n as f64;
-            let pose = if k == n {
-                Pose { r: to.r, t: over }
-            } else {
-                Pose {
-                    r: mul(&from.r, &exp_rot(scale(turn, t))),
-                    t: add(scale(up, 1.0 - t), scale(over, t)),
-                }
-            };
-            self.motion(false, pose, point);
-        }
+        let up = Pose { r: from.r, t: up };
+        self.motion(false, up, point);
+        self.turn_across(&up, to.r, [approach[0], approach[1], h], point);
         self.motion(
             false,
             Pose {
@@ -470,18 +517,60 @@ impl Motion {
         self.motion(false, to, point);
     }
 
-    /// The end: extruder off, retreat along the tool axis and rise to the safe height.
+    /// LINs from `from` to `over` while the orientation turns to `r` (slerp, at most
+    /// [`TRAVEL_ROTATION_STEP_DEG`] a LIN).
+    fn turn_across(&mut self, from: &Pose, r: Mat3, over: V3, point: usize) {
+        let turn = log_rot(&mul(&transpose(&from.r), &r));
+        let angle = norm(turn).to_degrees();
+        let n = ((angle / TRAVEL_ROTATION_STEP_DEG).ceil() as usize).max(1);
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let pose = if k == n {
+                Pose { r, t: over }
+            } else {
+                Pose {
+                    r: mul(&from.r, &exp_rot(scale(turn, t))),
+                    t: add(scale(from.t, 1.0 - t), scale(over, t)),
+                }
+            };
+            self.motion(false, pose, point);
+        }
+    }
+
+    /// The end: extruder off, retreat along the tool axis, rise to the safe point's height
+    /// (or the clearance over the part's top, if higher) and go to the safe point (PTP).
     fn leave(&mut self, from: &Pose, point: usize, travel_v: f64) {
         let c = self.clearance;
         let retreat = self.retreat(from, point, travel_v);
-        let h = (self.z_top + c).max(retreat[2]);
+        let h = (self.z_top + c).max(self.safe_z).max(retreat[2]);
+        let up = [retreat[0], retreat[1], h];
+        let Some(safe) = self.safe else {
+            self.motion(false, Pose { r: from.r, t: up }, point);
+            return;
+        };
+        // Up, turning the tool upright, across, and the safe point by PTP.
+        let back = Pose {
+            r: from.r,
+            t: retreat,
+        };
+        self.turn_across(&back, safe.r, up, point);
         self.motion(
             false,
             Pose {
-                r: from.r,
-                t: [retreat[0], retreat[1], h],
+                r: safe.r,
+                t: [safe.t[0], safe.t[1], h],
             },
             point,
         );
+        self.steps
+            .push_back(Step::Comment("safe point over the part".into()));
+        // Always written, even where the LIN across ended there: the program ends at it.
+        self.last = Some((safe, point));
+        self.steps.push_back(Step::Move {
+            kind: Kind::Ptp,
+            print: false,
+            pose: safe,
+            point,
+        });
     }
 }

@@ -47,14 +47,19 @@ impl ArmModel {
         }
     }
 
-    /// Configuration bits of θ: shoulder (wrist centre in front of A1), elbow (up/down),
-    /// wrist (θ5 sign).
+    /// KUKA's Status (S) of θ, the arm's configuration in three bits (KUKA System Software,
+    /// "Status" of a POS/E6POS): bit 0 set when the wrist centre lies behind the A1 axis (its X
+    /// in the A1 coordinate system negative: the overhead area), bit 1 when A3 ≥ φ (φ the A3 of
+    /// the stretched arm, wrist centre on the line through A2 and A3: the elbow up), bit 2 when
+    /// A5 ≤ 0 (the wrist flipped).
     fn config(&self, q: &[f64; 6]) -> u8 {
         let (psi3, k) = self.psi3_k();
         let cx1 = self.c2 * q[1].sin() + k * (q[1] + q[2] + psi3).sin() + self.a1;
-        u8::from(cx1 >= 0.0)
-            | (u8::from((q[2] + psi3).sin() >= 0.0) << 1)
-            | (u8::from(q[4].sin() >= 0.0) << 2)
+        let a = self.joints(*q);
+        let phi = wrap180(
+            ((-psi3).to_degrees() + self.joint_offsets[2]) * f64::from(self.joint_signs[2]),
+        );
+        u8::from(cx1 < 0.0) | (u8::from(a[2] >= phi) << 1) | (u8::from(a[4] <= 0.0) << 2)
     }
 
     /// Every inverse-kinematics solution (up to 8) of a flange pose, as θ (radians) with its
@@ -123,7 +128,8 @@ impl ArmModel {
     /// The solution within the joint limits nearest `near` (sum of absolute joint
     /// differences, each joint taken ±360° where its range allows), preferring configuration
     /// `keep` when given; `None` when the pose is out of reach or every solution breaks a
-    /// limit. Returns the joints and the configuration bits.
+    /// limit. Returns the joints and the configuration bits (KUKA's Status,
+    /// [`ArmModel::configuration`]).
     pub fn nearest(
         &self,
         flange: &Pose,
@@ -168,8 +174,46 @@ impl ArmModel {
         wrap180(self.theta(*joints)[4].to_degrees()).abs()
     }
 
-    /// Configuration bits of joint angles (shoulder, elbow, wrist).
+    /// The configuration of joint angles (degrees): KUKA's Status bits (overhead area, elbow
+    /// up, wrist flipped; see [`ArmModel::nearest`]'s configurations).
     pub fn configuration(&self, joints: &[f64; 6]) -> u8 {
-        self.config(&self.theta(*joints))
+        let mut a = *joints;
+        // The Status reads A3 and A5 within ±180°, as the model's angles are.
+        a[2] = wrap180(a[2]);
+        a[4] = wrap180(a[4]);
+        self.config(&self.theta(a))
+    }
+}
+
+/// KUKA's Turn (T) of joint angles (degrees): bit n set where A(n+1) < 0, so that with the
+/// Status it picks one of the solutions of a pose whose joints may turn past ±180°. A joint
+/// within [`TURN_ZERO`] below 0 (0 as `joints.csv` writes it) counts as 0.
+pub fn turn(joints: &[f64; 6]) -> u8 {
+    joints
+        .iter()
+        .enumerate()
+        .fold(0, |t, (n, a)| t | (u8::from(*a < -TURN_ZERO) << n))
+}
+
+/// Half the step (degrees) joint angles are written in: a joint this close below 0 is 0 for
+/// its Turn bit.
+pub const TURN_ZERO: f64 = 5e-5;
+
+/// A Status or Turn as KRL writes it, binary with `bits` digits: `'B010'`.
+pub fn bits_text(v: u8, bits: usize) -> String {
+    format!("'B{v:0bits$b}'")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turn_bits_and_their_text() {
+        assert_eq!(turn(&[0.0, -90.0, 90.0, 0.0, 90.0, 0.0]), 0b10);
+        assert_eq!(turn(&[-1.0, -90.0, 90.0, 0.0, 90.0, -5.0]), 0b100011);
+        assert_eq!(turn(&[0.0, -90.0, 90.0, -1e-12, 90.0, -1e-6]), 0b10);
+        assert_eq!(bits_text(2, 3), "'B010'");
+        assert_eq!(bits_text(0b100010, 6), "'B100010'");
     }
 }
