@@ -213,10 +213,19 @@ impl Shot {
     /// Neither a feature's colour nor the colour ramps have it (the palette's orange has green
     /// half of red, the ramp's warm end some blue).
     fn orange(&self) -> usize {
-        self.count(|c| {
-            let (r, g, b) = (f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
-            r >= 60.0 && b <= 0.04 * r && (0.3 * r..=0.42 * r).contains(&g)
-        })
+        self.count(is_orange)
+    }
+
+    /// Which pixels of the view are [`Shot::orange`]'s, row by row.
+    fn orange_mask(&self) -> Vec<bool> {
+        let mut out = Vec::with_capacity(self.w * self.h);
+        for y in 0..self.h {
+            for x in VIEW_LEFT..self.w {
+                let i = (y * self.w + x) * self.px;
+                out.push(is_orange([self.buf[i], self.buf[i + 1], self.buf[i + 2]]));
+            }
+        }
+        out
     }
 
     /// Pixels off the view's background (245, 246, 249).
@@ -224,6 +233,12 @@ impl Shot {
         let bg = [245i32, 246, 249];
         self.count(|c| (0..3).any(|k| (i32::from(c[k]) - bg[k]).abs() > 12))
     }
+}
+
+/// The simulated machine's orange ([`Shot::orange`]).
+fn is_orange(c: [u8; 3]) -> bool {
+    let (r, g, b) = (f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
+    r >= 60.0 && b <= 0.04 * r && (0.3 * r..=0.42 * r).contains(&g)
 }
 
 /// First pixel column of the view, past the side panel.
@@ -669,6 +684,10 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// Orange pixels the arm or the table covers at least in a screenshot.
 const MIN_MACHINE_PIXELS: usize = 2_000;
 
+/// Pixels of the machine's orange that must differ between two moves for the machine to have
+/// moved (a link shifted by a few pixels along its length).
+const MIN_MOVED_PIXELS: usize = 200;
+
 #[test]
 fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
     let Some(browser) = chromium() else { return };
@@ -771,6 +790,92 @@ fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
         std::fs::create_dir_all(&keep).unwrap();
         for e in std::fs::read_dir(&dir).unwrap().flatten() {
             std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The impeller's previews on `kuka` and `delta5` (issue 36 item 2) simulate the program the
+/// plan wrote: at the scrubber's middle and end the page draws without a script error, shows
+/// the move asked for, and draws the machine (the arm from the post's `joints.csv`, the table
+/// by B and C) in its orange, differently at the two moves. `FEATURES_KEEP_PREVIEW=DIR` keeps
+/// the screenshots (docs/simulation_*.png are such).
+#[test]
+fn the_impellers_previews_simulate_the_arm_and_the_table() {
+    let Some(browser) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("features-impeller-sim-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for machine in ["kuka", "delta5"] {
+        let out = dir.join(machine);
+        let o = Command::new(BIN)
+            .arg("plan")
+            .arg(fixture("impeller.step"))
+            .args(["--machine", machine, "--placement-time-limit", "inf", "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{machine}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let moves = std::fs::read_to_string(out.join("joints.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .count();
+        assert!(moves > 1000, "{machine}: {moves} moves");
+        let page = out.join("preview.html");
+        let mut orange = vec![];
+        for (at, f) in [("middle", "0.5"), ("end", "1")] {
+            let url = format!("file://{}#sim={f}", page.display());
+            let dom = headless_url(&browser, &url, &["--dump-dom"]);
+            let dom = String::from_utf8_lossy(&dom.stdout);
+            assert_eq!(
+                body_attribute(&dom, "data-error"),
+                None,
+                "{machine}: script error"
+            );
+            let shown: usize = body_attribute(&dom, "data-sim-move")
+                .and_then(|s| s.parse().ok())
+                .expect("the page names the move shown");
+            if at == "end" {
+                assert!(shown > 1000, "{machine}: move {shown} at the end");
+            }
+            let png = dir.join(format!("simulation_impeller_{machine}_{at}.png"));
+            orange.push(Shot::at(&browser, &url, &png).orange_mask());
+        }
+        let counts: Vec<usize> = orange
+            .iter()
+            .map(|m| m.iter().filter(|&&o| o).count())
+            .collect();
+        assert!(
+            counts.iter().all(|&n| n >= MIN_MACHINE_PIXELS),
+            "{machine}: {counts:?} orange pixels"
+        );
+        // The machine moved: pixels orange at one move and not at the other (a robot arm two
+        // metres long moves a few pixels between two points of a part 100 mm across).
+        let moved = orange[0]
+            .iter()
+            .zip(&orange[1])
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            moved >= MIN_MOVED_PIXELS,
+            "{machine}: {counts:?} orange pixels at the middle and the end, {moved} changed"
+        );
+        eprintln!(
+            "impeller {machine}: {counts:?} orange pixels at the middle and the end, {moved} changed"
+        );
+    }
+    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
+        let keep = PathBuf::from(keep);
+        std::fs::create_dir_all(&keep).unwrap();
+        for e in std::fs::read_dir(&dir).unwrap().flatten() {
+            if e.path().extension().is_some_and(|x| x == "png") {
+                std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
+            }
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -11,6 +11,7 @@ mod outputs;
 mod plan;
 mod preview;
 mod profiles;
+mod simulation;
 mod staged;
 
 use clap::{Args, Parser, Subcommand};

@@ -62,7 +62,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let staged = staged.ok_or_else(|| Failure::new(&outputs.dir, "no program was staged"))?;
     tell_placement(&plan, path, &bar);
     let warnings = print_warnings(&plan, path, &bar);
-    let summary = write_plan(plan, &outputs, staged, &earlier, args, warnings)?;
+    let summary = write_plan(plan, &machine, &outputs, staged, &earlier, args, warnings)?;
     bar.0.inc(1);
     drop(bar);
     emit(&summary)
@@ -335,6 +335,7 @@ fn print_warnings(plan: &Plan, path: &Path, bar: &Bar) -> usize {
 /// closing line to print.
 fn write_plan(
     mut plan: Plan,
+    machine: &robot_post::MachineProfile,
     outputs: &Outputs,
     staged: Staged,
     earlier: &[std::path::PathBuf],
@@ -346,7 +347,10 @@ fn write_plan(
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::new(dir, format!("cannot create output directory: {e}")))?;
     let preview_name = outputs.name("preview.html");
-    let page = crate::preview::plan_page(&plan, &path.display().to_string());
+    let joints_name = staged
+        .names()
+        .into_iter()
+        .find(|n| n.ends_with("joints.csv"));
     let collisions_name =
         (!plan.collisions.left.is_empty()).then(|| outputs.name("collisions.csv"));
     plan.report.outputs = staged
@@ -362,6 +366,10 @@ fn write_plan(
     staged
         .commit()
         .map_err(|e| Failure::new(dir, format!("cannot write the program: {e}")))?;
+    // The simulation view reads the joints the post wrote.
+    let joints = joints_name.map(|n| dir.join(n));
+    let simulation = crate::simulation::simulation(&plan, machine, joints.as_deref());
+    let page = crate::preview::plan_page(&plan, &path.display().to_string(), simulation);
     written(
         &preview_name,
         write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),

@@ -42,9 +42,16 @@ pub fn feature_meshes(assembly: &Assembly) -> Vec<FeatureMesh> {
     out
 }
 
-/// The `preview.html` of a plan: its features, its tool path and its figures.
-pub fn plan_page(plan: &plan::Plan, title: &str) -> String {
-    preview::html(&plan_preview(plan, title))
+/// The `preview.html` of a plan: its features, its tool path and its figures, and the
+/// simulation view of its program when there is one ([`crate::simulation`]).
+pub fn plan_page(
+    plan: &plan::Plan,
+    title: &str,
+    simulation: Option<preview::Simulation>,
+) -> String {
+    let mut page = plan_preview(plan, title);
+    page.simulation = simulation;
+    preview::html(&page)
 }
 
 /// The `preview.html` of a refused plan (issue 31): the plan's page with every failure of its

@@ -311,13 +311,15 @@ fn joints_csv_gives_every_motion_by_forward_kinematics() {
                 Pose::from_frame(read.tool.expect("tool")),
             );
             let base_inv = base.inverse();
-            let prints: Vec<&PathPoint> = path
-                .points
-                .iter()
-                .filter(|q| q.kind == MoveKind::Print)
-                .collect();
-            for (k, ((n, joints), mv)) in rows.iter().zip(&cart).enumerate() {
+            let mut last_point = 0;
+            for (k, ((n, point, joints), mv)) in rows.iter().zip(&cart).enumerate() {
                 assert_eq!(*n, k + 1);
+                // The points the motions go to, in the path's order.
+                assert!(
+                    *point >= last_point && *point < path.points.len(),
+                    "row {n}"
+                );
+                last_point = *point;
                 let j = joints.unwrap_or_else(|| panic!("row {n} out of reach"));
                 assert!(cell.arm.within_limits(&j), "row {n}: {j:?}");
                 // The tool pose by forward kinematics, in $BASE: the motion's frame.
@@ -332,15 +334,16 @@ fn joints_csv_gives_every_motion_by_forward_kinematics() {
                     mv.file,
                     mv.line
                 );
-                // A print motion's pose is a planned point's, with its tool axis.
+                // A print motion's pose is its planned point's, with its tool axis.
                 if mv.extruder {
                     let p = sub3(tcp.t, offset);
                     let axis = tcp.z_axis().map(|v| -v);
+                    let q: &PathPoint = &path.points[*point];
+                    assert_eq!(q.kind, MoveKind::Print, "row {n}");
                     assert!(
-                        prints
-                            .iter()
-                            .any(|q| len3(sub3(p, q.p)) <= 0.05 && angle_deg(axis, q.axis) <= 0.1),
-                        "row {n}: {p:?} is no planned point"
+                        len3(sub3(p, q.p)) <= 0.05 && angle_deg(axis, q.axis) <= 0.1,
+                        "row {n}: {p:?} is not point {point}'s {:?}",
+                        q.p
                     );
                 }
                 // The reach check's solution: the configuration kept, and a PTP's S and T.
@@ -369,7 +372,7 @@ fn joints_csv_gives_every_motion_by_forward_kinematics() {
         .iter()
         .filter(|mv| matches!(mv.target, Target::Frame(_)));
     let mut empty = 0;
-    for ((n, joints), mv) in rows.iter().zip(cart) {
+    for ((n, _, joints), mv) in rows.iter().zip(cart) {
         let marked = mv.note.as_deref() == Some("UNREACHABLE");
         assert_eq!(joints.is_none(), marked, "row {n}");
         empty += usize::from(marked);

@@ -10,12 +10,16 @@ use toolpath::{fixed, ToolPath};
 /// The name of the joint table written beside the program.
 pub const JOINTS_CSV: &str = "joints.csv";
 
-/// The joint table's header: the motion's number, then A1..A6 in degrees.
-pub const JOINTS_HEADER: &str = "move,A1,A2,A3,A4,A5,A6";
+/// The joint table's header: the motion's number, the tool path point the post made it for
+/// (its row in `toolpath.csv`, 0 the first after the header: a print motion's pose is that
+/// point's; a retreat, travel or approach names the point it leaves or leads to), then A1..A6
+/// in degrees.
+pub const JOINTS_HEADER: &str = "move,point,A1,A2,A3,A4,A5,A6";
 
 /// Writes `joints.csv` into `sink`: after [`JOINTS_HEADER`], one row per Cartesian motion of
 /// `steps` in the program's order (`move` counts them from 1, as the post's warnings do: the
-/// axis `PTP`s home have none), the joints of the solution `reach` follows for it, 4 decimals;
+/// axis `PTP`s home have none), the path point it goes to, the joints of the solution `reach`
+/// follows for it, 4 decimals;
 /// a motion out of reach has its number and empty joints. `reach` must start where the
 /// program's check did (a fresh [`Reach`]), so that it follows the same solutions.
 pub(super) fn write_joints(
@@ -35,6 +39,8 @@ pub(super) fn write_joints(
         let feature = path.points[point].feature;
         let solved = reach.motion(&pose, point, feature, (JOINTS_CSV, n + 1));
         text.push_str(&n.to_string());
+        text.push(',');
+        text.push_str(&point.to_string());
         match solved.joints {
             Some((j, _, _)) => {
                 for a in j {

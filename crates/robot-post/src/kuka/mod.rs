@@ -238,6 +238,6 @@ pub fn kuka_to(
 
 /// The part offset [`kuka`] places the part with (`$BASE` = part + offset, the cell's
 /// `part_position` included), its warnings dropped.
-pub(crate) fn part_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostError> {
+pub fn part_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostError> {
     placement(path, m, &mut Vec::new())
 }

@@ -640,9 +640,9 @@ pub fn assert_status_turn(read: &KrlRead) {
     }
 }
 
-/// The rows of a program's `joints.csv`: the motion's number and its joints (none when out of
-/// reach).
-pub fn joint_rows(files: &[(String, String)]) -> Vec<(usize, Option<[f64; 6]>)> {
+/// The rows of a program's `joints.csv`: the motion's number, the path point it goes to and
+/// its joints (none when out of reach).
+pub fn joint_rows(files: &[(String, String)]) -> Vec<(usize, usize, Option<[f64; 6]>)> {
     let (_, text) = files
         .iter()
         .find(|(n, _)| n == robot_post::kuka::JOINTS_CSV)
@@ -652,18 +652,19 @@ pub fn joint_rows(files: &[(String, String)]) -> Vec<(usize, Option<[f64; 6]>)> 
     lines
         .map(|l| {
             let cells: Vec<&str> = l.split(',').collect();
-            assert_eq!(cells.len(), 7, "{l}");
+            assert_eq!(cells.len(), 8, "{l}");
             let n: usize = cells[0].parse().expect("move number");
-            let joints = if cells[1..].iter().all(|c| c.is_empty()) {
+            let point: usize = cells[1].parse().expect("point");
+            let joints = if cells[2..].iter().all(|c| c.is_empty()) {
                 None
             } else {
-                let v: Vec<f64> = cells[1..]
+                let v: Vec<f64> = cells[2..]
                     .iter()
                     .map(|c| c.parse().expect("a joint angle"))
                     .collect();
                 Some([v[0], v[1], v[2], v[3], v[4], v[5]])
             };
-            (n, joints)
+            (n, point, joints)
         })
         .collect()
 }
