@@ -822,3 +822,159 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     };
     (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
 }
+
+/// KRL as a robot programmer writes it (issue 36 item 1), end to end: bundled parts planned for
+/// the KUKA cell with the controller's base and tool numbers and the extruder's ready input,
+/// in `lin` and in `spline` mode, read back by `robot_post::krl`: `BAS` selects the numbers;
+/// every Cartesian `PTP` has its Status and Turn; the first and last Cartesian motions are the
+/// safe point `safe_height` (50 mm) over the part's top; the program waits for the input before
+/// its first print motion; the stop interrupt resets the feed and the extruder and brakes; both
+/// are off at the end; and every print motion's target is a planned print point, in the path's
+/// order, the points a spline leaves out within its tolerance of the chord it draws.
+#[test]
+fn krl_reads_back_with_the_cells_conventions_in_lin_and_spline_mode() {
+    use robot_post::krl::{Motion, Target};
+    const SAFE: f64 = 50.0;
+    const SPLINE_TOLERANCE: f64 = 0.05;
+    for part in ["plate_boss_boss", "sphere_boss", "domed_pad"] {
+        for motion in ["lin", "spline"] {
+            let s = Scratch::new(&format!("krl-cell-{part}-{motion}"));
+            let out = s.path("out");
+            let o = plan(
+                &format!("{part}.step"),
+                &[
+                    "--machine",
+                    "kuka",
+                    "--set",
+                    "machine.kuka.base_index=1",
+                    "--set",
+                    "machine.kuka.tool_index=2",
+                    "--set",
+                    "machine.kuka.ready_input=3",
+                    "--set",
+                    &format!("machine.kuka.motion={motion}"),
+                    "-o",
+                    out.to_str().unwrap(),
+                ],
+            );
+            assert!(o.status.success(), "{part} {motion}: {}", stderr(&o));
+            let mut files = vec![];
+            for entry in std::fs::read_dir(&out).expect("output folder").flatten() {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if name.ends_with(".src") || name.ends_with(".dat") {
+                    files.push((name, read(&entry.path())));
+                }
+            }
+            let krl = robot_post::krl::read(&files).expect("the KRL reads back");
+            let at = format!("{part} {motion}");
+            assert_eq!((krl.base_index, krl.tool_index), (Some(1), Some(2)), "{at}");
+            let offset = krl.offset.expect("part offset");
+            // The planned print points, in order.
+            let rows = readback::rows(&read(&out.join("toolpath.csv")));
+            let prints: Vec<[f64; 3]> = rows.iter().filter(|r| r.print).map(|r| r.p).collect();
+            let top = prints.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
+            let cart: Vec<_> = krl
+                .moves
+                .iter()
+                .filter(|m| matches!(m.target, Target::Frame(_)))
+                .collect();
+            for m in &cart {
+                if m.motion == Motion::Ptp {
+                    assert!(
+                        m.status_turn.is_some(),
+                        "{at}: PTP without S and T at {}:{}",
+                        m.file,
+                        m.line
+                    );
+                }
+            }
+            for m in [cart.first(), cart.last()].into_iter().flatten() {
+                let Target::Frame(t) = m.target else {
+                    unreachable!()
+                };
+                assert_eq!(m.motion, Motion::Ptp, "{at}: {}:{}", m.file, m.line);
+                assert!(
+                    (t[2] - offset[2] - (top + SAFE)).abs() < 0.01,
+                    "{at}: the safe point at Z {} for a top at {top}",
+                    t[2] - offset[2]
+                );
+            }
+            let first_print = krl.moves.iter().position(|m| m.extruder).expect("prints");
+            let ready = krl.ready.as_ref().expect("the ready input's wait");
+            assert_eq!(ready.input, 3, "{at}");
+            assert!(
+                ready.halts && ready.before_move <= first_print,
+                "{at}: {ready:?}"
+            );
+            let (feed, extruder) = (
+                krl.feed_output.expect("feed output"),
+                krl.extruder_output.expect("extruder output"),
+            );
+            assert!(
+                krl.interrupts
+                    .iter()
+                    .any(|i| i.condition == "$STOPMESS==TRUE"
+                        && i.on
+                        && i.analog.contains(&(feed, 0.0))
+                        && i.outputs.contains(&(extruder, false))
+                        && i.brakes),
+                "{at}: {:?}",
+                krl.interrupts
+            );
+            assert_eq!((krl.end_feed, krl.end_extruder), (Some(0.0), false), "{at}");
+            // Every print motion ends on a planned print point, in order; the points between
+            // two print motions' ends lie within the tolerance of the chord (lin: none between).
+            let d = |a: [f64; 3], b: [f64; 3]| {
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            };
+            let (mut j, mut last): (usize, Option<usize>) = (0, None);
+            let mut skipped = 0;
+            for m in &krl.moves {
+                // A path ends where the extruder goes off: no chord across a travel.
+                let Target::Frame(t) = m.target else {
+                    last = None;
+                    continue;
+                };
+                if !m.extruder {
+                    last = None;
+                    continue;
+                }
+                let p = [t[0] - offset[0], t[1] - offset[1], t[2] - offset[2]];
+                let k = (j..prints.len())
+                    .find(|&k| d(prints[k], p) <= 0.002)
+                    .unwrap_or_else(|| {
+                        panic!("{at}: {}:{} ends on no planned point ahead", m.file, m.line)
+                    });
+                if let Some(l) = last.filter(|&l| l < k) {
+                    let (a, b) = (prints[l], prints[k]);
+                    for q in &prints[l + 1..k] {
+                        let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                        let aq = [q[0] - a[0], q[1] - a[1], q[2] - a[2]];
+                        let len2 = ab.iter().map(|x| x * x).sum::<f64>();
+                        let t = if len2 > 0.0 {
+                            (0..3).map(|i| ab[i] * aq[i]).sum::<f64>() / len2
+                        } else {
+                            0.0
+                        }
+                        .clamp(0.0, 1.0);
+                        let foot = [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]];
+                        let tolerance = if motion == "spline" {
+                            SPLINE_TOLERANCE
+                        } else {
+                            0.01
+                        };
+                        assert!(
+                            d(*q, foot) <= tolerance,
+                            "{at}: {q:?} left out, {} from the chord",
+                            d(*q, foot)
+                        );
+                    }
+                    skipped += k - l - 1;
+                }
+                last = Some(k);
+                j = k;
+            }
+            eprintln!("{at}: {} Cartesian motions, {skipped} planned points left out between print motions", cart.len());
+        }
+    }
+}
