@@ -830,10 +830,14 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 /// safe point `safe_height` (50 mm) over the part's top; the program waits for the input before
 /// its first print motion; the stop interrupt resets the feed and the extruder and brakes; both
 /// are off at the end; and every print motion's target is a planned print point, in the path's
-/// order, the points a spline leaves out within its tolerance of the chord it draws.
+/// order, the points a spline leaves out within its tolerance of the chord it draws; and
+/// `joints.csv` has a row per Cartesian motion whose forward kinematics is that motion's frame
+/// within 0.05 mm, and for a print motion the planned point the row names, with its axis
+/// within 0.1°.
 #[test]
 fn krl_reads_back_with_the_cells_conventions_in_lin_and_spline_mode() {
     use robot_post::krl::{Motion, Target};
+    use robot_post::kuka::Pose;
     const SAFE: f64 = 50.0;
     const SPLINE_TOLERANCE: f64 = 0.05;
     for part in ["plate_boss_boss", "sphere_boss", "domed_pad"] {
@@ -974,7 +978,56 @@ fn krl_reads_back_with_the_cells_conventions_in_lin_and_spline_mode() {
                 last = Some(k);
                 j = k;
             }
-            eprintln!("{at}: {} Cartesian motions, {skipped} planned points left out between print motions", cart.len());
+            // joints.csv: a row per Cartesian motion, whose forward kinematics (the profile's
+            // arm, then $TOOL, in $BASE) is the planned point it names, with its tool axis.
+            let cell = robot_post::MachineProfile::builtin(robot_post::MachineKind::Kuka)
+                .kuka
+                .expect("the KUKA cell");
+            let base_inv = Pose::from_frame(krl.base.expect("base")).inverse();
+            let tool = Pose::from_frame(krl.tool.expect("tool"));
+            let joints = read(&out.join("joints.csv"));
+            let mut lines = joints.lines();
+            assert_eq!(lines.next(), Some(robot_post::kuka::JOINTS_HEADER));
+            let mut checked = 0;
+            for (n, l) in lines.enumerate() {
+                let cells: Vec<f64> = l.split(',').map(|c| c.parse().expect(l)).collect();
+                assert_eq!(cells.len(), 8, "{at}: {l}");
+                assert_eq!(cells[0] as usize, n + 1, "{at}: {l}");
+                let j = [cells[2], cells[3], cells[4], cells[5], cells[6], cells[7]];
+                let tcp = base_inv.compose(&cell.arm.forward(j).compose(&tool));
+                let m = cart[n];
+                let Target::Frame(f) = m.target else {
+                    unreachable!()
+                };
+                let moved = d(tcp.t, [f[0], f[1], f[2]]);
+                assert!(
+                    moved <= 0.05,
+                    "{at}: row {}: {moved} mm from its motion",
+                    n + 1
+                );
+                let row = &rows[cells[1] as usize];
+                if m.extruder {
+                    let p = [
+                        tcp.t[0] - offset[0],
+                        tcp.t[1] - offset[1],
+                        tcp.t[2] - offset[2],
+                    ];
+                    let z = tcp.z_axis();
+                    let cos = -(0..3).map(|k| z[k] * row.axis[k]).sum::<f64>();
+                    assert!(
+                        d(p, row.p) <= 0.05 && cos >= 0.1f64.to_radians().cos(),
+                        "{at}: row {}: {p:?} is not its point {:?}",
+                        n + 1,
+                        row.p
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 1000, "{at}: {checked} print rows");
+            eprintln!(
+                "{at}: {} Cartesian motions, {skipped} planned points left out between print motions, {checked} print rows by forward kinematics",
+                cart.len()
+            );
         }
     }
 }
