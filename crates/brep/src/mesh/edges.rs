@@ -26,6 +26,12 @@ pub(super) fn face_edge_points(
     let mut params_of: HashMap<EdgeId, Vec<f64>> = HashMap::new();
     let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
     let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
+    // Whether a face is meshed, by index: a mesh's B-rep has a face per triangle, and a
+    // search of `faces` for each edge's faces was quadratic in them.
+    let mut meshed = vec![false; brep.faces.len()];
+    for f in faces {
+        meshed[f.idx()] = true;
+    }
     for e in brep.edges_of(faces) {
         let edge = brep.edge(e);
         for v in [edge.start, edge.end] {
@@ -44,7 +50,7 @@ pub(super) fn face_edge_points(
             .coedges
             .iter()
             .map(|&ce| brep.coedge_face(ce))
-            .filter(|f| faces.contains(f))
+            .filter(|f| meshed[f.idx()])
             .map(|f| brep.face_surface(f))
             .filter(|s| !matches!(s, Surface::Plane { .. }))
             .collect();
