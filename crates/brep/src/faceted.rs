@@ -118,20 +118,11 @@ impl FacetedFile {
     }
 
     /// The part: [`FacetedFile::brep`] with no schema.
-    fn part_turned(&self, rotation: Option<[[f64; 3]; 3]>) -> StepPart {
+    pub fn part_turned(&self, rotation: Option<[[f64; 3]; 3]>) -> StepPart {
         StepPart {
             brep: self.brep(rotation),
             schemas: vec![],
         }
-    }
-}
-
-impl crate::source::PartFile for FacetedFile {
-    fn part(&self) -> Result<StepPart, ReadError> {
-        Ok(self.part_turned(None))
-    }
-    fn rotated(&self, rotation: [[f64; 3]; 3]) -> Result<StepPart, ReadError> {
-        Ok(self.part_turned(Some(rotation)))
     }
 }
 
@@ -243,7 +234,6 @@ impl Builder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::source::PartFile;
 
     const TET: &[u8] =
         b"v 0 0 0\nv 10 0 0\nv 0 10 0\nv 0 0 10\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
@@ -252,7 +242,7 @@ mod tests {
     fn a_tetrahedron_is_a_solid_of_four_faces_and_six_edges_of_its_volume() {
         let file = meshfile::read_bytes(TET, Format::Obj).unwrap();
         let f = FacetedFile::from_mesh(file, 0.05).unwrap();
-        let part = f.part().unwrap();
+        let part = f.part_turned(None);
         let b = &part.brep;
         assert_eq!(
             (
@@ -273,7 +263,7 @@ mod tests {
             props.volume
         );
         // Turned upside down, it still encloses the same volume.
-        let down = f.turned([0.0, 0.0, 1.0]).unwrap();
+        let down = f.part_turned(Some(crate::turn_down([0.0, 0.0, 1.0])));
         let mesh = crate::mesh::mesh_faces(&down.brep, &faces, &Default::default()).unwrap();
         let props = crate::mass::mass_properties(&down.brep, &mesh);
         assert!((props.volume - 1000.0 / 6.0).abs() < 1e-6);

@@ -32,6 +32,15 @@ impl PartFile for StepFile {
     }
 }
 
+impl PartFile for FacetedFile {
+    fn part(&self) -> Result<StepPart, ReadError> {
+        Ok(self.part_turned(None))
+    }
+    fn rotated(&self, rotation: [[f64; 3]; 3]) -> Result<StepPart, ReadError> {
+        Ok(self.part_turned(Some(rotation)))
+    }
+}
+
 /// Reads a part file by its extension: `.stl`, `.3mf` and `.obj` as meshes (their gaps within
 /// `tolerance` mm welded, [`FacetedFile::read`]), anything else as STEP.
 pub fn read_part(path: &Path, tolerance: f64) -> Result<Box<dyn PartFile>, ReadError> {

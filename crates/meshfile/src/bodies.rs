@@ -4,6 +4,7 @@
 
 use crate::edges::edge_uses;
 use crate::measure::{cross, dot, measure, sub};
+use crate::tolerance::RAY_PARALLEL;
 use crate::Object;
 
 /// One body: an outer shell and its voids, triangles over the object's positions.
@@ -127,7 +128,7 @@ fn contains(positions: &[[f64; 3]], s: &[[u32; 3]], p: [f64; 3]) -> bool {
         let (e1, e2) = (sub(b, a), sub(c, a));
         let h = cross(d, e2);
         let det = dot(e1, h);
-        if det.abs() < 1e-14 {
+        if det.abs() < RAY_PARALLEL {
             continue;
         }
         let s0 = sub(p, a);

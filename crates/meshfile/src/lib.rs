@@ -20,6 +20,7 @@ pub mod measure;
 pub mod obj;
 pub mod stl;
 pub mod threemf;
+mod tolerance;
 pub mod weld;
 
 use std::path::Path;

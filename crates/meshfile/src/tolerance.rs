@@ -1,0 +1,5 @@
+//! The crate's tolerances, named once.
+
+/// The determinant (Möller–Trumbore) under which a ray is taken as parallel to a triangle's
+/// plane, missing it: the crossing count of an inside test.
+pub(crate) const RAY_PARALLEL: f64 = 1e-14;
