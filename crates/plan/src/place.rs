@@ -1,6 +1,6 @@
 //! The place stage: how the part stands on the build plate: as modelled (its −Z down), on a
 //! chosen planar face (`--base-face ID`), or on the planar face the rule of `--orient auto`
-//! picks. The file is parsed once ([`brep::StepFile`]) and translated turned for each
+//! picks. The file is parsed once ([`brep::PartFile`]: STEP, or a mesh) and translated turned for each
 //! candidate; the winner's features come out extracted.
 //!
 //! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
@@ -18,7 +18,7 @@ use crate::report::PlacementEntry;
 use brep::math::V3;
 use brep::mesh::{mesh_faces, MeshOptions};
 use brep::topology::{Brep, FaceId};
-use brep::{StepFile, StepPart};
+use brep::{PartFile, StepPart};
 use features::{extract_all, Assembly, ExtractOptions};
 
 /// How many candidate directions `--orient auto` tries.
@@ -81,7 +81,7 @@ pub struct Placed {
 /// Stands the part of `file` as `how` says; `--orient auto` measures each candidate's support
 /// with `process`'s layers and beads `bead_width` wide.
 pub fn place(
-    file: &StepFile,
+    file: &dyn PartFile,
     how: Placement,
     process: &crate::Process,
     bead_width: f64,
@@ -99,7 +99,7 @@ pub fn place(
 }
 
 /// The part on its planar face `#id`.
-fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceError> {
+fn base_face(file: &dyn PartFile, part: StepPart, id: u64) -> Result<Placed, PlaceError> {
     let b = &part.brep;
     let face = (0..b.faces.len())
         .map(|k| FaceId(k as u32))
@@ -120,7 +120,7 @@ fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceEr
 
 /// The part on the face the rule of `--orient auto` picks (module docs).
 fn auto(
-    file: &StepFile,
+    file: &dyn PartFile,
     part: StepPart,
     process: &crate::Process,
     bead_width: f64,
@@ -164,7 +164,7 @@ fn auto(
 /// when it cannot be measured), the part turned onto it and its features; `None` when its
 /// features cannot be extracted.
 fn measure(
-    file: &StepFile,
+    file: &dyn PartFile,
     c: &Candidate,
     k: usize,
     process: &crate::Process,
@@ -202,7 +202,7 @@ pub struct RankedFace {
 /// `--orient auto` (module docs), each with its largest face; those whose features cannot be
 /// extracted are left out.
 pub fn ranked_faces(
-    file: &StepFile,
+    file: &dyn PartFile,
     process: &crate::Process,
     bead_width: f64,
 ) -> Result<Vec<RankedFace>, PlaceError> {
