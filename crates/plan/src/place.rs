@@ -273,12 +273,12 @@ struct Candidate {
 /// [`CANDIDATES`]), each with its largest face.
 fn candidates(b: &Brep) -> Vec<Candidate> {
     let mut out: Vec<(Candidate, f64)> = vec![];
-    for k in 0..b.faces.len() {
-        let f = FaceId(k as u32);
-        let Some(n) = b.plane_normal(f) else {
-            continue;
-        };
-        let area = face_area(b, f);
+    let planar: Vec<(FaceId, V3)> = (0..b.faces.len())
+        .map(|k| FaceId(k as u32))
+        .filter_map(|f| Some((f, b.plane_normal(f)?)))
+        .collect();
+    let faces: Vec<FaceId> = planar.iter().map(|p| p.0).collect();
+    for (&(f, n), area) in planar.iter().zip(face_areas(b, &faces)) {
         match out
             .iter_mut()
             .find(|(c, _)| c.down.dot(&n) > SAME_DIRECTION_DOT)
@@ -304,6 +304,27 @@ fn candidates(b: &Brep) -> Vec<Candidate> {
     out.sort_by(|a, c| c.area.total_cmp(&a.area));
     out.truncate(CANDIDATES);
     out
+}
+
+/// Each face's area from one mesh of them all (a mesh's B-rep has a face per triangle: one
+/// mesh each was quadratic in them); face by face ([`face_area`]) when they do not mesh
+/// together.
+fn face_areas(b: &Brep, faces: &[FaceId]) -> Vec<f64> {
+    let Ok(m) = mesh_faces(b, faces, &MeshOptions::default()) else {
+        return faces.iter().map(|&f| face_area(b, f)).collect();
+    };
+    m.faces
+        .iter()
+        .map(|t| {
+            t.triangles
+                .iter()
+                .map(|tri| {
+                    let [a, c, d] = tri.map(|i| m.positions[t.vertex[i as usize] as usize]);
+                    0.5 * (c - a).cross(&(d - a)).norm()
+                })
+                .sum()
+        })
+        .collect()
 }
 
 /// A face's area from its mesh (0 when it does not mesh).
