@@ -344,3 +344,27 @@ fn inspect_measures_the_mesh_as_the_step_file() {
         );
     }
 }
+
+#[test]
+fn a_mesh_stands_on_its_largest_face_and_previews() {
+    // A box on its side: --orient auto ranks the triangles' directions by area (one mesh of
+    // them all) and stands it on a 30 x 20 face, whose two triangles face -Y.
+    let scratch = Scratch::new("orient");
+    let o = object(&stl_of("box.step", &scratch));
+    let mut side = o.clone();
+    for p in &mut side.positions {
+        *p = [p[0], -p[2], p[1]];
+    }
+    let part = scratch.path("side.obj");
+    std::fs::write(&part, obj_text(&side)).unwrap();
+    let report = plan(&part, &scratch.path("out"), &["--orient", "auto"]);
+    assert_eq!(report["features"][0]["subtype"], "mesh_two5d");
+    let down = report["placement"]["down"].as_array().unwrap();
+    let down: Vec<f64> = down.iter().map(|x| x.as_f64().unwrap()).collect();
+    assert!(down[1].abs() > 0.99, "{down:?}");
+    assert!((extruded(&report) - 6000.0).abs() < 0.02 * 6000.0);
+    let page = scratch.path("side.html");
+    let r = run(&["preview", s(&part), "-o", s(&page)]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(page.exists());
+}

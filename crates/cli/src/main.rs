@@ -84,7 +84,7 @@ enum Command {
 /// Arguments of `features preview`.
 #[derive(Debug, Args)]
 pub struct PreviewArgs {
-    /// STEP file to read.
+    /// STEP file to read, or a mesh (.stl, .3mf, .obj).
     #[arg(value_name = "PART.step")]
     pub part: PathBuf,
     /// The page to write, a self-contained .html file (no network: opens offline)
