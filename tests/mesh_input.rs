@@ -368,3 +368,23 @@ fn a_mesh_stands_on_its_largest_face_and_previews() {
     assert!(r.status.success(), "{}", stderr(&r));
     assert!(page.exists());
 }
+
+#[test]
+fn a_needle_triangle_is_split_away_without_a_warning() {
+    // A 10 mm cube whose top diagonal is split at (5 5 10) by a triangle of no area (a mended
+    // T-junction): closed and manifold, but no plane holds the needle.
+    let scratch = Scratch::new("needle");
+    let part = scratch.path("needle.obj");
+    let text = "v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nv 0 0 10\nv 10 0 10\nv 10 10 10\nv 0 10 10\nv 5 5 10\n\
+                f 1 4 3\nf 1 3 2\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 3 4 8\nf 3 8 7\nf 1 5 8\nf 1 8 4\n\
+                f 2 3 7\nf 2 7 6\nf 5 6 9\nf 9 6 7\nf 5 9 7\n";
+    std::fs::write(&part, text).unwrap();
+    let out = scratch.path("out");
+    let r = run(&["plan", s(&part), "-o", s(&out)]);
+    let err = stderr(&r);
+    assert!(r.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert!((extruded(&report) - 1000.0).abs() < 0.02 * 1000.0);
+}

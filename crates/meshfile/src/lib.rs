@@ -17,6 +17,7 @@
 pub mod bodies;
 pub mod edges;
 pub mod measure;
+pub mod needles;
 pub mod obj;
 pub mod stl;
 pub mod threemf;
@@ -159,6 +160,8 @@ pub struct Closed {
     pub mended: Option<EdgeCounts>,
     /// Vertices moved to close the gaps.
     pub moved: usize,
+    /// Needles (triangles with their corners on one line) split away ([`needles`]).
+    pub needles: usize,
 }
 
 /// Why a mesh object cannot be planned: its edges after welding within the tolerance.
@@ -183,7 +186,8 @@ impl std::fmt::Display for NotClosed {
 }
 
 /// `o` welded (exactly equal corners joined; where that leaves edges open or shared by more
-/// than two triangles, corners within `tolerance` mm too) and told apart into bodies; refused
+/// than two triangles, corners within `tolerance` mm too), its needles split away and told
+/// apart into bodies; refused
 /// with its edge counts when it is still not closed and manifold.
 pub fn close(o: &Object, tolerance: f64) -> Result<Closed, NotClosed> {
     let exact = weld::weld(o, 0.0);
@@ -201,11 +205,14 @@ pub fn close(o: &Object, tolerance: f64) -> Result<Closed, NotClosed> {
         }
         (near, Some(before))
     };
+    let mut object = welded.object;
+    let needles = needles::split_needles(&object.positions, &mut object.triangles);
     Ok(Closed {
-        bodies: bodies::bodies(&welded.object),
-        object: welded.object,
+        bodies: bodies::bodies(&object),
+        object,
         mended,
         moved: welded.moved,
+        needles,
     })
 }
 
