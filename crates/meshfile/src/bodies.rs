@@ -21,14 +21,18 @@ pub struct Body {
 /// some triangles the wrong way round is mended).
 pub fn bodies(o: &Object) -> Vec<Body> {
     let shells = oriented_shells(&o.triangles);
-    let volumes: Vec<f64> = shells
-        .iter()
-        .map(|s| measure(&o.positions, s).volume)
-        .collect();
-    // Which shells hold which: shell j inside shell i when a vertex of j is inside i.
+    let measures: Vec<_> = shells.iter().map(|s| measure(&o.positions, s)).collect();
+    let volumes: Vec<f64> = measures.iter().map(|m| m.volume).collect();
+    // Which shells hold which: shell j inside shell i when a vertex of j is inside i (only
+    // asked of a larger shell whose box holds j's).
     let n = shells.len();
+    let boxed = |j: usize, i: usize| {
+        (0..3).all(|k| {
+            measures[i].min[k] <= measures[j].min[k] && measures[j].max[k] <= measures[i].max[k]
+        })
+    };
     let inside = |j: usize, i: usize| -> bool {
-        if i == j || volumes[i].abs() <= volumes[j].abs() {
+        if i == j || volumes[i].abs() <= volumes[j].abs() || !boxed(j, i) {
             return false;
         }
         let p = o.positions[shells[j][0][0] as usize];
