@@ -16,6 +16,7 @@
 
 pub mod bbox;
 pub mod curve;
+pub mod faceted;
 pub mod mass;
 pub mod math;
 pub mod mesh;
@@ -23,6 +24,7 @@ pub mod nurbs;
 pub mod orient;
 pub mod section;
 pub mod solid;
+pub mod source;
 pub mod step;
 pub mod subset;
 pub mod surface;
@@ -34,6 +36,8 @@ pub mod validate;
 pub use step::{error, p21, write};
 
 pub use error::ReadError;
+pub use faceted::FacetedFile;
 pub use solid::SolidReport;
+pub use source::{read_part, PartFile};
 pub use step::{read_step, read_step_bytes, read_step_turned, turn_down, StepFile, StepPart};
 pub use topology::Brep;

@@ -89,6 +89,7 @@ impl Brep {
         }
         let mut out = Brep {
             solids: vec![solid.clone()],
+            origin: self.origin,
             units: self.units.clone(),
             warnings: self.warnings.clone(),
             ..Brep::default()

@@ -139,9 +139,22 @@ pub struct LengthUnit {
     pub mm_per_unit: f64,
 }
 
+/// What a B-rep was made from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Origin {
+    /// A STEP file's exact geometry.
+    #[default]
+    Step,
+    /// A triangle mesh's facets (STL, 3MF, OBJ; [`crate::faceted`]): every face a planar
+    /// triangle with line edges, planned whole as `mesh_two5d` features.
+    Mesh,
+}
+
 /// A whole file read into one arena.
 #[derive(Debug, Clone, Default)]
 pub struct Brep {
+    /// What it was made from.
+    pub origin: Origin,
     /// Solids in file order.
     pub solids: Vec<Solid>,
     /// Shells.

@@ -18,7 +18,12 @@ struct Solid {
 /// Runs the command.
 pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
     let path = &args.part;
-    let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    // STEP, or a mesh (STL, 3MF, OBJ) whose gaps within the default process tolerance are
+    // welded.
+    let tolerance = plan::Process::default().base().tolerance;
+    let part = brep::read_part(path, tolerance)
+        .and_then(|f| f.part())
+        .map_err(|e| Failure::new(path, e))?;
     let assembly =
         extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
     // The reader's warnings (skipped header lines, unknown entities, faces turned round) first.

@@ -43,6 +43,9 @@ impl Inspection {
 /// Runs the command.
 pub fn run(args: &InspectArgs) -> Result<(), Failure> {
     let path = &args.part;
+    if meshfile::is_mesh(path) {
+        return crate::inspect_mesh::run(args);
+    }
     let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
     let mut reports = vec![];
     for s in part.brep.solid_ids() {

@@ -5,6 +5,7 @@
 
 mod extract;
 mod inspect;
+mod inspect_mesh;
 mod memory;
 mod mesh;
 mod outputs;
@@ -43,7 +44,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Read a STEP file and report each solid: volume, area, topology, surface kinds, checks.
+    /// Read a STEP file and report each solid: volume, area, topology, surface kinds, checks (or a
+    /// mesh file: each object's volume, area, box, open and non-manifold edges).
     #[command(
         after_help = "Examples:\n  features inspect part.step\n  features inspect part.step --json"
     )]
@@ -83,7 +85,7 @@ enum Command {
 /// Arguments of `features preview`.
 #[derive(Debug, Args)]
 pub struct PreviewArgs {
-    /// STEP file to read.
+    /// STEP file to read, or a mesh (.stl, .3mf, .obj).
     #[arg(value_name = "PART.step")]
     pub part: PathBuf,
     /// The page to write, a self-contained .html file (no network: opens offline)
@@ -111,7 +113,8 @@ pub enum ProfilesAction {
 /// Arguments of `features plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// STEP file to read.
+    /// STEP file to read, or a mesh (.stl, .3mf, .obj): each closed body one mesh_two5d feature
+    /// in planar layers along +Z.
     #[arg(value_name = "PART.step")]
     pub part: PathBuf,
     /// Process file (TOML): `[defaults]` layer parameters and `[features.<id>]` overrides
@@ -187,7 +190,7 @@ fn seconds(s: &str) -> Result<f64, String> {
 /// Arguments of `features extract`.
 #[derive(Debug, Args)]
 pub struct ExtractArgs {
-    /// STEP file to read.
+    /// STEP file to read, or a mesh (.stl, .3mf, .obj).
     #[arg(value_name = "PART.step")]
     pub part: PathBuf,
     /// Print the feature tree as one JSON object (schema `features.extract/1`) [default: text].
@@ -204,7 +207,8 @@ pub struct ExtractArgs {
 /// Arguments of `features inspect`.
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// STEP file to read (AP203, AP214 or AP242; any length unit, reported in mm).
+    /// STEP file to read (AP203, AP214 or AP242; any length unit, reported in mm), or a mesh
+    /// (.stl, .3mf, .obj: volume, area, box, open and non-manifold edges).
     #[arg(value_name = "PART.step")]
     pub part: PathBuf,
     /// Print the report as one JSON object instead of text [default: text].

@@ -21,7 +21,9 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     let outputs = Outputs::from_arg(args.output.as_deref(), path, machine.kind)?;
     let earlier = outputs.claim(args.force)?;
     let bar = Bar::new(path);
-    let file = brep::StepFile::read(path).map_err(|e| Failure::new(path, e))?;
+    // STEP, or a mesh (STL, 3MF, OBJ) whose gaps within the process tolerance are welded.
+    let file =
+        brep::read_part(path, process.base().tolerance).map_err(|e| Failure::new(path, e))?;
     bar.0.inc(1);
     bar.0.set_prefix("planning");
     let progress = |p: Progress| bar.progress(p);
@@ -46,7 +48,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
     // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise. Each
     // placement tried starts afresh.
     let mut fresh = Fresh::new(&outputs);
-    let result = plan::plan_file_to(&file, &process, &machine, &options, &mut fresh);
+    let result = plan::plan_file_to(&*file, &process, &machine, &options, &mut fresh);
     let staged = fresh.last();
     bar.0.inc(1);
     bar.0.set_prefix("writing");
@@ -438,7 +440,13 @@ fn summary_line(plan: &Plan, args: &PlanArgs, outputs: &Outputs, warnings: usize
         .part_warnings
         .iter()
         .any(|w| w.kind == plan::WarningKind::OverlappingSolids);
+    // A mesh (STL, 3MF, OBJ) is planned so whatever the settings: each body whole.
+    let mesh = plan
+        .features()
+        .iter()
+        .any(|f| f.feature.subtype == features::MESH_TWO5D);
     let planar = match (chosen && plan.report.slicing == "planar", plus_z_only(kind)) {
+        _ if mesh => " sliced whole in planar layers along +Z (a mesh: each body one mesh_two5d feature),".to_string(),
         (false, _) => String::new(),
         (true, _) if overlap => {
             " sliced whole in planar layers along +Z (slicing auto: the part's solids overlap),"

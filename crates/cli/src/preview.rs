@@ -222,7 +222,11 @@ pub fn run(args: &PreviewArgs) -> Result<(), Failure> {
             "the preview is a web page: give -o a file ending in .html",
         ));
     }
-    let part = brep::read_step(path).map_err(|e| Failure::new(path, e))?;
+    // STEP, or a mesh (STL, 3MF, OBJ): each body one mesh_two5d feature.
+    let tolerance = plan::Process::default().base().tolerance;
+    let part = brep::read_part(path, tolerance)
+        .and_then(|f| f.part())
+        .map_err(|e| Failure::new(path, e))?;
     let assembly =
         extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
     let features = feature_meshes(&assembly);

@@ -11,7 +11,7 @@
 //!   its first layer would be laid in the air;
 //! - a solid that encloses no volume (a sliver a CAD system left) is skipped with a warning.
 
-use crate::extract::{extract, ExtractError, ExtractOptions, FeatureTree};
+use crate::extract::{ExtractError, FeatureTree};
 use brep::math::{Aabb, P3};
 use brep::topology::{Brep, SolidId};
 use parry3d::na::Point3;
@@ -59,20 +59,19 @@ impl Assembly {
     }
 }
 
-/// `solid #id`, the STEP entity of a tree's solid.
+/// `solid #id`, the STEP entity of a tree's solid; `body N` for a mesh's body (its place
+/// among the file's bodies), with the object's name when it has one.
 pub fn solid_name(t: &FeatureTree) -> String {
-    format!("solid #{}", t.brep.solids[t.solid.idx()].step_id)
-}
-
-/// Extracts every solid of `brep` and orders and checks them together.
-///
-/// Fails on the first solid whose extraction fails, or when no solid encloses a volume.
-pub fn extract_all(brep: &Brep, opts: &ExtractOptions) -> Result<Assembly, ExtractError> {
-    assemble(brep, |b, s| extract(b, s, opts))
+    let s = &t.brep.solids[t.solid.idx()];
+    match (t.brep.origin, s.name.as_str()) {
+        (brep::topology::Origin::Step, _) => format!("solid #{}", s.step_id),
+        (brep::topology::Origin::Mesh, "") => format!("body {}", s.step_id),
+        (brep::topology::Origin::Mesh, name) => format!("body {} (`{name}`)", s.step_id),
+    }
 }
 
 /// Each solid of `brep` made a tree by `tree_of`, then ordered and checked together (see
-/// [`extract_all`]).
+/// [`crate::extract_all`]).
 pub(crate) fn assemble(
     brep: &Brep,
     tree_of: impl Fn(&Brep, SolidId) -> Result<FeatureTree, ExtractError>,

@@ -10,14 +10,16 @@ pub mod assembly;
 pub mod check;
 pub mod extract;
 pub mod measure;
+pub mod part;
 pub mod split;
 mod tolerance;
 pub mod whole;
 
-pub use assembly::{extract_all, solid_name, Assembly};
+pub use assembly::{solid_name, Assembly};
 pub use check::{check_solid, SolidCheck, SolidProblem};
 pub use extract::{
     extract, ExtractError, ExtractOptions, Feature, FeatureKind, FeatureTree, Reference, RootLoop,
     RootOutcome,
 };
-pub use whole::{is_whole_part, whole_part_features};
+pub use part::extract_all;
+pub use whole::{is_whole_part, mesh_features, whole_part_features, MESH_TWO5D};

@@ -15,10 +15,35 @@ use crate::assembly::{overlaps, relate, solid_name, solid_trees, Assembly};
 use crate::extract::{ExtractError, Feature, FeatureKind, FeatureTree, Reference};
 use crate::measure::{measure, Measured};
 use brep::solid::analysis_options;
-use brep::topology::{Brep, FaceId, ShellId, SolidId};
+use brep::topology::{Brep, FaceId, Origin, ShellId, SolidId};
 
 /// The `subtype` of a solid planned whole.
 pub const WHOLE_PART: &str = "whole_part";
+
+/// The `subtype` of a mesh's body planned whole (the seed paper's mesh two5D feature): a
+/// solid whose B-rep is a triangle mesh's facets ([`brep::topology::Origin::Mesh`]).
+pub const MESH_TWO5D: &str = "mesh_two5d";
+
+/// The `subtype` of a solid of `brep` planned whole: [`MESH_TWO5D`] for a mesh's body,
+/// [`WHOLE_PART`] otherwise.
+fn whole_subtype(brep: &Brep) -> &'static str {
+    match brep.origin {
+        Origin::Mesh => MESH_TWO5D,
+        Origin::Step => WHOLE_PART,
+    }
+}
+
+/// The bodies of a mesh's B-rep (STL, 3MF, OBJ) as features: each body ONE `mesh_two5d`
+/// feature ([`whole_part_tree`]), the bodies built lowest first like a STEP file's solids
+/// ([`crate::extract_all`]); bodies that overlap are sliced together as ONE feature instead
+/// ([`whole_part_features`]), so that the material they share is laid once.
+pub fn mesh_features(brep: &Brep) -> Result<Assembly, ExtractError> {
+    let assembly = crate::assembly::assemble(brep, whole_part_tree)?;
+    if assembly.overlapping {
+        return whole_part_features(brep);
+    }
+    Ok(assembly)
+}
 
 /// The build direction of a solid planned whole: +Z.
 pub const PLUS_Z: [f64; 3] = [0.0, 0.0, 1.0];
@@ -108,6 +133,7 @@ fn solids_together(
         })
         .collect();
     let feature = whole_feature(
+        whole_subtype(brep),
         faces,
         voids,
         shell,
@@ -134,8 +160,10 @@ fn solids_together(
 /// The smallest box diagonal (mm) an analysis mesh is sized for.
 const MIN_DIAG: f64 = 1e-3;
 
-/// A whole-part feature (id 0, two5d, on the build plate) of shell faces `faces` with `voids`.
+/// A whole-part feature (id 0, two5d, on the build plate) of shell faces `faces` with
+/// `voids`, of `subtype` ([`WHOLE_PART`] or [`MESH_TWO5D`]).
 fn whole_feature(
+    subtype: &str,
     faces: Vec<FaceId>,
     voids: Vec<Vec<FaceId>>,
     shell: ShellId,
@@ -146,7 +174,7 @@ fn whole_feature(
     Feature {
         id: 0,
         kind: FeatureKind::Two5d,
-        subtype: WHOLE_PART.to_string(),
+        subtype: subtype.to_string(),
         reference: plate_reference(),
         parents: vec![],
         faces,
@@ -173,10 +201,9 @@ fn plate_reference() -> Reference {
 
 /// Whether every tree of `assembly` is a solid planned whole ([`whole_part_features`]).
 pub fn is_whole_part(assembly: &Assembly) -> bool {
-    assembly
-        .trees
-        .iter()
-        .all(|t| t.features.len() == 1 && t.features[0].subtype == WHOLE_PART)
+    assembly.trees.iter().all(|t| {
+        t.features.len() == 1 && [WHOLE_PART, MESH_TWO5D].contains(&t.features[0].subtype.as_str())
+    })
 }
 
 /// Solid `solid` of `part` as a tree of one two5d feature: its outer shell's faces with its
@@ -215,7 +242,15 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
             voids.len()
         ));
     }
-    let feature = whole_feature(outer, voids, outer_shell, part_volume, closed, problems);
+    let feature = whole_feature(
+        whole_subtype(&b),
+        outer,
+        voids,
+        outer_shell,
+        part_volume,
+        closed,
+        problems,
+    );
     Ok(FeatureTree {
         brep: b,
         solid,

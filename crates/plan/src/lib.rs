@@ -2,7 +2,7 @@
 //! `plan.json`. The stages ([`Stage`]), each a function in its own module taking the previous
 //! stage's value and returning its own:
 //!
-//! read (`brep::StepFile`) → [`place`] → [`extract`] → [`lay`] (fill and lay each feature, in
+//! read (`brep::StepFile`, or a mesh file: `brep::FacetedFile`) → [`place`] → [`extract`] → [`lay`] (fill and lay each feature, in
 //! parallel; then sequence them into one tool path) → [`smooth`] → [`head`] (the print head's
 //! check and avoidance; then the skirt and brim on the first layer, [`adhesion`]) → [`gates`] (self-check, collisions; refused plans stop here) →
 //! [`post`] (the program) → [`gates::after_post`] (reach, `strict`). The report is built once,
@@ -205,7 +205,7 @@ pub fn plan_into(
 /// [`plan_into`] for the part of a parsed STEP file, stood on the plate as
 /// [`Options::placement`] says ([`place`]).
 pub fn plan_file_into(
-    file: &brep::StepFile,
+    file: &dyn brep::PartFile,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,
@@ -221,7 +221,7 @@ pub fn plan_file_into(
 /// in turn ([`retry::find`]), each written afresh into `out` so that only the chosen plan's
 /// files are left in it; otherwise the one placement asked for.
 pub fn plan_file_to(
-    file: &brep::StepFile,
+    file: &dyn brep::PartFile,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,

@@ -1,6 +1,6 @@
 //! The place stage: how the part stands on the build plate: as modelled (its −Z down), on a
 //! chosen planar face (`--base-face ID`), or on the planar face the rule of `--orient auto`
-//! picks. The file is parsed once ([`brep::StepFile`]) and translated turned for each
+//! picks. The file is parsed once ([`brep::PartFile`]: STEP, or a mesh) and translated turned for each
 //! candidate; the winner's features come out extracted.
 //!
 //! **The rule of `--orient auto`.** Every direction in which planar faces of the part point
@@ -18,7 +18,7 @@ use crate::report::PlacementEntry;
 use brep::math::V3;
 use brep::mesh::{mesh_faces, MeshOptions};
 use brep::topology::{Brep, FaceId};
-use brep::{StepFile, StepPart};
+use brep::{PartFile, StepPart};
 use features::{extract_all, Assembly, ExtractOptions};
 
 /// How many candidate directions `--orient auto` tries.
@@ -81,7 +81,7 @@ pub struct Placed {
 /// Stands the part of `file` as `how` says; `--orient auto` measures each candidate's support
 /// with `process`'s layers and beads `bead_width` wide.
 pub fn place(
-    file: &StepFile,
+    file: &dyn PartFile,
     how: Placement,
     process: &crate::Process,
     bead_width: f64,
@@ -99,7 +99,7 @@ pub fn place(
 }
 
 /// The part on its planar face `#id`.
-fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceError> {
+fn base_face(file: &dyn PartFile, part: StepPart, id: u64) -> Result<Placed, PlaceError> {
     let b = &part.brep;
     let face = (0..b.faces.len())
         .map(|k| FaceId(k as u32))
@@ -120,7 +120,7 @@ fn base_face(file: &StepFile, part: StepPart, id: u64) -> Result<Placed, PlaceEr
 
 /// The part on the face the rule of `--orient auto` picks (module docs).
 fn auto(
-    file: &StepFile,
+    file: &dyn PartFile,
     part: StepPart,
     process: &crate::Process,
     bead_width: f64,
@@ -164,7 +164,7 @@ fn auto(
 /// when it cannot be measured), the part turned onto it and its features; `None` when its
 /// features cannot be extracted.
 fn measure(
-    file: &StepFile,
+    file: &dyn PartFile,
     c: &Candidate,
     k: usize,
     process: &crate::Process,
@@ -202,7 +202,7 @@ pub struct RankedFace {
 /// `--orient auto` (module docs), each with its largest face; those whose features cannot be
 /// extracted are left out.
 pub fn ranked_faces(
-    file: &StepFile,
+    file: &dyn PartFile,
     process: &crate::Process,
     bead_width: f64,
 ) -> Result<Vec<RankedFace>, PlaceError> {
@@ -273,12 +273,12 @@ struct Candidate {
 /// [`CANDIDATES`]), each with its largest face.
 fn candidates(b: &Brep) -> Vec<Candidate> {
     let mut out: Vec<(Candidate, f64)> = vec![];
-    for k in 0..b.faces.len() {
-        let f = FaceId(k as u32);
-        let Some(n) = b.plane_normal(f) else {
-            continue;
-        };
-        let area = face_area(b, f);
+    let planar: Vec<(FaceId, V3)> = (0..b.faces.len())
+        .map(|k| FaceId(k as u32))
+        .filter_map(|f| Some((f, b.plane_normal(f)?)))
+        .collect();
+    let faces: Vec<FaceId> = planar.iter().map(|p| p.0).collect();
+    for (&(f, n), area) in planar.iter().zip(face_areas(b, &faces)) {
         match out
             .iter_mut()
             .find(|(c, _)| c.down.dot(&n) > SAME_DIRECTION_DOT)
@@ -304,6 +304,27 @@ fn candidates(b: &Brep) -> Vec<Candidate> {
     out.sort_by(|a, c| c.area.total_cmp(&a.area));
     out.truncate(CANDIDATES);
     out
+}
+
+/// Each face's area from one mesh of them all (a mesh's B-rep has a face per triangle: one
+/// mesh each was quadratic in them); face by face ([`face_area`]) when they do not mesh
+/// together.
+fn face_areas(b: &Brep, faces: &[FaceId]) -> Vec<f64> {
+    let Ok(m) = mesh_faces(b, faces, &MeshOptions::default()) else {
+        return faces.iter().map(|&f| face_area(b, f)).collect();
+    };
+    m.faces
+        .iter()
+        .map(|t| {
+            t.triangles
+                .iter()
+                .map(|tri| {
+                    let [a, c, d] = tri.map(|i| m.positions[t.vertex[i as usize] as usize]);
+                    0.5 * (c - a).cross(&(d - a)).norm()
+                })
+                .sum()
+        })
+        .collect()
 }
 
 /// A face's area from its mesh (0 when it does not mesh).

@@ -41,7 +41,7 @@ pub struct FeatureEntry {
     pub parents: Vec<usize>,
     /// Solid volume, mm³, rounded to 1e-3.
     pub volume_mm3: f64,
-    /// STEP `#id`s of its faces.
+    /// STEP `#id`s of its faces (none for a mesh's body: its triangles are no STEP faces).
     pub faces: Vec<u64>,
     /// Concave loops at its root.
     pub root_loops: usize,
@@ -62,7 +62,10 @@ impl FeatureEntry {
             },
             parents: f.parents.iter().map(|p| offset + p).collect(),
             volume_mm3: round(f.volume, 1e3),
-            faces: f.step_faces(&tree.brep),
+            faces: match tree.brep.origin {
+                brep::topology::Origin::Step => f.step_faces(&tree.brep),
+                brep::topology::Origin::Mesh => vec![],
+            },
             root_loops: f.root_loops,
         }
     }

@@ -38,7 +38,7 @@
 use crate::place::{entry_turned, Placed};
 use crate::report::{PlacementEntry, TriedEntry};
 use crate::{Gate, Options, Plan, PlanError, Process, Progress};
-use brep::StepFile;
+use brep::PartFile;
 use robot_post::machine::MachineProfile;
 use robot_post::ProgramSink;
 
@@ -205,7 +205,7 @@ impl Candidate {
     /// Its whole plan, written into `sink` and `csv`.
     pub fn plan(
         &self,
-        file: &StepFile,
+        file: &dyn PartFile,
         process: &Process,
         machine: &MachineProfile,
         options: &Options,
@@ -382,7 +382,7 @@ fn none_fits(e: &PlanError, machine: &MachineProfile) -> Option<TriedEntry> {
 /// the other planar faces, best first, at most [`MAX_FACES`]. A turn to fit is tried after
 /// any candidate that leaves the bed or envelope ([`find`]). Append new kinds at the end.
 pub fn candidates(
-    file: &StepFile,
+    file: &dyn PartFile,
     process: &Process,
     machine: &MachineProfile,
 ) -> Result<Vec<Candidate>, PlanError> {
@@ -439,7 +439,7 @@ impl std::fmt::Display for Stopped {
 /// planned is given up ([`crate::Options::stop_at`]); the refusal lists what was tried and
 /// what was not ([`Stopped`]).
 pub fn find(
-    file: &StepFile,
+    file: &dyn PartFile,
     process: &Process,
     machine: &MachineProfile,
     options: &Options,

@@ -10,6 +10,9 @@ use crate::tolerance::NONZERO;
 use crate::topology::{Brep, EdgeId, FaceId};
 use std::collections::HashMap;
 
+/// Faces meshed together that are searched rather than indexed.
+const FEW_FACES: usize = 32;
+
 /// Vertex positions, vertex indices and edge point indices for one face's boundary.
 #[allow(clippy::type_complexity)]
 pub(super) fn face_edge_points(
@@ -26,6 +29,21 @@ pub(super) fn face_edge_points(
     let mut params_of: HashMap<EdgeId, Vec<f64>> = HashMap::new();
     let mut vert_idx: Vec<Option<u32>> = vec![None; brep.vertices.len()];
     let mut edge_pts: HashMap<EdgeId, Vec<u32>> = HashMap::new();
+    // Whether a face is meshed: a search of `faces` for a few, by index for many (a mesh's
+    // B-rep has a face per triangle, and a search for each edge's faces was quadratic in
+    // them; an index of every face for each face meshed alone would be too).
+    let index = (faces.len() > FEW_FACES).then(|| {
+        let mut m = vec![false; brep.faces.len()];
+        for f in faces {
+            m[f.idx()] = true;
+        }
+        m
+    });
+    let meshed = |f: FaceId| {
+        index
+            .as_ref()
+            .map_or_else(|| faces.contains(&f), |m| m[f.idx()])
+    };
     for e in brep.edges_of(faces) {
         let edge = brep.edge(e);
         for v in [edge.start, edge.end] {
@@ -44,7 +62,7 @@ pub(super) fn face_edge_points(
             .coedges
             .iter()
             .map(|&ce| brep.coedge_face(ce))
-            .filter(|f| faces.contains(f))
+            .filter(|&f| meshed(f))
             .map(|f| brep.face_surface(f))
             .filter(|s| !matches!(s, Surface::Plane { .. }))
             .collect();

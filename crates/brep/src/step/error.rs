@@ -37,6 +37,17 @@ pub enum ReadError {
         /// Entity type name.
         entity: String,
     },
+    /// A mesh file (STL, 3MF, OBJ) that could not be read.
+    #[error(transparent)]
+    Mesh(#[from] meshfile::MeshReadError),
+    /// A mesh object that is not closed and manifold, even with its small gaps welded.
+    #[error("{}{why}", if object.is_empty() { String::new() } else { format!("object `{object}`: ") })]
+    NotClosed {
+        /// The object's name (empty when the file has one object without a name).
+        object: String,
+        /// Its edges.
+        why: meshfile::NotClosed,
+    },
     /// The file holds no solid at all.
     #[error(
         "no solid in the file (found no MANIFOLD_SOLID_BREP, BREP_WITH_VOIDS or closed shell){0}"
