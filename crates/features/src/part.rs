@@ -1,5 +1,5 @@
 //! A part's features, whatever it was read from: a STEP file's solids recognised feature by
-//! feature ([`crate::extract`]), a mesh's bodies each one `mesh_two5d` feature
+//! feature ([`crate::extract()`]), a mesh's bodies each one `mesh_two5d` feature
 //! ([`crate::whole::mesh_features`]).
 
 use crate::assembly::{assemble, Assembly};
