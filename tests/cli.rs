@@ -686,6 +686,7 @@ fn extract_json_plate_boss_boss_has_the_exact_shape() {
             "units",
             "part",
             "features",
+            "support_features",
             "build_order",
             "depth",
             "concave_loops",
@@ -693,6 +694,8 @@ fn extract_json_plate_boss_boss_has_the_exact_shape() {
         ]
     );
     assert_eq!(v["schema"], "features.extract/1");
+    // The bosses stand on the plate: no support.
+    assert_eq!(v["support_features"], serde_json::json!([]));
     // Both roots of the two bosses are split off, each naming the feature it bounds.
     let loops = v["concave_loops"].as_array().expect("concave_loops array");
     assert_eq!(loops.len(), 2);
