@@ -282,7 +282,7 @@ fn krl_feed_follows_the_planned_flow_per_lin() {
         .find(|(n, _)| n == "impeller.src")
         .map(|(_, t)| t.clone())
         .expect("impeller.src");
-    assert!(main.contains("; filament feed per print LIN: $ANOUT[1] = feed ratio / 0.10000"));
+    assert!(main.contains("; filament feed per print motion: $ANOUT[1] = feed ratio / 0.10000"));
     assert!(
         !main.contains("mm per mm of bead"),
         "no single ratio for the program"

@@ -81,6 +81,7 @@ pub fn post(
         notes,
         config: &config,
         arcs: base.arc_fitting.then_some(base.tolerance),
+        refused_unreachable: !options.allow_unreachable,
     };
     let post = machine.post();
     let (program, csv) = match csv {

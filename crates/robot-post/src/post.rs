@@ -33,6 +33,9 @@ pub struct Job<'a> {
     /// post writes runs of print moves along a circle as `G2`/`G3`
     /// ([`crate::marlin::arcs`]); `None`: straight moves only.
     pub arcs: Option<f64>,
+    /// The plan is refused when a point is out of the arm's reach (no `--allow-unreachable`),
+    /// its files dropped: the KUKA post then leaves out `joints.csv` when it finds one.
+    pub refused_unreachable: bool,
 }
 
 /// A post: writes a machine's program for a tool path.
@@ -147,7 +150,11 @@ impl Post for KukaPost<'_> {
         job: &Job,
         sink: &mut dyn ProgramSink,
     ) -> Result<Program, PostError> {
-        let program = kuka_to(path, self.0, job.stem, job.source, job.notes, sink)?;
+        let joints = match job.refused_unreachable {
+            true => crate::kuka::JointsCsv::UnlessUnreachable,
+            false => crate::kuka::JointsCsv::Always,
+        };
+        let program = kuka_to(path, self.0, job.stem, job.source, job.notes, sink, joints)?;
         Ok(measured(
             program.figures,
             PostFigures::Kuka,

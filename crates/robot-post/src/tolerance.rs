@@ -71,3 +71,7 @@ pub(crate) const ROUND_UP_SLACK: f64 = 1e-9;
 
 /// Tool axes shorter than this are not directions (the post refuses them).
 pub const MIN_AXIS: f64 = 1e-9;
+
+/// Below this length (mm) the sum of a spline's incoming and outgoing chord directions has
+/// no direction (the path turns back on itself): the tangent is the chord.
+pub(crate) const BISECTOR_ZERO: f64 = 1e-9;

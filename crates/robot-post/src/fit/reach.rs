@@ -72,7 +72,15 @@ impl ReachShift {
 /// Errors as [`crate::kuka()`]'s (not a valid `kuka` profile, a non-finite point, a tool axis
 /// that is not a unit vector).
 pub fn unreachable_points(path: &ToolPath, m: &MachineProfile) -> Result<usize, PostError> {
-    let program = crate::kuka::kuka_to(path, m, "fit", "", &[], &mut Discard)?;
+    let program = crate::kuka::kuka_to(
+        path,
+        m,
+        "fit",
+        "",
+        &[],
+        &mut Discard,
+        crate::kuka::JointsCsv::Never,
+    )?;
     Ok(program.figures.values().map(|f| f.unreachable_points).sum())
 }
 

@@ -169,7 +169,15 @@ pub fn kuka(
     source: &str,
 ) -> Result<KrlProgram, PostError> {
     let mut files = InMemory::default();
-    let mut program = kuka_to(path, m, program_name, source, &[], &mut files)?;
+    let mut program = kuka_to(
+        path,
+        m,
+        program_name,
+        source,
+        &[],
+        &mut files,
+        JointsCsv::Always,
+    )?;
     program.files = files
         .files
         .into_iter()
@@ -191,6 +199,7 @@ pub fn kuka_to(
     source: &str,
     notes: &[String],
     sink: &mut dyn ProgramSink,
+    joints: JointsCsv,
 ) -> Result<KrlProgram, PostError> {
     let cell = m.kuka_table()?;
     path.check_finite()?;
@@ -227,13 +236,34 @@ pub fn kuka_to(
         &mut warnings,
     )?;
     // The joints of the solutions the check followed, from a third run of the planner and the
-    // same check again.
-    write_joints(path, steps(), Reach::new(path, cell, &base), sink)?;
+    // same check again (as long again as the program's check).
+    let unreachable: usize = figures.values().map(|f| f.unreachable_points).sum();
+    let wanted = match joints {
+        JointsCsv::Always => true,
+        JointsCsv::UnlessUnreachable => unreachable == 0,
+        JointsCsv::Never => false,
+    };
+    if wanted {
+        write_joints(path, steps(), Reach::new(path, cell, &base), sink)?;
+    }
     Ok(KrlProgram {
         files: vec![],
         figures,
         warnings,
     })
+}
+
+/// Whether [`kuka_to`] writes `joints.csv` ([`JOINTS_CSV`]), a third run of the planner and
+/// the reach check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JointsCsv {
+    /// Always.
+    Always,
+    /// Unless some point is out of reach: for a plan that is then refused (no
+    /// `--allow-unreachable`), whose files are dropped.
+    UnlessUnreachable,
+    /// Never: the program is posted only to be measured ([`crate::fit`]).
+    Never,
 }
 
 /// The part offset [`kuka`] places the part with (`$BASE` = part + offset, the cell's

@@ -351,7 +351,7 @@ pub fn cubic_point(p0: V3, p1: V3, d_in: V3, d_out: V3, s: f64) -> V3 {
     let bisector = |a: V3| {
         let m = add(a, dir);
         let n = norm(m);
-        if n > 1e-9 {
+        if n > crate::tolerance::BISECTOR_ZERO {
             scale(m, len / n)
         } else {
             d

@@ -79,6 +79,7 @@ pub fn marlin_to(
         notes,
         config: &[],
         arcs: None,
+        refused_unreachable: false,
     };
     marlin_job_to(path, m, &job, sink)
 }
