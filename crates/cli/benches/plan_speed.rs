@@ -126,8 +126,7 @@ fn run_measured(
     } else {
         Err(format!("wait status {status:#x}"))
     };
-    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    let cpu = s(usage.ru_utime) + s(usage.ru_stime);
+    let cpu = timeval_s(usage.ru_utime) + timeval_s(usage.ru_stime);
     // Linux reports ru_maxrss in KiB.
     Ok((seconds, usage.ru_maxrss, cpu, code))
 }
@@ -239,8 +238,12 @@ fn cpu_now() -> f64 {
     let mut u: libc::rusage = unsafe { std::mem::zeroed() };
     // SAFETY: `u` is valid for writes.
     unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
-    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    s(u.ru_utime) + s(u.ru_stime)
+    timeval_s(u.ru_utime) + timeval_s(u.ru_stime)
+}
+
+/// A `timeval` in seconds.
+fn timeval_s(t: libc::timeval) -> f64 {
+    t.tv_sec as f64 + t.tv_usec as f64 * 1e-6
 }
 
 /// Plans `step` for `machine` in this process as `features plan --allow-collisions` does (the

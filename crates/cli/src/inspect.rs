@@ -209,15 +209,20 @@ fn to_text(ins: &Inspection) -> String {
             );
         }
     }
-    let warnings = ins.warnings();
+    warnings_text(&mut s, &ins.warnings());
+    s
+}
+
+/// The text report's closing lines: a blank line, then `warnings:    none` or the count and
+/// one `  - ` line for each (a STEP file's and a mesh file's report alike).
+pub(crate) fn warnings_text(s: &mut String, warnings: &[String]) {
     let _ = writeln!(s);
     if warnings.is_empty() {
         let _ = writeln!(s, "warnings:    none");
     } else {
         let _ = writeln!(s, "warnings:    {}", warnings.len());
-        for w in &warnings {
+        for w in warnings {
             let _ = writeln!(s, "  - {w}");
         }
     }
-    s
 }

@@ -174,14 +174,6 @@ fn to_text(source: &str, file: &meshfile::MeshFile, reports: &[Report], toleranc
             warnings.push(format!("object {}: {w}", i + 1));
         }
     }
-    let _ = writeln!(s);
-    if warnings.is_empty() {
-        let _ = writeln!(s, "warnings:    none");
-    } else {
-        let _ = writeln!(s, "warnings:    {}", warnings.len());
-        for w in &warnings {
-            let _ = writeln!(s, "  - {w}");
-        }
-    }
+    crate::inspect::warnings_text(&mut s, &warnings);
     s
 }
