@@ -15,6 +15,7 @@ mod edges;
 mod grid;
 mod loops;
 mod model;
+pub mod offset;
 mod options;
 mod triangulate;
 mod uv;
@@ -23,6 +24,7 @@ pub use domain::{face_domain, FaceDomain};
 pub use edges::discretize_edge;
 pub use loops::{loop_roles, LoopRole};
 pub use model::{FaceTriangulation, Mesh};
+pub use offset::{enclosed_volume, offset_mesh, OffsetMesh};
 pub use options::{MeshError, MeshOptions};
 
 use crate::math::P3;
