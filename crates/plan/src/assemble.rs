@@ -204,5 +204,19 @@ fn feature_report(f: LaidFeature, checked: &Checked, program: Option<&Program>) 
         post: program.and_then(|p| p.figures.get(&id)).map(post_entry),
         collision: checked.collisions.get(&id).cloned().unwrap_or_default(),
         pedestal_height_mm: None,
+        machining_allowance: f.allowance.map(|a| crate::report::AllowanceEntry {
+            requested_mm: a.requested,
+            min_mm: round(a.min, 1e3),
+            max_mm: round(a.max, 1e3),
+            samples: a.samples,
+            thinnest_at: a.thinnest_at.map(|x| round(x, 1e3)),
+            grown_volume_mm3: round(f.grown.as_ref().map_or(0.0, |g| g.volume), 1e3),
+            layered_volume_mm3: f
+                .grown
+                .as_ref()
+                .and_then(|g| g.layered_volume)
+                .map(|v| round(v, 1e3)),
+            folds: f.grown.as_ref().map_or(0, |g| g.folds.len()),
+        }),
     }
 }

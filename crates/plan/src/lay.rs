@@ -49,6 +49,11 @@ pub struct LaidFeature {
     /// What holds up its layers (issue 31): measured from the features alone for planar
     /// layers, as laid for curved ones; `None` where nothing was measured.
     pub held: Option<crate::support::Held>,
+    /// The machining allowance its beads leave over its nominal faces (issue 37, item 2);
+    /// `None` without one.
+    pub allowance: Option<slicer::allowance::AllowanceLeft>,
+    /// Its grown solid (volume, folds) with a machining allowance.
+    pub grown: Option<slicer::Grown>,
 }
 
 /// What the lay stage returns.
@@ -83,13 +88,14 @@ pub fn lay(
     let mut cursor: Option<P3> = None;
     let mut features = vec![];
     let mut warnings = vec![];
+    let mut grown = vec![];
     for chunk in extracted.order.chunks(window) {
         crate::in_time(stop_at)?;
         let fills: Vec<Result<_, PlanError>> = chunk
             .par_iter()
             .map(|&slot| {
                 let t = &extracted.assembly.trees[slot.tree];
-                let params = process.params_for(&base, extracted.id(slot))?;
+                let params = process.feature_params(&base, slot.offset, extracted.feature(slot))?;
                 let fill = fill_feature(t, extracted.feature(slot), &params, machine.bead())?;
                 let fill = match columns.get(&extracted.id(slot)) {
                     Some(c) => fill.with_support(c, &params),
@@ -146,17 +152,79 @@ pub fn lay(
             }
             laid.held = held.get(&id).copied();
             warnings.extend(below);
+            if params.machining_allowance > 0.0 {
+                grown.push((features.len(), slot, params.clone()));
+            }
             features.push(laid);
             plans.push((id, plan));
             tell(Progress::FeatureDone);
         }
     }
+    measure_allowance(extracted, &grown, &plans, &mut features)?;
     tell(Progress::Planned);
     Ok(Laid {
         features,
         toolpath: slicer::sequence(plans),
         warnings,
     })
+}
+
+/// The machining allowance the part's beads leave over each grown feature's nominal faces
+/// (issue 37, item 2): `grown` holds each such feature's index in `features`, slot and
+/// parameters. A feature whose offset folded says where.
+fn measure_allowance(
+    extracted: &Extracted,
+    grown: &[(usize, Slot, LayerParams)],
+    plans: &[(usize, FeaturePlan)],
+    features: &mut [LaidFeature],
+) -> Result<(), PlanError> {
+    if grown.is_empty() {
+        return Ok(());
+    }
+    let points: Vec<PathPoint> = plans
+        .iter()
+        .flat_map(|(_, p)| p.points.iter().copied())
+        .collect();
+    let envelope = slicer::allowance::Envelope::new(&points);
+    drop(points);
+    let measured: Vec<Result<_, PlanError>> = grown
+        .par_iter()
+        .map(|(i, slot, params)| {
+            let t = &extracted.assembly.trees[slot.tree];
+            let left = slicer::allowance::allowance_left(
+                t,
+                extracted.feature(*slot),
+                params,
+                &envelope,
+                extracted.plates[slot.tree].as_ref(),
+            )?;
+            Ok((*i, left))
+        })
+        .collect();
+    for m in measured {
+        let (i, left) = m?;
+        let Some(laid) = features.get_mut(i) else {
+            continue;
+        };
+        laid.allowance = left;
+        let id = laid.planned.id;
+        if let Some(g) = plans.get(i).and_then(|p| p.1.figures.grown.clone()) {
+            if let Some(at) = g.folds.first() {
+                laid.warnings.push(Warning::feature(
+                    id,
+                    WarningKind::Planner(format!(
+                        "feature {id}: its machining allowance folds over itself at {} place(s), first near ({:.2}, {:.2}, {:.2}) mm (a concave radius under the allowance): filled there, the allowance larger",
+                        g.folds.len(),
+                        at[0],
+                        at[1],
+                        at[2]
+                    )),
+                ));
+            }
+            laid.grown = Some(g);
+        }
+    }
+    Ok(())
 }
 
 /// Transition layers chosen by `auto` that miss the feature's volume by more than the
@@ -180,7 +248,7 @@ fn offset_if_transition_misses(
     // What the self-check expects: the sparse part at its density, the rest at the fill ratio.
     let fig = &plan.figures;
     let expected = slicer::verify::expected_volume(
-        f.volume,
+        planned_volume(f, &plan.figures),
         params.filling_ratio,
         fig.sparse_volume,
         fig.sparse_density(params.infill_density),
@@ -198,6 +266,12 @@ fn offset_if_transition_misses(
     let t = &extracted.assembly.trees[slot.tree];
     let plan = fill_feature(t, f, &offset_params, bead)?.lay(cursor);
     Ok((plan, Some(rel)))
+}
+
+/// The volume a feature's plan is checked against: its grown solid's where a machining
+/// allowance grew it (issue 37, item 2), else its own.
+fn planned_volume(f: &features::Feature, fig: &slicer::figures::FeatureFigures) -> f64 {
+    fig.grown.as_ref().map_or(f.volume, |g| g.planned_volume())
 }
 
 /// The figures of feature `slot` as laid in `plan`, and the part's warning when it reaches
@@ -240,7 +314,7 @@ fn laid_feature(
         planned: PlannedFeature {
             id,
             kind: f.kind.as_str().to_string(),
-            volume: f.volume,
+            volume: planned_volume(f, fig),
             fill: params.filling_ratio,
             sparse: fig.sparse_volume,
             density: fig.sparse_density(params.infill_density),
@@ -262,6 +336,8 @@ fn laid_feature(
         warnings,
         below_resolution: None,
         held: None,
+        allowance: None,
+        grown: None,
     };
     (laid, below)
 }

@@ -335,6 +335,7 @@ impl Stood {
             post: None,
             collision: Default::default(),
             pedestal_height_mm: Some(round(self.height, 1e6)),
+            machining_allowance: None,
         }
     }
 

@@ -238,6 +238,24 @@ impl Process {
             .map_err(|e| ProcessError(format!("process [orientation]: {e}")))
     }
 
+    /// The layer parameters of feature `f` of a tree whose features are numbered from
+    /// `offset` in the file: [`Process::params_for`], with `base_allowance` the largest
+    /// `machining_allowance` of the features it grows from (issue 37, item 2: it stands on
+    /// their grown faces).
+    pub fn feature_params(
+        &self,
+        base: &LayerParams,
+        offset: usize,
+        f: &features::Feature,
+    ) -> Result<LayerParams, ProcessError> {
+        let mut params = self.params_for(base, offset + f.id)?;
+        for &p in &f.parents {
+            let parent = self.params_for(base, offset + p)?.machining_allowance;
+            params.base_allowance = params.base_allowance.max(parent);
+        }
+        Ok(params)
+    }
+
     /// The layer parameters of feature `id` (file-wide): the defaults with its overrides,
     /// checked.
     pub fn params_for(&self, base: &LayerParams, id: usize) -> Result<LayerParams, ProcessError> {

@@ -196,6 +196,36 @@ pub struct FeatureReport {
     /// The pedestal's height, mm (the `pedestal` feature only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pedestal_height_mm: Option<f64>,
+    /// The machining allowance asked for and left (issue 37, item 2); absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machining_allowance: Option<AllowanceEntry>,
+}
+
+/// A grown feature's machining allowance in `plan.json` (issue 37, item 2): what was asked,
+/// the grown solid planned, and what the beads leave over the nominal faces
+/// ([`slicer::allowance`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AllowanceEntry {
+    /// `machining_allowance`, mm.
+    pub requested_mm: f64,
+    /// Least allowance the beads leave over a nominal face, mm (at least the allowance less
+    /// the tolerance where the plan keeps it).
+    pub min_mm: f64,
+    /// Most, mm.
+    pub max_mm: f64,
+    /// Nominal points measured.
+    pub samples: usize,
+    /// Where the least was measured (nominal point, mm).
+    pub thinnest_at: [f64; 3],
+    /// Volume of the grown solid planned instead of the nominal one, mm³.
+    pub grown_volume_mm3: f64,
+    /// Planar layers: the volume of the layers that cover it (each the union of its sections
+    /// over its thickness, the stair-steps kept outside the allowance), mm³; what the
+    /// self-check expects. `null` for curved layers, checked against the grown solid's.
+    pub layered_volume_mm3: Option<f64>,
+    /// Places where the offset folded over itself (a concave radius under the allowance),
+    /// filled as a larger allowance.
+    pub folds: usize,
 }
 
 /// A feature's colliding moves (issue 18): the moves, print or travel, whose swept head meets

@@ -18,7 +18,8 @@
 //!    limits and no head below its layers. It is also the one candidate tried after a failed
 //!    self-check ([`planar_may_help`]): small split-off features (pins, contacts) that their
 //!    own layers cannot hold are laid with the part around them. Not when the part as
-//!    modelled already is that plan ([`planar_may_help`]).
+//!    modelled already is that plan ([`planar_may_help`]). Also after a curved feature's
+//!    offsets fold (paper, Fig. 9), which planar layers cannot.
 //!
 //! None is planned when no placement can fit the machine: the part as modelled measures
 //! across more than any placement holds ([`robot_post::fit::largest_across`]).
@@ -272,6 +273,9 @@ pub fn planar_may_help(e: &PlanError, process: &Process) -> bool {
             gate: Gate::SelfCheck(_),
             ..
         } => true,
+        // A curved feature's offsets folding (a machining allowance can take its layers past a
+        // valley's radius): planar layers of the whole part have no reference to fold.
+        PlanError::Feature(slicer::planar::FeatureError::OffsetFolds { .. }) => true,
         _ => placement_may_help(e),
     }
 }

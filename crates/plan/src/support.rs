@@ -72,7 +72,7 @@ pub fn planar(
         };
         for f in &t.features {
             let id = offset + f.id;
-            let params = process.params_for(&base, id)?;
+            let params = process.feature_params(&base, offset, f)?;
             let gap = match (lifted, standing[ti]) {
                 (true, Some(z)) => z - plate,
                 _ => 0.0,

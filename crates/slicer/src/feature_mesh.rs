@@ -1,9 +1,10 @@
-//! The mesh a feature is sliced from, and its chord tolerance.
+//! The mesh a feature is sliced from, its chord tolerance, and its growth by a machining
+//! allowance (issue 37, item 2).
 
 use crate::error::FeatureError;
 use crate::params::LayerParams;
 use crate::tolerance::MICROMETRE;
-use brep::mesh::{mesh_faces, MeshOptions};
+use brep::mesh::{enclosed_volume, mesh_faces, offset_mesh, MeshOptions};
 use features::{Feature, FeatureTree};
 
 /// Chord tolerance of the mesh a feature is sliced from: much finer than a layer, since its
@@ -14,12 +15,93 @@ pub(crate) fn slicing_tolerance(params: &LayerParams) -> f64 {
         .max(MICROMETRE)
 }
 
-/// The mesh of a feature's shell and its voids, at chord tolerance `tol`.
+/// How far a feature's mesh is grown for machining (issue 37, item 2), mm: `own` its
+/// `machining_allowance` (every face but the build-plate face, the feature's base and its voids,
+/// outward), `base` its parent's (the base faces, which lie on the parent's face, moved with
+/// that face's offset: into the feature by that much).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Allowance {
+    /// The feature's own faces' offset, mm.
+    pub own: f64,
+    /// Its base faces' lift, mm.
+    pub base: f64,
+}
+
+impl Allowance {
+    /// A feature's allowance from its parameters.
+    pub fn of(params: &LayerParams) -> Allowance {
+        Allowance {
+            own: params.machining_allowance,
+            base: params.base_allowance,
+        }
+    }
+
+    /// The allowance of the feature a feature with `params` grows from (its own faces grown by
+    /// the child's `base_allowance`; its base, far under the child, taken as not lifted).
+    pub fn of_parent(params: &LayerParams) -> Allowance {
+        Allowance {
+            own: params.base_allowance,
+            base: 0.0,
+        }
+    }
+
+    /// The allowance of a solid built before the one with `params` (its own allowance taken
+    /// as this one's, standing on the plate).
+    pub fn of_parent_solid(params: &LayerParams) -> Allowance {
+        Allowance {
+            own: params.machining_allowance,
+            base: 0.0,
+        }
+    }
+
+    /// Nothing is grown.
+    pub fn is_none(&self) -> bool {
+        self.own == 0.0 && self.base == 0.0
+    }
+}
+
+/// What growing a feature by its allowance gave (issue 37, item 2).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Grown {
+    /// The grown solid's volume, mm³: the nominal volume plus what the offset added to the
+    /// mesh (so the mesh's chords count the same in both).
+    pub volume: f64,
+    /// Nominal points where the offset turned a triangle over (a concave radius under the
+    /// allowance): the grown surface crosses itself there and its sections are read by winding.
+    pub folds: Vec<[f64; 3]>,
+    /// Nominal points of knife edges whose mitre was cut back.
+    pub capped: Vec<[f64; 3]>,
+    /// Planar layers only: the volume of the layers that cover the grown solid (each the union
+    /// of its sections over its thickness, `crate::planar`), mm³; more than `volume` by the
+    /// stair-steps they keep outside the allowance. What the self-check expects then.
+    pub layered_volume: Option<f64>,
+}
+
+impl Grown {
+    /// The volume the plan of the grown feature is checked against, mm³: its layers' where
+    /// they cover it, else the grown solid's.
+    pub fn planned_volume(&self) -> f64 {
+        self.layered_volume.unwrap_or(self.volume)
+    }
+}
+
+/// The mesh of a feature's shell and its voids, at chord tolerance `tol`, grown by `allowance`.
 pub(crate) fn feature_mesh(
     tree: &FeatureTree,
     f: &Feature,
     tol: f64,
+    allowance: Allowance,
 ) -> Result<brep::mesh::Mesh, FeatureError> {
+    Ok(grown_mesh(tree, f, tol, allowance)?.0)
+}
+
+/// [`feature_mesh`], and what growing it gave (`None` without an allowance).
+pub(crate) fn grown_mesh(
+    tree: &FeatureTree,
+    f: &Feature,
+    tol: f64,
+    allowance: Allowance,
+) -> Result<(brep::mesh::Mesh, Option<Grown>), FeatureError> {
     let mut faces = f.faces.clone();
     for v in &f.voids {
         faces.extend(v.iter().copied());
@@ -39,8 +121,83 @@ pub(crate) fn feature_mesh(
     if fine.is_finite() && fine < tol {
         mesh = mesh_at(fine.max(MICROMETRE))?;
     }
+    let grown = match allowance.is_none() {
+        true => None,
+        false => {
+            let nominal = enclosed_volume(&mesh);
+            let (m, g) = grow(tree, f, &mesh, allowance);
+            mesh = m;
+            Some(Grown {
+                volume: f.volume + enclosed_volume(&mesh) - nominal,
+                ..g
+            })
+        }
+    };
     orient_voids(&mut mesh, &f.voids);
-    Ok(mesh)
+    Ok((mesh, grown))
+}
+
+/// `mesh` (the feature's, voids not yet turned) offset by `allowance`: the build-plate face and
+/// the voids (closed cavities no cutter reaches) stay, the base faces move in by `base`, every
+/// other face out by `own`.
+fn grow(
+    tree: &FeatureTree,
+    f: &Feature,
+    mesh: &brep::mesh::Mesh,
+    allowance: Allowance,
+) -> (brep::mesh::Mesh, Grown) {
+    let plate = plate_faces(f, mesh);
+    let distance = |face: brep::topology::FaceId| {
+        if plate.contains(&face) || f.voids.iter().any(|v| v.contains(&face)) {
+            0.0
+        } else if f.heal_faces.contains(&face) {
+            -allowance.base
+        } else {
+            allowance.own
+        }
+    };
+    let off = offset_mesh(&tree.brep, mesh, &distance);
+    let xyz = |p: &brep::math::P3| [p.x, p.y, p.z];
+    let grown = Grown {
+        volume: 0.0,
+        folds: off.folds.iter().map(xyz).collect(),
+        capped: off.capped.iter().map(xyz).collect(),
+        layered_volume: None,
+    };
+    (off.mesh, grown)
+}
+
+/// A face of `mesh` this close (mm) to the plate all over lies on it.
+const ON_PLATE_MM: f64 = 1e-4;
+
+/// The faces of feature `f` (meshed as `mesh`) that lie on the build plate: for a feature on the
+/// plate, its reference face and every face whose points all lie at its lowest height along
+/// the build direction (a part sliced whole names no face).
+pub(crate) fn plate_faces(f: &Feature, mesh: &brep::mesh::Mesh) -> Vec<brep::topology::FaceId> {
+    if f.reference.surface != "build_plate" {
+        return vec![];
+    }
+    let mut out: Vec<_> = f.reference.face.into_iter().collect();
+    let Some(n) = f.reference.normal else {
+        return out;
+    };
+    let up = brep::math::V3::new(n[0], n[1], n[2]);
+    let height = |g: &u32| mesh.positions.get(*g as usize).map(|p| p.coords.dot(&up));
+    let low = mesh
+        .positions
+        .iter()
+        .map(|p| p.coords.dot(&up))
+        .fold(f64::INFINITY, f64::min);
+    for t in &mesh.faces {
+        let flat = t
+            .vertex
+            .iter()
+            .all(|g| height(g).is_some_and(|h| h - low <= ON_PLATE_MM));
+        if flat && !t.triangles.is_empty() && !out.contains(&t.face) {
+            out.push(t.face);
+        }
+    }
+    out
 }
 
 /// Each void shell of `voids` turned to face into the void where a file wrote it facing out

@@ -30,6 +30,10 @@ pub struct FeatureFigures {
     /// sliced from (its vertices lie on the exact faces, within the slicing tolerance of the
     /// lowest point of a curved face), so the feature is not meshed a second time for it.
     pub below_plate: f64,
+    /// The solid planned when the feature is grown by a machining allowance (issue 37, item
+    /// 2): its volume (what the self-check expects instead of the nominal one) and where the
+    /// offset folded; `None` for the nominal feature.
+    pub grown: Option<crate::feature_mesh::Grown>,
     /// Things to know.
     pub warnings: Vec<String>,
 }

@@ -31,7 +31,7 @@
 
 use crate::chart::{choose_chart, mapped_mesh, refined, translate_chart, MAX_MAPPED_EDGE};
 use crate::error::FeatureError;
-use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::feature_mesh::{grown_mesh, slicing_tolerance, Allowance};
 use crate::feature_plan::{FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use crate::figures::FreeformFigures;
 use crate::figures::{FeatureFigures, LayerChart, Layering};
@@ -206,7 +206,7 @@ pub fn fill_freeform<'a>(
     // N into the feature: the host face's outward normal (the parent's outside).
     let sign = if b.face(rf).same_sense { 1.0 } else { -1.0 };
     let tol = slicing_tolerance(params);
-    let mesh = feature_mesh(tree, f, tol)?;
+    let (mesh, grown) = grown_mesh(tree, f, tol, Allowance::of(params))?;
     if mesh.positions.is_empty() {
         return Err(err("its mesh is empty".into()));
     }
@@ -229,6 +229,7 @@ pub fn fill_freeform<'a>(
     let spacing = params.spacing(bead.width);
     let mut fig = FeatureFigures {
         below_plate: below,
+        grown,
         ..FeatureFigures::default()
     };
     let mut ff = FreeformFigures {
@@ -483,6 +484,10 @@ impl FreeformFill<'_> {
         let mut cursor = entry;
         let cursor = &mut cursor;
         let mut prev_regions: Vec<Region> = vec![];
+        // Whether a layer below had material: a feature standing on its parent's face grown by
+        // a machining allowance (`base_allowance`) has none under that height, and its first
+        // layer with material rests on that grown face as layer 0 rests on the reference.
+        let mut laid_any = false;
         // A band of transition layers over offset layers: each point of its first layer rests
         // on the last offset layer laid there (the offset layers stop where the band takes
         // over, point by point), so it is held by any of them, not by the last one alone.
@@ -508,6 +513,8 @@ impl FreeformFill<'_> {
                 offset_regions.extend(regions.iter().cloned());
             }
             let held_by = (banded && layer == offset_layers).then_some(&offset_regions);
+            let on_reference = layer == 0 || (params.base_allowance > 0.0 && !laid_any);
+            laid_any |= !regions.is_empty();
             let below = std::mem::replace(&mut prev_regions, regions);
             let start = cursor
                 .and_then(|c| chart.inverse(&c).map(|(q, _)| q))
@@ -519,7 +526,7 @@ impl FreeformFill<'_> {
             };
             // Each path lifted onto the layer and its unsupported points counted, in parallel.
             let support = Support {
-                layer,
+                on_reference,
                 below: below.as_slice(),
                 held_by: held_by.map(|r| r.as_slice()),
                 reach: reach(dl, params.overhang_angle_deg),
@@ -666,8 +673,9 @@ fn lift_paths(
 /// under it.
 #[derive(Clone, Copy)]
 struct Support<'a> {
-    /// The layer's index (0: the first, on the reference face).
-    layer: usize,
+    /// The layer rests on the reference face (the first layer, or the first with material over
+    /// a parent's grown face).
+    on_reference: bool,
     /// The regions of the layer below.
     below: &'a [Region],
     /// The offset layers' regions under the first transition layer, if this is it.
@@ -684,7 +692,7 @@ impl Support<'_> {
         let mut unheld = 0;
         let mut unsupported = 0.0;
         for (i, x) in pts.iter().enumerate() {
-            let (off, limit) = if self.layer == 0 {
+            let (off, limit) = if self.on_reference {
                 let off = if chart.on_face(x.q) {
                     0.0
                 } else {

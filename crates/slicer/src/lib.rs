@@ -18,6 +18,8 @@
 //!   (one region of a curved or thin planar layer filled with beads of varying width, shared
 //!   by both planners), `lift` (chart paths onto a curved layer), `feature_mesh`, `tolerance`,
 //!   `skins` (the solid skins of planar layers, from their neighbours' sections);
+//! - [`allowance`]: the machining allowance a plan leaves over a grown feature's nominal
+//!   faces (its bead envelope measured);
 //! - [`orient`]: tool-axis smoothing inside a tolerance cone;
 //! - [`support`]: what holds each layer up (the overhang limit), from the features alone;
 //! - [`support_material`]: columns of support under what the overhang limit leaves unheld;
@@ -33,6 +35,7 @@
 
 #![warn(missing_docs)]
 
+pub mod allowance;
 mod chart;
 pub mod error;
 mod fast_hash;
@@ -66,6 +69,7 @@ pub use toolpath;
 pub use toolpath::vec3;
 
 pub use feature_fill::{fill_feature, FeatureFill};
+pub use feature_mesh::{Allowance, Grown};
 pub use feature_plan::{sequence, FeaturePlan, Layer, LayerPath, LayerSurface};
 pub use fill::{fill_layer, order_paths, regions_from_loops, Path2, PathKind, Point2, Region};
 pub use params::{InfillPattern, LayerHeightPattern, LayerParams, LayerParamsPatch, PathMode};

@@ -27,6 +27,9 @@ pub const MAX_OVERHANG_ANGLE_DEG: f64 = 90.0;
 /// Widest brim and farthest skirt (`brim_width_mm`, `skirt_distance_mm`), mm.
 pub const MAX_ADHESION_MM: f64 = 100.0;
 
+/// Largest `machining_allowance`, mm: more is a different part, not a workblank of this one.
+pub const MAX_MACHINING_ALLOWANCE: f64 = 50.0;
+
 /// Most skirt loops (`skirt_loops`).
 pub const MAX_SKIRT_LOOPS: usize = 100;
 
@@ -225,6 +228,9 @@ fn is_default_bottom(n: &usize) -> bool {
 fn is_default_below_area(a: &f64) -> bool {
     *a == DEFAULT_SOLID_INFILL_BELOW_AREA
 }
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
 
 /// Layer and path parameters of one feature.
 ///
@@ -329,6 +335,18 @@ pub struct LayerParams {
     /// How the part is cut into what is planned ([`Slicing`]); the part's, so set in
     /// `[defaults]` only. Default `auto`.
     pub slicing: Slicing,
+    /// Machining allowance, mm (issue 37, item 2; the seed's `tolerance` read as "the
+    /// machining allowance for the following post-process"): the feature's faces, but those on
+    /// the build plate and those it grows from, are offset outward by this on their exact
+    /// surfaces, neighbouring faces extended or trimmed to meet, and that grown solid is
+    /// planned (`brep::mesh::offset`). Default 0 (the nominal part).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub machining_allowance: f64,
+    /// How far the feature's base lies above its reference surface: the `machining_allowance`
+    /// of the feature it grows from, whose offset face it then stands on. Set by the planner
+    /// from the parent's parameters, never read from a file.
+    #[serde(skip)]
+    pub base_allowance: f64,
 }
 
 impl Default for LayerParams {
@@ -368,6 +386,8 @@ impl Default for LayerParams {
             brim_width_mm: 0.0,
             arc_fitting: false,
             slicing: Slicing::Auto,
+            machining_allowance: 0.0,
+            base_allowance: 0.0,
         }
     }
 }
@@ -605,6 +625,12 @@ impl LayerParams {
                 self.skirt_loops
             ));
         }
+        let m = self.machining_allowance;
+        if !(m.is_finite() && (0.0..=MAX_MACHINING_ALLOWANCE).contains(&m)) {
+            return Err(format!(
+                "machining_allowance must be 0 to {MAX_MACHINING_ALLOWANCE} mm, got {m}"
+            ));
+        }
         if let Some(a) = self.fixed_tool_axis {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if !(n.is_finite() && n > ZERO_AXIS) {
@@ -721,6 +747,9 @@ impl LayerParams {
         if let Some(v) = p.slicing {
             out.slicing = v;
         }
+        if let Some(v) = p.machining_allowance {
+            out.machining_allowance = v;
+        }
         out
     }
 }
@@ -833,6 +862,9 @@ pub struct LayerParamsPatch {
     /// Overrides [`LayerParams::slicing`] (`[defaults]` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub slicing: Option<Slicing>,
+    /// Overrides [`LayerParams::machining_allowance`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machining_allowance: Option<f64>,
 }
 
 #[cfg(test)]

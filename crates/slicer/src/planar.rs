@@ -6,7 +6,7 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
-use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::feature_mesh::{grown_mesh, slicing_tolerance, Allowance, Grown};
 use crate::fill::{
     fill_layer_with, order_greedy, regions_from_loops, thinner_than, Region, SparseLayer,
 };
@@ -255,11 +255,12 @@ pub fn fill_two5d(
     params
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
-    let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
+    let (plane, (mesh, grown), top) = plane_grown_mesh_top(tree, f, params)?;
     let heights = two5d_layer_heights(params, &mesh, &plane, top);
     let spacing = params.spacing(bead.width);
     let fig = FeatureFigures {
         below_plate: below_plate(tree, &mesh.positions),
+        grown,
         ..FeatureFigures::default()
     };
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
@@ -270,13 +271,30 @@ pub fn fill_two5d(
         tops.push((z + 0.5 * dl, z + dl, dl));
         z += dl;
     }
+    let covering = fig.grown.is_some();
     let sections: Vec<Vec<Region>> = tops
         .par_iter()
-        .map(|&(mid, _, _)| {
-            let cut = plane.offset(mid);
-            section_regions(&mesh, &cut, &cut)
+        .map(|&(mid, top, dl)| {
+            let at = |z: f64| {
+                let cut = plane.offset(z);
+                section_regions(&mesh, &cut, &cut)
+            };
+            match covering {
+                false => at(mid),
+                true => covering_section(at, (mid, top, dl)),
+            }
         })
         .collect();
+    let mut fig = fig;
+    if let Some(g) = fig.grown.as_mut() {
+        g.layered_volume = Some(
+            sections
+                .iter()
+                .zip(&tops)
+                .map(|(rs, t)| rs.iter().map(region_area).sum::<f64>() * t.2)
+                .sum(),
+        );
+    }
     let mids: Vec<f64> = tops.iter().map(|t| t.0).collect();
     let (filled, sparse) = fill_sections(sections, &mids, params, bead.width, spacing);
     Ok(Two5dFill {
@@ -288,6 +306,26 @@ pub fn fill_two5d(
         sparse,
         fig,
     })
+}
+
+/// Where a layer's sections are taken near its bottom and top, as a share of its thickness in
+/// from them ([`covering_section`]).
+const COVER_INSET: f64 = 0.02;
+
+/// A layer of a feature grown by a machining allowance (issue 37, item 2): what its sections
+/// at its middle, near its bottom and near its top (`at` each height; the layer's middle, top
+/// and thickness given) cover together, so that the layer holds the grown solid over its whole
+/// thickness and a stair-step never eats into the allowance where a face slopes (a section at
+/// the middle alone leaves `h/2·cos α` of it uncovered on a face at α from the layers). The
+/// union (non-zero) also reads the grown mesh's trimmed folds as the solid they bound.
+fn covering_section(
+    at: impl Fn(f64) -> Vec<Region>,
+    (mid, top, dl): (f64, f64, f64),
+) -> Vec<Region> {
+    let inset = COVER_INSET * dl;
+    let mut r = crate::fill::union(&at(mid), &at(top - dl + inset));
+    r = crate::fill::union(&r, &at(top - inset));
+    r
 }
 
 /// The outline of a tree's build-plate face: the section of its base feature `f` (a two5d
@@ -307,15 +345,37 @@ pub fn plate_regions(
 }
 
 /// A two5d feature's reference plane, its mesh at the slicing tolerance, and its top: the
-/// height of its highest mesh point over the plane ([`mesh_and_top`]).
+/// height of its highest mesh point over the plane.
 pub(crate) fn plane_mesh_top(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
 ) -> Result<(Plane, brep::mesh::Mesh, f64), FeatureError> {
-    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
-    let (mesh, top) = mesh_and_top(tree, f, params, &plane)?;
+    let (plane, (mesh, _), top) = plane_grown_mesh_top(tree, f, params)?;
     Ok((plane, mesh, top))
+}
+
+/// A feature's mesh and what growing it by its machining allowance gave.
+type GrownMesh = (brep::mesh::Mesh, Option<Grown>);
+
+/// [`plane_mesh_top`] with what growing the feature by its machining allowance gave. A feature
+/// standing on its parent's grown face (`base_allowance`) has its layers' plane lifted onto
+/// that face.
+fn plane_grown_mesh_top(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+) -> Result<(Plane, GrownMesh, f64), FeatureError> {
+    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
+    let lift = params.base_allowance;
+    let plane = plane.offset(lift);
+    let (mesh, grown) = grown_mesh(tree, f, slicing_tolerance(params), Allowance::of(params))?;
+    let top = mesh
+        .positions
+        .iter()
+        .map(|p| plane.height(p))
+        .fold(0.0f64, f64::max);
+    Ok((plane, (mesh, grown), top))
 }
 
 /// The faces of a mesh whose points lie within this of one height over the layers' plane
@@ -347,22 +407,6 @@ pub(crate) fn two5d_layer_heights(
         }
     }
     params.layer_heights_through(top, &steps)
-}
-
-/// A feature's mesh at the slicing tolerance, and the height of its highest point over `plane`.
-pub(crate) fn mesh_and_top(
-    tree: &FeatureTree,
-    f: &Feature,
-    params: &LayerParams,
-    plane: &Plane,
-) -> Result<(brep::mesh::Mesh, f64), FeatureError> {
-    let mesh = feature_mesh(tree, f, slicing_tolerance(params))?;
-    let top = mesh
-        .positions
-        .iter()
-        .map(|p| plane.height(p))
-        .fold(0.0f64, f64::max);
-    Ok((mesh, top))
 }
 
 /// The regions of `mesh`'s section by the plane `cut`, in the 2-D frame of `frame` (a plane

@@ -38,10 +38,10 @@ pub fn narrow_sections(
     if f.kind != FeatureKind::Two5d || limit.is_nan() || limit <= 0.0 {
         return Ok(None);
     }
-    let Some(plane) = reference_plane(tree, f) else {
+    if reference_plane(tree, f).is_none() {
         return Ok(None);
-    };
-    let (mesh, top) = crate::planar::mesh_and_top(tree, f, params, &plane)?;
+    }
+    let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
     let mut mids = vec![];
     let mut z = 0.0;
     for dl in crate::planar::two5d_layer_heights(params, &mesh, &plane, top) {

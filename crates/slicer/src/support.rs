@@ -16,7 +16,7 @@
 //! feature's mesh at each layer's middle, as the planar planner does, and stops there).
 
 use crate::error::FeatureError;
-use crate::feature_mesh::{feature_mesh, slicing_tolerance};
+use crate::feature_mesh::{feature_mesh, slicing_tolerance, Allowance};
 use crate::fill::{outside_grown, pieces_outside};
 use crate::geom2d::{region_area, Region};
 use crate::params::{LayerParams, SupportMaterial};
@@ -182,7 +182,9 @@ pub fn planar_support(
             let cut = plane.offset(-0.5 * h0);
             let mut regions = vec![];
             for (t, g) in under {
-                regions.extend(section_regions(&feature_mesh(t, g, tol)?, &cut));
+                // The parents as grown by their allowance, which lifted this feature's base.
+                let mesh = feature_mesh(t, g, tol, Allowance::of_parent(params))?;
+                regions.extend(section_regions(&mesh, &cut));
             }
             Some(regions)
         }

@@ -16,7 +16,7 @@
 //!   gap support leaves under a held surface): no column is built under it.
 
 use crate::error::FeatureError;
-use crate::feature_mesh::feature_mesh;
+use crate::feature_mesh::{feature_mesh, Allowance};
 use crate::fill::{union, Region};
 use crate::params::LayerParams;
 use crate::tolerance::HEIGHT_SLACK;
@@ -87,7 +87,8 @@ pub fn below(
     }
     let meshes = earlier
         .iter()
-        .map(|(t, g)| feature_mesh(t, g, tol))
+        // Grown by this solid's allowance (each solid's own is not known here).
+        .map(|(t, g)| feature_mesh(t, g, tol, Allowance::of_parent_solid(params)))
         .collect::<Result<Vec<_>, _>>()?;
     // Each layer's middle over the plane (negative: below it).
     let mut mids = Vec::with_capacity(heights.len());

@@ -1,0 +1,305 @@
+//! The machining allowance a plan leaves (issue 37, item 2): how much bead lies over each
+//! nominal face of a feature grown by `machining_allowance`, measured on the planned path.
+//!
+//! The bead envelope is the union of the planned print segments' beads: a segment from `a` to
+//! `b` lays a bead `width` wide across and `thickness` deep under the nozzle tip along the tool
+//! axis (Isa & Lazoglu 2019, Eq. 1's rectangular section). The allowance left at a point `p` of
+//! a nominal outer face is the radius of the largest ball around `p` inside the envelope: the
+//! nearest way out, taken over rays leaving `p` within [`RAY_CONE_DEG`] of the face's outward
+//! normal (a ray into the feature meets its own infill, which need not be solid), each marched
+//! in steps of [`STEP_MM`] to its last point in a bead, with the envelope closed over a layer's
+//! inner slivers ([`CLOSING_SHARE`]). Over a face the rays' least exit is the
+//! normal's; at a concave corner between a feature and its parent it is the way out past the
+//! corner. Points are the nominal mesh's vertices on the feature's own faces (not the
+//! build-plate face, not the faces it grows from, not voids).
+
+use crate::error::FeatureError;
+use crate::feature_mesh::{feature_mesh, plate_faces, slicing_tolerance, Allowance};
+use crate::params::LayerParams;
+use crate::toolpath::{MoveKind, PathPoint, Role};
+use brep::math::{P3, V3};
+use brep::section::Plane;
+use features::{Feature, FeatureTree};
+use std::collections::HashMap;
+
+/// Step of the march along each ray, mm: the measured allowance is within half of it.
+pub const STEP_MM: f64 = 0.02;
+/// Rays leave a point within this of its outward normal, degrees.
+pub const RAY_CONE_DEG: f64 = 70.0;
+/// Most points measured per feature (the vertices are taken at an even stride).
+const MAX_SAMPLES: usize = 1500;
+/// Each bead is taken larger by this share of the widest bead, and every exit that much
+/// shorter: the envelope closed over the slivers a layer leaves between its perimeters and its
+/// infill's turns (0.14 mm across at a boss's rim, 0.3 mm in a hub's top skin at its rim),
+/// which the flowing bead fills and which are not outside the part. Beads of neighbouring
+/// layers then also overlap on the surface they share.
+pub const CLOSING_SHARE: f64 = 0.5;
+/// A point this far out of a face that lies in a child feature is covered by it, mm.
+const INSIDE_PROBE_MM: f64 = 0.05;
+/// Side of the envelope's grid cells, mm.
+const CELL_MM: f64 = 1.0;
+
+/// The allowance a plan leaves over a feature's nominal faces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AllowanceLeft {
+    /// `machining_allowance` asked for, mm.
+    pub requested: f64,
+    /// Least allowance left over any measured point, mm.
+    pub min: f64,
+    /// Most, mm (a ray still in material at `requested` + 2 × bead width + 1 mm stops there).
+    pub max: f64,
+    /// Points measured.
+    pub samples: usize,
+    /// The nominal point where the least was measured.
+    pub thinnest_at: [f64; 3],
+}
+
+/// One print segment's bead.
+#[derive(Debug, Clone, Copy)]
+struct Bead {
+    a: P3,
+    b: P3,
+    axis: V3,
+    half_width: f64,
+    thickness: f64,
+}
+
+impl Bead {
+    /// Whether `x` lies in the bead grown by `closing` (module docs).
+    fn holds(&self, x: &P3, closing: f64) -> bool {
+        let h = (x - self.b).dot(&self.axis);
+        if !(-self.thickness - closing..=closing).contains(&h) {
+            return false;
+        }
+        let xp = x - self.axis * h;
+        let ap = self.a - self.axis * (self.a - self.b).dot(&self.axis);
+        let ab = self.b - ap;
+        let len2 = ab.norm_squared();
+        let t = if len2 > 0.0 {
+            ((xp - ap).dot(&ab) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (xp - (ap + ab * t)).norm() <= self.half_width + closing
+    }
+}
+
+/// The beads of a planned path on a grid, for "is this point in material".
+pub struct Envelope {
+    beads: Vec<Bead>,
+    cells: HashMap<[i32; 3], Vec<u32>>,
+    widest: f64,
+    /// How much larger each bead is taken ([`CLOSING_SHARE`] of the widest), mm.
+    closing: f64,
+}
+
+fn cell_of(p: &P3) -> [i32; 3] {
+    [
+        (p.x / CELL_MM).floor() as i32,
+        (p.y / CELL_MM).floor() as i32,
+        (p.z / CELL_MM).floor() as i32,
+    ]
+}
+
+impl Envelope {
+    /// The envelope of the print moves of `points` (the part's, support left out).
+    pub fn new(points: &[PathPoint]) -> Envelope {
+        let mut beads = vec![];
+        for w in points.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let part = !(b.role.is_support() || matches!(b.role, Role::Skirt | Role::Brim));
+            if b.kind != MoveKind::Print || !part || b.width <= 0.0 {
+                continue;
+            }
+            let axis = V3::from(b.axis);
+            let Some(axis) = axis.try_normalize(1e-12) else {
+                continue;
+            };
+            beads.push(Bead {
+                a: P3::from(a.p),
+                b: P3::from(b.p),
+                axis,
+                half_width: 0.5 * b.width,
+                thickness: b.thickness,
+            });
+        }
+        let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        let widest = beads
+            .iter()
+            .map(|b| 2.0 * b.half_width)
+            .fold(0.0f64, f64::max);
+        let closing = CLOSING_SHARE * widest;
+        for (i, bd) in beads.iter().enumerate() {
+            let r = bd.half_width.max(bd.thickness) + closing;
+            let lo = P3::new(
+                bd.a.x.min(bd.b.x) - r,
+                bd.a.y.min(bd.b.y) - r,
+                bd.a.z.min(bd.b.z) - r,
+            );
+            let hi = P3::new(
+                bd.a.x.max(bd.b.x) + r,
+                bd.a.y.max(bd.b.y) + r,
+                bd.a.z.max(bd.b.z) + r,
+            );
+            let (l, h) = (cell_of(&lo), cell_of(&hi));
+            for x in l[0]..=h[0] {
+                for y in l[1]..=h[1] {
+                    for z in l[2]..=h[2] {
+                        cells.entry([x, y, z]).or_default().push(i as u32);
+                    }
+                }
+            }
+        }
+        Envelope {
+            beads,
+            cells,
+            widest,
+            closing,
+        }
+    }
+
+    /// Whether `x` lies in some bead.
+    pub fn holds(&self, x: &P3) -> bool {
+        self.cells.get(&cell_of(x)).is_some_and(|ix| {
+            ix.iter()
+                .any(|&i| self.beads[i as usize].holds(x, self.closing))
+        })
+    }
+
+    /// How far a ray from `p` along `dir` runs before it leaves material for good, up to
+    /// `reach`: its last point in a bead (the voids a layer leaves inside, between a perimeter
+    /// and the infill's turns, are passed through: they are not outside the part). A ray that
+    /// reaches the build plate `plate` first counts as `reach`: no cutter comes from under the
+    /// plate.
+    fn exit(&self, p: &P3, dir: &V3, reach: f64, plate: Option<&Plane>) -> f64 {
+        let mut last = 0.0;
+        let mut s = STEP_MM;
+        while s < reach {
+            let x = p + dir * s;
+            if plate.is_some_and(|pl| pl.height(&x) < 0.0) {
+                return reach;
+            }
+            if self.holds(&x) {
+                last = s;
+            }
+            s += STEP_MM;
+        }
+        (last + 0.5 * STEP_MM).min(reach)
+    }
+
+    /// [`Envelope::exit`] less the closing: the distance to the beads' own boundary.
+    fn exit_unclosed(&self, p: &P3, dir: &V3, reach: f64, plate: Option<&Plane>) -> f64 {
+        (self.exit(p, dir, reach + self.closing, plate) - self.closing).max(0.0)
+    }
+}
+
+/// The allowance the beads of `envelope` leave over feature `f`'s nominal faces (module docs),
+/// the tree standing on `plate`; `None` when the feature is not grown or has no face to
+/// measure.
+pub fn allowance_left(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    envelope: &Envelope,
+    plate: Option<&Plane>,
+) -> Result<Option<AllowanceLeft>, FeatureError> {
+    let requested = params.machining_allowance;
+    if requested <= 0.0 {
+        return Ok(None);
+    }
+    let mesh = feature_mesh(tree, f, slicing_tolerance(params), Allowance::default())?;
+    let b = &tree.brep;
+    let on_plate = plate_faces(f, &mesh);
+    let own = |face| {
+        !on_plate.contains(&face)
+            && !f.heal_faces.contains(&face)
+            && !f.voids.iter().any(|v| v.contains(&face))
+    };
+    // Vertices of faces that are not the feature's own (its base, the plate) are left out:
+    // the allowance there is the neighbour's.
+    let mut foreign = vec![false; mesh.positions.len()];
+    for t in mesh.faces.iter().filter(|t| !own(t.face)) {
+        for &g in &t.vertex {
+            foreign[g as usize] = true;
+        }
+    }
+    let mut samples: Vec<(P3, V3)> = vec![];
+    let mut seen = vec![false; mesh.positions.len()];
+    for t in mesh.faces.iter().filter(|t| own(t.face)) {
+        let surf = b.face_surface(t.face);
+        let sense = if b.face(t.face).same_sense { 1.0 } else { -1.0 };
+        for (&g, uv) in t.vertex.iter().zip(&t.uv) {
+            let g = g as usize;
+            if foreign[g] || seen[g] {
+                continue;
+            }
+            seen[g] = true;
+            if let Some(n) = surf.normal(uv[0], uv[1]) {
+                samples.push((mesh.positions[g], n * sense));
+            }
+        }
+    }
+    // Where a feature grows from this one its face is inside the part: not measured.
+    let children = tree
+        .features
+        .iter()
+        .filter(|g| g.parents.contains(&f.id))
+        .map(|g| feature_mesh(tree, g, slicing_tolerance(params), Allowance::default()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let boxes: Vec<_> = children.iter().map(|m| m.bbox()).collect();
+    samples.retain(|(p, n)| {
+        let q = p + n * INSIDE_PROBE_MM;
+        !children
+            .iter()
+            .zip(&boxes)
+            .any(|(m, b)| in_box(b, &q) && m.winding_number(&q) > 0.5)
+    });
+    if samples.is_empty() {
+        return Ok(None);
+    }
+    let stride = samples.len().div_ceil(MAX_SAMPLES);
+    let reach = requested + 2.0 * envelope.widest + 1.0;
+    let measured: Vec<(f64, P3)> = samples
+        .iter()
+        .step_by(stride)
+        .map(|(p, n)| (nearest_exit(envelope, (p, n), reach, plate), *p))
+        .collect();
+    let (min, at) = measured
+        .iter()
+        .fold((f64::INFINITY, P3::origin()), |m, &(a, p)| {
+            if a < m.0 {
+                (a, p)
+            } else {
+                m
+            }
+        });
+    let max = measured.iter().map(|m| m.0).fold(0.0f64, f64::max);
+    Ok(Some(AllowanceLeft {
+        requested,
+        min,
+        max,
+        samples: measured.len(),
+        thinnest_at: [at.x, at.y, at.z],
+    }))
+}
+
+fn in_box(b: &brep::math::Aabb, q: &P3) -> bool {
+    (0..3).all(|k| b.min[k] <= q[k] && q[k] <= b.max[k])
+}
+
+/// The least exit over rays from `p` within [`RAY_CONE_DEG`] of `n`: the normal, and rings of
+/// 8 at a third, two thirds and all of the cone's angle.
+fn nearest_exit(envelope: &Envelope, (p, n): (&P3, &V3), reach: f64, plate: Option<&Plane>) -> f64 {
+    let u = brep::math::any_perpendicular(n);
+    let v = n.cross(&u);
+    let mut best = envelope.exit_unclosed(p, n, reach, plate);
+    for ring in 1..=3 {
+        let tilt = (RAY_CONE_DEG * ring as f64 / 3.0).to_radians();
+        for k in 0..8 {
+            let phi = std::f64::consts::TAU * (k as f64 + 0.5 * (ring % 2) as f64) / 8.0;
+            let dir = n * tilt.cos() + (u * phi.cos() + v * phi.sin()) * tilt.sin();
+            best = best.min(envelope.exit_unclosed(p, &dir, best, plate));
+        }
+    }
+    best
+}
