@@ -30,25 +30,40 @@ struct Bead {
 
 /// Plans `step` with the allowance on `machine`; the plan.json and the print points.
 fn plan(step: &str, machine: &str, scratch: &Scratch) -> (Value, Vec<Bead>) {
+    let (report, out, _) = plan_with(step, machine, ALLOWANCE, scratch);
+    (report, beads_of(&out))
+}
+
+/// Plans `step` on `machine` with `machining_allowance = allowance` (none for 0): plan.json,
+/// the output folder and stderr.
+fn plan_with(
+    step: &str,
+    machine: &str,
+    allowance: f64,
+    scratch: &Scratch,
+) -> (Value, std::path::PathBuf, String) {
     let out = scratch.path(&format!("{machine}_{}", step.replace(".step", "")));
-    let o = Command::new(BIN)
-        .args([
-            "plan",
-            fixture(step).to_str().unwrap(),
-            "--machine",
-            machine,
-        ])
-        .args(["--set", &format!("machining_allowance={ALLOWANCE}")])
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("runs");
+    let mut cmd = Command::new(BIN);
+    cmd.args([
+        "plan",
+        fixture(step).to_str().unwrap(),
+        "--machine",
+        machine,
+    ]);
+    if allowance > 0.0 {
+        cmd.args(["--set", &format!("machining_allowance={allowance}")]);
+    }
+    let o = cmd.arg("-o").arg(&out).output().expect("runs");
     assert!(o.status.success(), "{step} on {machine}: {}", stderr(&o));
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    (report, out, stderr(&o))
+}
+
+/// The print points of the plan written to `out`.
+fn beads_of(out: &std::path::Path) -> Vec<Bead> {
     let csv = std::fs::read_to_string(out.join("toolpath.csv")).unwrap();
-    let beads = csv
-        .lines()
+    csv.lines()
         .skip(1)
         .filter_map(|l| {
             let c: Vec<&str> = l.split(',').collect();
@@ -59,8 +74,7 @@ fn plan(step: &str, machine: &str, scratch: &Scratch) -> (Value, Vec<Bead>) {
                 role: c[12].to_string(),
             })
         })
-        .collect();
-    (report, beads)
+        .collect()
 }
 
 fn allowance(f: &Value) -> &Value {
@@ -173,16 +187,7 @@ fn plate_boss_boss_is_printed_a_millimetre_oversize_on_every_face_but_the_plate(
 #[test]
 fn without_an_allowance_the_report_says_nothing_of_it() {
     let scratch = Scratch::new("allowance_none");
-    let out = scratch.path("pbb");
-    let o = Command::new(BIN)
-        .args(["plan", fixture("plate_boss_boss.step").to_str().unwrap()])
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("runs");
-    assert!(o.status.success(), "{}", stderr(&o));
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    let (report, _, _) = plan_with("plate_boss_boss.step", "marlin", 0.0, &scratch);
     for f in report["features"].as_array().unwrap() {
         assert!(f.get("machining_allowance").is_none(), "{f}");
     }
@@ -264,22 +269,11 @@ fn a_fillet_under_the_allowance_folds_and_is_filled_larger_never_less() {
     // boss_fillet: a boss on a plate with a concave fillet of radius 2 at its root. Grown by
     // 3 mm the fillet's offset folds over itself: the plan says where and fills it.
     let scratch = Scratch::new("allowance_fold");
-    let out = scratch.path("bf");
-    let o = Command::new(BIN)
-        .args(["plan", fixture("boss_fillet.step").to_str().unwrap()])
-        .args(["--set", "machining_allowance=3"])
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("runs");
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let (report, _, err) = plan_with("boss_fillet.step", "marlin", 3.0, &scratch);
     assert!(
         err.contains("machining allowance folds over itself") && err.contains("first near ("),
         "{err}"
     );
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
     let boss = &report["features"][1]["machining_allowance"];
     assert!(boss["folds"].as_u64().unwrap() > 0, "{boss}");
     assert!(num(&boss["min_mm"]) >= 3.0 - TOLERANCE, "{boss}");
