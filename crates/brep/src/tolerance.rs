@@ -83,3 +83,15 @@ pub const CLOSED_PROFILE: f64 = 1e-7;
 /// The 2 × 2 normal equations of a surface projection are singular where the determinant is
 /// below this fraction of the product of their diagonal.
 pub const SINGULAR_DET_RELATIVE: f64 = 1e-18;
+
+/// Two unit normals closer than this (`1 − cos`) at a mesh vertex are one (the faces are
+/// tangent there): an offset moves the vertex once along it (`mesh::offset`).
+pub const OFFSET_TANGENT: f64 = 1e-7;
+
+/// An offset's mitre drops the directions where the eigenvalues of `NᵀN` fall below this share
+/// of the largest: the faces constrain no move along them (`mesh::offset`).
+pub const OFFSET_RANK_CUTOFF: f64 = 1e-9;
+
+/// An offset's slide of a face's edge along the face shorter than this, mm, is none
+/// (`mesh::offset`).
+pub const SLIDE_ZERO: f64 = 1e-9;

@@ -16,6 +16,7 @@
 use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, plate_faces, slicing_tolerance, Allowance};
 use crate::params::LayerParams;
+use crate::tolerance::SHORT_VECTOR;
 use crate::toolpath::{MoveKind, PathPoint, Role};
 use brep::math::{P3, V3};
 use brep::section::Plane;
@@ -112,7 +113,7 @@ impl Envelope {
                 continue;
             }
             let axis = V3::from(b.axis);
-            let Some(axis) = axis.try_normalize(1e-12) else {
+            let Some(axis) = axis.try_normalize(SHORT_VECTOR) else {
                 continue;
             };
             beads.push(Bead {

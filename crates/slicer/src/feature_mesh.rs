@@ -2,6 +2,7 @@
 //! allowance (issue 37, item 2).
 
 use crate::error::FeatureError;
+use crate::geom2d::Region;
 use crate::params::LayerParams;
 use crate::tolerance::MICROMETRE;
 use brep::mesh::{enclosed_volume, mesh_faces, offset_mesh, MeshOptions};
@@ -165,6 +166,26 @@ fn grow(
         layered_volume: None,
     };
     (off.mesh, grown)
+}
+
+/// Where a layer's sections are taken near its bottom and top, as a share of its thickness in
+/// from them ([`covering_section`]).
+const COVER_INSET: f64 = 0.02;
+
+/// A layer of a feature grown by a machining allowance (issue 37, item 2): what its sections
+/// at its middle, near its bottom and near its top (`at` each height; the layer's middle, top
+/// and thickness given) cover together, so that the layer holds the grown solid over its whole
+/// thickness and a stair-step never eats into the allowance where a face slopes (a section at
+/// the middle alone leaves `h/2·cos α` of it uncovered on a face at α from the layers). The
+/// union (non-zero) also reads the grown mesh's trimmed folds as the solid they bound.
+pub(crate) fn covering_section(
+    at: impl Fn(f64) -> Vec<Region>,
+    (mid, top, dl): (f64, f64, f64),
+) -> Vec<Region> {
+    let inset = COVER_INSET * dl;
+    let mut r = crate::fill::union(&at(mid), &at(top - dl + inset));
+    r = crate::fill::union(&r, &at(top - inset));
+    r
 }
 
 /// A face of `mesh` this close (mm) to the plate all over lies on it.

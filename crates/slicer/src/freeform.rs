@@ -484,9 +484,8 @@ impl FreeformFill<'_> {
         let mut cursor = entry;
         let cursor = &mut cursor;
         let mut prev_regions: Vec<Region> = vec![];
-        // Whether a layer below had material: a feature standing on its parent's face grown by
-        // a machining allowance (`base_allowance`) has none under that height, and its first
-        // layer with material rests on that grown face as layer 0 rests on the reference.
+        // A layer below had material (a feature on a parent grown by `base_allowance` has none
+        // under that height: its first layer with some rests on the grown face, as layer 0).
         let mut laid_any = false;
         // A band of transition layers over offset layers: each point of its first layer rests
         // on the last offset layer laid there (the offset layers stop where the band takes
@@ -592,19 +591,40 @@ impl FreeformFill<'_> {
             }
             layers.extend(layer_of(layer, (dl, z), levels.is_some(), layer_paths));
         }
-        let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
-        fig.finish(id, points.len(), &printed);
-        if blend.is_some() && spread.3 > 0 {
-            fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
-        }
-        lay_warnings(&mut fig, id, against, &ff);
-        FeaturePlan {
-            feature: id,
-            points,
-            layers,
-            figures: fig,
-            freeform: Some(ff),
-        }
+        finished(
+            id,
+            (points, layers),
+            (fig, ff),
+            blend.is_some(),
+            spread,
+            against,
+        )
+    }
+}
+
+/// Feature `id`'s plan from its laid `points` and `layers`: its figures finished (the thickness
+/// `spread` of its points where the layers are `blended`), with the warnings of `against` (fixed
+/// axes pointing against the layers' growth).
+fn finished(
+    id: usize,
+    (points, layers): (Vec<PathPoint>, Vec<Layer>),
+    (mut fig, ff): (FeatureFigures, FreeformFigures),
+    blended: bool,
+    spread: (f64, f64, f64, usize),
+    against: (usize, f64),
+) -> FeaturePlan {
+    let printed: Vec<f64> = layers.iter().map(|l: &Layer| l.thickness).collect();
+    fig.finish(id, points.len(), &printed);
+    if blended && spread.3 > 0 {
+        fig.thickness = (spread.0, spread.1 / spread.3 as f64, spread.2);
+    }
+    lay_warnings(&mut fig, id, against, &ff);
+    FeaturePlan {
+        feature: id,
+        points,
+        layers,
+        figures: fig,
+        freeform: Some(ff),
     }
 }
 

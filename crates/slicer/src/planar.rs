@@ -281,7 +281,7 @@ pub fn fill_two5d(
             };
             match covering {
                 false => at(mid),
-                true => covering_section(at, (mid, top, dl)),
+                true => crate::feature_mesh::covering_section(at, (mid, top, dl)),
             }
         })
         .collect();
@@ -306,26 +306,6 @@ pub fn fill_two5d(
         sparse,
         fig,
     })
-}
-
-/// Where a layer's sections are taken near its bottom and top, as a share of its thickness in
-/// from them ([`covering_section`]).
-const COVER_INSET: f64 = 0.02;
-
-/// A layer of a feature grown by a machining allowance (issue 37, item 2): what its sections
-/// at its middle, near its bottom and near its top (`at` each height; the layer's middle, top
-/// and thickness given) cover together, so that the layer holds the grown solid over its whole
-/// thickness and a stair-step never eats into the allowance where a face slopes (a section at
-/// the middle alone leaves `h/2·cos α` of it uncovered on a face at α from the layers). The
-/// union (non-zero) also reads the grown mesh's trimmed folds as the solid they bound.
-fn covering_section(
-    at: impl Fn(f64) -> Vec<Region>,
-    (mid, top, dl): (f64, f64, f64),
-) -> Vec<Region> {
-    let inset = COVER_INSET * dl;
-    let mut r = crate::fill::union(&at(mid), &at(top - dl + inset));
-    r = crate::fill::union(&r, &at(top - inset));
-    r
 }
 
 /// The outline of a tree's build-plate face: the section of its base feature `f` (a two5d

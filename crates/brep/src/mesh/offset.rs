@@ -24,20 +24,14 @@
 
 use super::model::Mesh;
 use crate::math::{P3, V3};
+use crate::tolerance::{NONZERO, OFFSET_RANK_CUTOFF, OFFSET_TANGENT, SLIDE_ZERO};
 use crate::topology::{Brep, FaceId};
 use nalgebra::Matrix3;
-
-/// Two normals closer than this (`1 − cos`) are one: the faces are tangent there.
-const TANGENT: f64 = 1e-7;
 
 /// A corner's move is at most this many times the largest distance asked for: the mitre of two
 /// faces meeting at a knife edge (nearly opposite normals) runs off far, and is cut back to
 /// this (its vertex named in [`OffsetMesh::capped`]).
 pub const MAX_MITRE: f64 = 4.0;
-
-/// Eigenvalues of `NᵀN` below this share of the largest are dropped: the faces constrain no
-/// direction there (they are tangent along it).
-const RANK_CUTOFF: f64 = 1e-9;
 
 /// The offset of a mesh and where it went wrong.
 #[derive(Debug, Clone)]
@@ -79,7 +73,7 @@ pub fn offset_mesh(brep: &Brep, mesh: &Mesh, distance: &dyn Fn(FaceId) -> f64) -
                 .normal(uv[0], uv[1])
                 .map(|n| n * sense)
                 .or(fallback[i])
-                .and_then(|n| n.try_normalize(1e-12));
+                .and_then(|n| n.try_normalize(NONZERO));
             if let (Some(n), Some(c)) = (n, cons.get_mut(g as usize)) {
                 c.push((n, d));
             }
@@ -160,7 +154,7 @@ fn carry_inside(
         let gi = g as usize;
         // The slide: the move less its part along this face's normal there.
         let slide = moves[gi] - n * moves[gi].dot(n);
-        if slide.norm() > 1e-9 {
+        if slide.norm() > SLIDE_ZERO {
             slides.push((mesh.positions[gi], slide));
         }
     }
@@ -205,7 +199,10 @@ fn carry_inside(
 fn mitre(cons: &[(V3, f64)], cap: f64) -> (V3, bool) {
     let mut merged: Vec<(V3, f64)> = Vec::with_capacity(cons.len());
     for &(n, d) in cons {
-        match merged.iter_mut().find(|(m, _)| 1.0 - m.dot(&n) < TANGENT) {
+        match merged
+            .iter_mut()
+            .find(|(m, _)| 1.0 - m.dot(&n) < OFFSET_TANGENT)
+        {
             Some(m) => m.1 = m.1.max(d),
             None => merged.push((n, d)),
         }
@@ -226,7 +223,7 @@ fn mitre(cons: &[(V3, f64)], cap: f64) -> (V3, bool) {
             let mut x = V3::zeros();
             for k in 0..3 {
                 let l = eig.eigenvalues[k];
-                if l > RANK_CUTOFF * top {
+                if l > OFFSET_RANK_CUTOFF * top {
                     let v: V3 = eig.eigenvectors.column(k).into();
                     x += v * (v.dot(&ntd) / l);
                 }
@@ -253,7 +250,7 @@ fn triangle_normals(mesh: &Mesh, t: &super::model::FaceTriangulation) -> Vec<Opt
             acc[i as usize] += n;
         }
     }
-    acc.into_iter().map(|n| n.try_normalize(1e-18)).collect()
+    acc.into_iter().map(|n| n.try_normalize(NONZERO)).collect()
 }
 
 /// The volume a closed, outward mesh encloses (divergence theorem over its triangles), mm³.
