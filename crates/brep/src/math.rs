@@ -103,6 +103,10 @@ impl Aabb {
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x
     }
+    /// Whether `p` lies in the box, its faces included.
+    pub fn contains(&self, p: &P3) -> bool {
+        (0..3).all(|k| p[k] >= self.min[k] && p[k] <= self.max[k])
+    }
     /// Length of the diagonal (0 when empty).
     pub fn diagonal(&self) -> f64 {
         if self.is_empty() {

@@ -240,15 +240,11 @@ impl Solid {
     }
 
     fn contains(&self, p: &P3) -> bool {
-        inside_box(&self.bbox, p)
+        self.bbox.contains(p)
             && self.shape.as_ref().is_some_and(|m| {
                 m.contains_local_point(&Point3::new(p.x as f32, p.y as f32, p.z as f32))
             })
     }
-}
-
-fn inside_box(b: &Aabb, p: &P3) -> bool {
-    (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k])
 }
 
 /// The volume (mm³) two solids share, counted on a grid of [`OVERLAP_GRID`]³ cell centres over

@@ -253,7 +253,7 @@ pub fn allowance_left(
         !children
             .iter()
             .zip(&boxes)
-            .any(|(m, b)| in_box(b, &q) && m.winding_number(&q) > 0.5)
+            .any(|(m, b)| b.contains(&q) && m.winding_number(&q) > 0.5)
     });
     if samples.is_empty() {
         return Ok(None);
@@ -282,10 +282,6 @@ pub fn allowance_left(
         samples: measured.len(),
         thinnest_at: [at.x, at.y, at.z],
     }))
-}
-
-fn in_box(b: &brep::math::Aabb, q: &P3) -> bool {
-    (0..3).all(|k| b.min[k] <= q[k] && q[k] <= b.max[k])
 }
 
 /// The least exit over rays from `p` within [`RAY_CONE_DEG`] of `n`: the normal, and rings of
