@@ -181,12 +181,7 @@ fn measure_allowance(
     if grown.is_empty() {
         return Ok(());
     }
-    let points: Vec<PathPoint> = plans
-        .iter()
-        .flat_map(|(_, p)| p.points.iter().copied())
-        .collect();
-    let envelope = slicer::allowance::Envelope::new(&points);
-    drop(points);
+    let envelope = slicer::allowance::Envelope::new(plans.iter().map(|(_, p)| p.points.as_slice()));
     let measured: Vec<Result<_, PlanError>> = grown
         .par_iter()
         .map(|(i, slot, params)| {

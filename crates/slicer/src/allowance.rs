@@ -103,10 +103,11 @@ fn cell_of(p: &P3) -> [i32; 3] {
 }
 
 impl Envelope {
-    /// The envelope of the print moves of `points` (the part's, support left out).
-    pub fn new(points: &[PathPoint]) -> Envelope {
+    /// The envelope of the print moves of each path of `paths` (the part's, support, skirt and
+    /// brim left out), a move running from the point before it in its own path.
+    pub fn new<'p>(paths: impl IntoIterator<Item = &'p [PathPoint]>) -> Envelope {
         let mut beads = vec![];
-        for w in points.windows(2) {
+        for w in paths.into_iter().flat_map(|p| p.windows(2)) {
             let (a, b) = (&w[0], &w[1]);
             let part = !(b.role.is_support() || matches!(b.role, Role::Skirt | Role::Brim));
             if b.kind != MoveKind::Print || !part || b.width <= 0.0 {
