@@ -282,3 +282,133 @@ fn a_fillet_under_the_allowance_folds_and_is_filled_larger_never_less() {
         "the fold is filled: {boss}"
     );
 }
+
+/// The data a `preview.html` draws (the JSON in its `<script id="data">`).
+fn preview_data(page: &str) -> Value {
+    let open = "<script id=\"data\" type=\"application/json\">";
+    let json = page
+        .split(open)
+        .nth(1)
+        .and_then(|s| s.split("</script>").next())
+        .expect("the page holds its data");
+    serde_json::from_str(&json.replace("<\\/", "</")).expect("JSON")
+}
+
+/// Little-endian `f32`s (or `u32`s read as such) from the page's URL-safe base64.
+fn words(b64: &Value) -> Vec<u32> {
+    let text = b64.as_str().expect("base64 text");
+    let digit = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => u32::from(c - b'A'),
+            b'a'..=b'z' => u32::from(c - b'a') + 26,
+            b'0'..=b'9' => u32::from(c - b'0') + 52,
+            b'-' => 62,
+            b'_' => 63,
+            _ => panic!("not base64: {c}"),
+        }
+    };
+    let mut bytes = vec![];
+    for chunk in text.as_bytes().chunks(4) {
+        let n = chunk
+            .iter()
+            .filter(|&&c| c != b'=')
+            .enumerate()
+            .fold(0u32, |n, (k, &c)| n | digit(c) << (18 - 6 * k));
+        let kept = chunk.iter().filter(|&&c| c != b'=').count() - 1;
+        bytes.extend((0..kept).map(|k| (n >> (16 - 8 * k)) as u8));
+    }
+    bytes
+        .chunks(4)
+        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+        .collect()
+}
+
+#[test]
+fn the_preview_colours_the_nominal_surface_by_the_allowance_left() {
+    let scratch = Scratch::new("allowance_preview");
+    let (report, out, _) = plan_with("plate_boss_boss.step", "marlin", ALLOWANCE, &scratch);
+    let page = std::fs::read_to_string(out.join("preview.html")).unwrap();
+    let data = preview_data(&page);
+    let features = data["features"].as_array().unwrap();
+    assert_eq!(features.len(), 3);
+    for (f, reported) in features.iter().zip(report["features"].as_array().unwrap()) {
+        let a = &f["allowance"];
+        assert_eq!(num(&a["requested"]), ALLOWANCE, "{a}");
+        let pos: Vec<f32> = words(&f["positions"])
+            .into_iter()
+            .map(f32::from_bits)
+            .collect();
+        let tri = words(&f["triangles"]);
+        let left: Vec<f32> = words(&a["left"]).into_iter().map(f32::from_bits).collect();
+        assert_eq!(left.len() * 3, pos.len(), "one value a vertex");
+        let at = |v: u32| [0, 1, 2].map(|k| f64::from(pos[3 * v as usize + k]));
+        // Every value shown lies within what the report measured, which is the allowance
+        // give or take a bead.
+        let (lo, hi) = (
+            num(&allowance(reported)["min_mm"]),
+            num(&allowance(reported)["max_mm"]),
+        );
+        let shown: Vec<f64> = left
+            .iter()
+            .filter(|x| x.is_finite())
+            .map(|&x| f64::from(x))
+            .collect();
+        assert!(
+            shown.len() >= 4,
+            "feature {}: {} shown",
+            f["id"],
+            shown.len()
+        );
+        for x in &shown {
+            assert!(
+                *x >= lo - 1e-3 && *x <= hi + 1e-3,
+                "feature {}: {x} outside {lo}..{hi}",
+                f["id"]
+            );
+            assert!(*x >= ALLOWANCE - TOLERANCE && *x <= ALLOWANCE + BEAD, "{x}");
+        }
+        // Triangle by triangle: the plate's face (z = 0) and the plate's top under the boss
+        // (radius 12) are not the outside: nothing shown; the plate's and the bosses' sides
+        // are, at every corner.
+        let mut sides = 0;
+        for t in tri.chunks(3) {
+            let corners = [t[0], t[1], t[2]].map(at);
+            let measured = [t[0], t[1], t[2]].map(|v| left[v as usize].is_finite());
+            let on_plate = corners.iter().all(|p| p[2].abs() < 1e-3);
+            let under_boss = f["id"] == 0
+                && corners
+                    .iter()
+                    .all(|p| (p[2] - 6.0).abs() < 1e-3 && p[0].hypot(p[1]) < 11.5);
+            if on_plate || under_boss {
+                assert!(
+                    measured.iter().all(|m| !m),
+                    "feature {}: {corners:?} coloured",
+                    f["id"]
+                );
+            }
+            let radius = |p: &[f64; 3]| p[0].hypot(p[1]);
+            let side = match f["id"].as_u64() {
+                Some(0) => corners.iter().all(|p| {
+                    (p[0] - corners[0][0]).abs() < 1e-3 && (p[0].abs() - 30.0).abs() < 1e-3
+                }),
+                Some(1) => corners.iter().all(|p| (radius(p) - 12.0).abs() < 0.1),
+                _ => corners.iter().all(|p| (radius(p) - 5.0).abs() < 0.1),
+            };
+            if side {
+                sides += 1;
+                assert!(
+                    measured.iter().all(|m| *m),
+                    "feature {}: {corners:?} blank",
+                    f["id"]
+                );
+            }
+        }
+        assert!(sides > 0, "feature {}: no side triangle", f["id"]);
+    }
+    // Without an allowance the page has no such colours.
+    let (_, out, _) = plan_with("plate_boss_boss.step", "marlin", 0.0, &scratch);
+    let page = std::fs::read_to_string(out.join("preview.html")).unwrap();
+    for f in preview_data(&page)["features"].as_array().unwrap() {
+        assert!(f["allowance"].is_null(), "{}", f["allowance"]);
+    }
+}

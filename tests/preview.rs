@@ -275,7 +275,102 @@ fn box_mesh(id: usize, label: &str, lo: [f32; 3], hi: [f32; 3]) -> FeatureMesh {
         label: label.into(),
         positions,
         triangles,
+        allowance: None,
     }
+}
+
+/// The allowance ramp's warm end (least left), shaded: green about half of red, a little blue.
+fn is_warm(c: [u8; 3]) -> bool {
+    let (r, g, b) = (f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
+    r >= 60.0 && (0.38 * r..=0.56 * r).contains(&g) && (0.08 * r..=0.22 * r).contains(&b)
+}
+
+/// The ramp's cool end (most left): blue, little red or green.
+fn is_cool(c: [u8; 3]) -> bool {
+    let (r, g, b) = (f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
+    b >= 60.0 && r <= 0.3 * b && g <= 0.3 * b
+}
+
+#[test]
+fn the_part_is_coloured_by_the_machining_allowance_left() {
+    let Some(browser) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("features-allowance-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Three boxes side by side: a millimetre left over the first, two over the second, the
+    // third not measured.
+    let boxes: Vec<FeatureMesh> = [1.0f32, 2.0, f32::NAN]
+        .iter()
+        .enumerate()
+        .map(|(i, &left)| {
+            let x = -30.0 + 22.0 * i as f32;
+            let mut m = box_mesh(i, "two5d", [x, -10.0, 0.0], [x + 18.0, 10.0, 12.0]);
+            m.allowance = Some(preview::MeshAllowance {
+                requested: 1.0,
+                left: vec![left; m.positions.len()],
+            });
+            m
+        })
+        .collect();
+    let page = preview::html(&Preview {
+        title: "allowance".into(),
+        features: boxes,
+        ..Preview::default()
+    });
+    let file = dir.join("allowance.html");
+    std::fs::write(&file, &page).unwrap();
+    // At first each feature has its own colour; `#part=allowance` (as choosing "machining
+    // allowance left" does) colours the two measured boxes' corners by what was left.
+    let dom = headless(&browser, &file, &["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    assert_eq!(
+        body_attribute(&dom, "data-part-colour").as_deref(),
+        Some("feature")
+    );
+    let url = format!("file://{}#part=allowance", file.display());
+    let dom = headless_url(&browser, &url, &["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    assert_eq!(
+        body_attribute(&dom, "data-part-colour").as_deref(),
+        Some("allowance")
+    );
+    // 12 triangles a box, 3 corners each, two boxes measured.
+    assert_eq!(
+        body_attribute(&dom, "data-allowance-vertices").as_deref(),
+        Some("72")
+    );
+    assert_eq!(
+        body_attribute(&dom, "data-allowance-range").as_deref(),
+        Some("1 2")
+    );
+    assert!(
+        dom.contains("1.000 to 2.000 mm"),
+        "the legend gives the range"
+    );
+    // The picture: the first box warm, the second cool; by feature, neither.
+    let coloured = Shot::at(&browser, &url, &dir.join("allowance.png"));
+    let plain = Shot::of(&browser, &page, &dir, "plain");
+    let (warm, cool) = (coloured.count(is_warm), coloured.count(is_cool));
+    assert!(
+        warm > 2000 && cool > 2000,
+        "{warm} warm, {cool} cool pixels"
+    );
+    assert!(
+        plain.count(is_warm) < warm / 10 && plain.count(is_cool) < cool / 10,
+        "by feature: {} warm, {} cool pixels",
+        plain.count(is_warm),
+        plain.count(is_cool)
+    );
+    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
+        let keep = PathBuf::from(keep);
+        std::fs::create_dir_all(&keep).unwrap();
+        for f in ["allowance.html", "allowance.png"] {
+            std::fs::copy(dir.join(f), keep.join(f)).unwrap();
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A small two-feature path: rectangular rings on a 40 × 30 × 4 mm plate, then circles of a

@@ -5,15 +5,23 @@ use crate::mesh::write_atomic;
 use crate::{emit, Failure, PreviewArgs};
 use brep::mesh::{mesh_faces, MeshOptions};
 use features::{extract_all, Assembly, ExtractOptions};
-use preview::{FeatureMesh, HeadShape, MachineShape, Mark, MarkKind, Preview};
+use preview::{FeatureMesh, HeadShape, MachineShape, Mark, MarkKind, MeshAllowance, Preview};
 use robot_post::{MachineKind, MachineProfile};
+use slicer::allowance::AllowanceSample;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Write as _;
 
 /// Chord tolerance of the meshes drawn, as a share of the part's size (at least 0.05 mm).
 const VIEW_TOLERANCE_SHARE: f64 = 1.0 / 400.0;
 
-/// Every feature of `assembly` meshed for the view, file-wide ids, in build order.
-pub fn feature_meshes(assembly: &Assembly) -> Vec<FeatureMesh> {
+/// Every feature of `assembly` meshed for the view, file-wide ids, in build order; a feature
+/// with a machining allowance measured (`allowance`, by file-wide id) coloured by what was left
+/// ([`allowance_mesh`]).
+pub fn feature_meshes(
+    assembly: &Assembly,
+    allowance: &BTreeMap<usize, Vec<AllowanceSample>>,
+    requested: impl Fn(usize) -> Option<f64>,
+) -> Vec<FeatureMesh> {
     let mut out = vec![];
     let mut offset = 0;
     for t in &assembly.trees {
@@ -27,19 +35,83 @@ pub fn feature_meshes(assembly: &Assembly) -> Vec<FeatureMesh> {
                 label: format!("{} {on}", f.kind.as_str()),
                 ..FeatureMesh::default()
             };
-            if let Ok(m) = mesh_faces(&t.brep, &f.faces, &opts) {
-                mesh.positions = m
-                    .positions
-                    .iter()
-                    .map(|p| [p.x as f32, p.y as f32, p.z as f32])
-                    .collect();
-                mesh.triangles = m.triangles();
+            let samples = allowance.get(&mesh.id).zip(requested(mesh.id));
+            match (mesh_faces(&t.brep, &f.faces, &opts), samples) {
+                (Ok(m), Some((samples, requested))) => {
+                    (mesh.positions, mesh.triangles, mesh.allowance) =
+                        allowance_mesh(&m, samples, requested);
+                }
+                (Ok(m), None) => {
+                    mesh.positions = m.positions.iter().map(to_f32).collect();
+                    mesh.triangles = m.triangles();
+                }
+                (Err(_), _) => {}
             }
             out.push(mesh);
         }
         offset += t.features.len();
     }
     out
+}
+
+fn to_f32(p: &brep::math::P3) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}
+
+/// A feature's view mesh coloured by the machining allowance left (issue 37, item 2): each
+/// B-rep face's vertices its own (the colours do not run across an edge into a face that was
+/// not measured), each valued by the nearest measured point of its face, NaN on faces with
+/// none or where the nearest is covered by a child feature.
+fn allowance_mesh(
+    m: &brep::mesh::Mesh,
+    samples: &[AllowanceSample],
+    requested: f64,
+) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Option<MeshAllowance>) {
+    let mut on_face: HashMap<brep::topology::FaceId, Vec<&AllowanceSample>> = HashMap::new();
+    for s in samples {
+        on_face.entry(s.face).or_default().push(s);
+    }
+    let (mut positions, mut triangles, mut left) = (vec![], vec![], vec![]);
+    for ft in &m.faces {
+        let near = on_face.get(&ft.face);
+        let mut index: HashMap<u32, u32> = HashMap::new();
+        for t in &ft.triangles {
+            let g = t.map(|i| ft.vertex.get(i as usize).copied().unwrap_or(u32::MAX));
+            if g[0] == g[1] || g[1] == g[2] || g[0] == g[2] {
+                continue;
+            }
+            let Some(corners) = g
+                .iter()
+                .map(|&v| m.positions.get(v as usize))
+                .collect::<Option<Vec<_>>>()
+            else {
+                continue;
+            };
+            let mut tri = [0u32; 3];
+            for (k, (&v, p)) in g.iter().zip(corners).enumerate() {
+                tri[k] = *index.entry(v).or_insert_with(|| {
+                    positions.push(to_f32(p));
+                    let value = near
+                        .and_then(|s| {
+                            s.iter().min_by(|a, b| {
+                                let da = (brep::math::P3::from(a.at) - p).norm_squared();
+                                let db = (brep::math::P3::from(b.at) - p).norm_squared();
+                                da.total_cmp(&db)
+                            })
+                        })
+                        .and_then(|s| s.left);
+                    left.push(value.map_or(f32::NAN, |x| x as f32));
+                    (positions.len() - 1) as u32
+                });
+            }
+            triangles.push(tri);
+        }
+    }
+    let allowance = MeshAllowance {
+        requested: requested as f32,
+        left,
+    };
+    (positions, triangles, Some(allowance))
 }
 
 /// The `preview.html` of a plan: its features, its tool path and its figures, and the
@@ -169,7 +241,13 @@ fn plan_preview<'a>(plan: &'a plan::Plan, title: &str) -> Preview<'a> {
     let volume: f64 = f.iter().map(|x| x.extruded_volume_mm3).sum();
     Preview {
         title: title.to_string(),
-        features: feature_meshes(&plan.assembly),
+        features: feature_meshes(&plan.assembly, &plan.allowance_left, |id| {
+            f.iter()
+                .find(|x| x.feature.id == id)?
+                .machining_allowance
+                .as_ref()
+                .map(|a| a.requested_mm)
+        }),
         path: Some(&plan.toolpath),
         figures: vec![
             ("machine".into(), plan.report.machine.clone()),
@@ -229,7 +307,7 @@ pub fn run(args: &PreviewArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::new(path, e))?;
     let assembly =
         extract_all(&part.brep, &ExtractOptions::default()).map_err(|e| Failure::new(path, e))?;
-    let features = feature_meshes(&assembly);
+    let features = feature_meshes(&assembly, &BTreeMap::new(), |_| None);
     let volume: f64 = assembly.trees.iter().map(|t| t.part_volume).sum();
     let page = preview::html(&Preview {
         title: path.display().to_string(),

@@ -62,6 +62,14 @@ impl Stages {
             adhesion,
         } = self;
         let program = posted.map(|p| p.program);
+        let mut features = features;
+        let allowance_left = features
+            .iter_mut()
+            .filter_map(|f| {
+                let a = f.allowance.as_mut()?;
+                Some((f.planned.id, std::mem::take(&mut a.measured)))
+            })
+            .collect();
         let filament_area = machine.bead().filament_area();
         // The pedestal first (printed first), then the part's features in build order.
         let reports: Vec<FeatureReport> = checked
@@ -126,6 +134,7 @@ impl Stages {
             assembly: extracted.assembly,
             collisions: checked.avoided,
             part_warnings: all,
+            allowance_left,
         }
     }
 }

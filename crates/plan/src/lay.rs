@@ -193,16 +193,26 @@ fn measure_allowance(
                 &envelope,
                 extracted.plates[slot.tree].as_ref(),
             )?;
-            Ok((*i, left))
+            Ok((*i, left, params.tolerance))
         })
         .collect();
     for m in measured {
-        let (i, left) = m?;
+        let (i, left, tolerance) = m?;
         let Some(laid) = features.get_mut(i) else {
             continue;
         };
-        laid.allowance = left;
         let id = laid.planned.id;
+        if let Some(a) = left.as_ref().filter(|a| a.min < a.requested - tolerance) {
+            let at = a.thinnest_at;
+            laid.warnings.push(Warning::feature(
+                id,
+                WarningKind::Planner(format!(
+                    "feature {id}: its beads leave {:.3} mm of machining allowance near ({:.2}, {:.2}, {:.2}) mm, under the {} mm asked less the {tolerance} mm tolerance (the preview colours the allowance left): a thinner layer or bead follows the offset closer",
+                    a.min, at[0], at[1], at[2], a.requested
+                )),
+            ));
+        }
+        laid.allowance = left;
         if let Some(g) = plans.get(i).and_then(|p| p.1.figures.grown.clone()) {
             if let Some(at) = g.folds.first() {
                 laid.warnings.push(Warning::feature(

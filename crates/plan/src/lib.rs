@@ -157,6 +157,10 @@ pub struct Plan {
     /// The part's warnings as typed values, in the report's order (its `warnings` are their
     /// texts): what a caller branches on.
     pub part_warnings: Vec<Warning>,
+    /// Per feature with a machining allowance (file-wide id), the points of its nominal faces
+    /// where the allowance left was measured and what was left (issue 37, item 2): the
+    /// preview's colours.
+    pub allowance_left: std::collections::BTreeMap<usize, Vec<slicer::allowance::AllowanceSample>>,
 }
 
 impl Plan {

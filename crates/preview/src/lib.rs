@@ -2,7 +2,9 @@
 //! planned tool path with WebGL in any current browser, offline: the viewer's script, its
 //! styles and the data are all inline; the file names no other file and no address.
 //!
-//! - the features' meshes, translucent, one colour each, toggled one by one;
+//! - the features' meshes, translucent, one colour each, toggled one by one; with a machining
+//!   allowance ([`MeshAllowance`]), the nominal surface coloured by the allowance the beads
+//!   leave over it (warm where least, cool where most, grey where nothing was measured);
 //! - the tool path as lines, print and travel told apart (travel hidden at first), a range of
 //!   layers over the whole build order, coloured by feature, layer or local layer thickness,
 //!   support material's beads in a colour of their own (green);
@@ -64,6 +66,20 @@ pub struct FeatureMesh {
     pub positions: Vec<[f32; 3]>,
     /// Triangles over `positions`.
     pub triangles: Vec<[u32; 3]>,
+    /// The machining allowance left over each vertex, if the feature has one.
+    pub allowance: Option<MeshAllowance>,
+}
+
+/// A feature's nominal surface coloured by the machining allowance its beads leave (issue 37,
+/// item 2).
+#[derive(Debug, Clone, Default)]
+pub struct MeshAllowance {
+    /// `machining_allowance` asked for, mm.
+    pub requested: f32,
+    /// The allowance left over each vertex of the mesh (one per position), mm; NaN where
+    /// nothing was measured (the build plate, a face shared with another feature, a face a
+    /// child feature covers).
+    pub left: Vec<f32>,
 }
 
 /// What a preview shows.
@@ -167,11 +183,19 @@ fn meshes_json(features: &[FeatureMesh]) -> Vec<serde_json::Value> {
         .map(|f| {
             let pos: Vec<f32> = f.positions.iter().flatten().copied().collect();
             let tri: Vec<u32> = f.triangles.iter().flatten().copied().collect();
+            let allowance = f
+                .allowance
+                .as_ref()
+                .filter(|a| a.left.len() == f.positions.len());
             serde_json::json!({
                 "id": f.id,
                 "label": f.label,
                 "positions": base64_f32(&pos),
                 "triangles": base64_u32(&tri),
+                "allowance": allowance.map_or(serde_json::Value::Null, |a| serde_json::json!({
+                    "requested": a.requested,
+                    "left": base64_f32(&a.left),
+                })),
             })
         })
         .collect()
@@ -276,6 +300,10 @@ mod tests {
                 label: "two5d".into(),
                 positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
                 triangles: vec![[0, 1, 2]],
+                allowance: Some(MeshAllowance {
+                    requested: 1.0,
+                    left: vec![1.0, 1.5, f32::NAN],
+                }),
             }],
             path: Some(&path),
             figures: vec![("features".into(), "1".into())],

@@ -371,8 +371,11 @@
     gl.useProgram(meshProg);
     gl.uniformMatrix4fv(gl.getUniformLocation(meshProg, "mvp"), false, v.mvp);
     gl.uniform3fv(gl.getUniformLocation(meshProg, "eye"), new Float32Array(v.eye));
-    gl.uniform4f(gl.getUniformLocation(meshProg, "colour"), colour[0], colour[1], colour[2], 1);
+    gl.uniform1f(gl.getUniformLocation(meshProg, "alpha"), 1);
     var mp = gl.getAttribLocation(meshProg, "pos"), mn = gl.getAttribLocation(meshProg, "nrm");
+    /* One colour for the whole mesh: the colour attribute held constant. */
+    var mc = gl.getAttribLocation(meshProg, "col");
+    gl.disableVertexAttribArray(mc); gl.vertexAttrib3f(mc, colour[0], colour[1], colour[2]);
     gl.bindBuffer(gl.ARRAY_BUFFER, mesh.pos); gl.enableVertexAttribArray(mp); gl.vertexAttribPointer(mp, 3, gl.FLOAT, false, 0, 0);
     gl.bindBuffer(gl.ARRAY_BUFFER, mesh.nrm); gl.enableVertexAttribArray(mn); gl.vertexAttribPointer(mn, 3, gl.FLOAT, false, 0, 0);
     gl.drawArrays(gl.TRIANGLES, 0, mesh.n);

@@ -11,7 +11,9 @@
 //! inner slivers ([`CLOSING_SHARE`]). Over a face the rays' least exit is the
 //! normal's; at a concave corner between a feature and its parent it is the way out past the
 //! corner. Points are the nominal mesh's vertices on the feature's own faces (not the
-//! build-plate face, not the faces it grows from, not voids).
+//! build-plate face, not the faces it grows from, not voids), at an even stride with a few on
+//! every face; each is kept with what was left over it ([`AllowanceSample`]), for a picture of
+//! the surface coloured by the allowance.
 
 use crate::error::FeatureError;
 use crate::feature_mesh::{feature_mesh, plate_faces, slicing_tolerance, Allowance};
@@ -20,6 +22,7 @@ use crate::tolerance::SHORT_VECTOR;
 use crate::toolpath::{MoveKind, PathPoint, Role};
 use brep::math::{P3, V3};
 use brep::section::Plane;
+use brep::topology::FaceId;
 use features::{Feature, FeatureTree};
 use std::collections::HashMap;
 
@@ -40,8 +43,23 @@ const INSIDE_PROBE_MM: f64 = 0.05;
 /// Side of the envelope's grid cells, mm.
 const CELL_MM: f64 = 1.0;
 
-/// The allowance a plan leaves over a feature's nominal faces.
+/// Fewest points measured on each own face (all of a face with fewer vertices).
+const MIN_PER_FACE: usize = 4;
+
+/// One point of a nominal face and the allowance the beads leave over it.
 #[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AllowanceSample {
+    /// The point, mm.
+    pub at: [f64; 3],
+    /// The B-rep face it lies on.
+    pub face: FaceId,
+    /// The allowance left over it, mm; `None` where a child feature covers the point (inside
+    /// the part: nothing to machine).
+    pub left: Option<f64>,
+}
+
+/// The allowance a plan leaves over a feature's nominal faces.
+#[derive(Debug, Clone, PartialEq)]
 pub struct AllowanceLeft {
     /// `machining_allowance` asked for, mm.
     pub requested: f64,
@@ -53,6 +71,8 @@ pub struct AllowanceLeft {
     pub samples: usize,
     /// The nominal point where the least was measured.
     pub thinnest_at: [f64; 3],
+    /// Every point measured, and those a child covers, face by face.
+    pub measured: Vec<AllowanceSample>,
 }
 
 /// One print segment's bead.
@@ -225,22 +245,37 @@ pub fn allowance_left(
             foreign[g as usize] = true;
         }
     }
-    let mut samples: Vec<(P3, V3)> = vec![];
-    let mut seen = vec![false; mesh.positions.len()];
+    // Each own face's vertices, with its own normal there (an edge's vertices measured once
+    // for each face it bounds).
+    let mut per_face: Vec<(FaceId, Vec<(P3, V3)>)> = vec![];
     for t in mesh.faces.iter().filter(|t| own(t.face)) {
         let surf = b.face_surface(t.face);
         let sense = if b.face(t.face).same_sense { 1.0 } else { -1.0 };
+        let mut on_face = vec![];
+        let mut seen = std::collections::HashSet::new();
         for (&g, uv) in t.vertex.iter().zip(&t.uv) {
             let g = g as usize;
-            if foreign[g] || seen[g] {
+            if foreign[g] || !seen.insert(g) {
                 continue;
             }
-            seen[g] = true;
             if let Some(n) = surf.normal(uv[0], uv[1]) {
-                samples.push((mesh.positions[g], n * sense));
+                on_face.push((mesh.positions[g], n * sense));
             }
         }
+        if !on_face.is_empty() {
+            per_face.push((t.face, on_face));
+        }
     }
+    // An even stride over the feature, at least MIN_PER_FACE points on every face.
+    let total: usize = per_face.iter().map(|(_, s)| s.len()).sum();
+    let stride = total.div_ceil(MAX_SAMPLES).max(1);
+    let samples: Vec<(FaceId, P3, V3)> = per_face
+        .iter()
+        .flat_map(|(face, s)| {
+            let k = stride.min(s.len().div_ceil(MIN_PER_FACE)).max(1);
+            s.iter().step_by(k).map(move |&(p, n)| (*face, p, n))
+        })
+        .collect();
     // Where a feature grows from this one its face is inside the part: not measured.
     let children = tree
         .features
@@ -249,39 +284,41 @@ pub fn allowance_left(
         .map(|g| feature_mesh(tree, g, slicing_tolerance(params), Allowance::default()))
         .collect::<Result<Vec<_>, _>>()?;
     let boxes: Vec<_> = children.iter().map(|m| m.bbox()).collect();
-    samples.retain(|(p, n)| {
+    let covered = |p: &P3, n: &V3| {
         let q = p + n * INSIDE_PROBE_MM;
-        !children
+        children
             .iter()
             .zip(&boxes)
             .any(|(m, b)| b.contains(&q) && m.winding_number(&q) > 0.5)
-    });
-    if samples.is_empty() {
-        return Ok(None);
-    }
-    let stride = samples.len().div_ceil(MAX_SAMPLES);
+    };
     let reach = requested + 2.0 * envelope.widest + 1.0;
-    let measured: Vec<(f64, P3)> = samples
+    let measured: Vec<AllowanceSample> = samples
         .iter()
-        .step_by(stride)
-        .map(|(p, n)| (nearest_exit(envelope, (p, n), reach, plate), *p))
+        .map(|(face, p, n)| AllowanceSample {
+            at: [p.x, p.y, p.z],
+            face: *face,
+            left: (!covered(p, n)).then(|| nearest_exit(envelope, (p, n), reach, plate)),
+        })
         .collect();
-    let (min, at) = measured
-        .iter()
-        .fold((f64::INFINITY, P3::origin()), |m, &(a, p)| {
-            if a < m.0 {
-                (a, p)
-            } else {
-                m
-            }
-        });
-    let max = measured.iter().map(|m| m.0).fold(0.0f64, f64::max);
+    let mut left = measured.iter().filter_map(|m| Some((m.left?, m.at)));
+    let Some(first) = left.next() else {
+        return Ok(None);
+    };
+    let (mut min, mut max, mut at, mut count) = (first.0, first.0, first.1, 1);
+    for (a, p) in left {
+        if a < min {
+            (min, at) = (a, p);
+        }
+        max = max.max(a);
+        count += 1;
+    }
     Ok(Some(AllowanceLeft {
         requested,
         min,
         max,
-        samples: measured.len(),
-        thinnest_at: [at.x, at.y, at.z],
+        samples: count,
+        thinnest_at: at,
+        measured,
     }))
 }
 
