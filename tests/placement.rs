@@ -324,3 +324,53 @@ fn a_part_whose_features_fail_their_self_check_plans_sliced_whole() {
         assert!((k - 1.0).abs() < 1e-9, "{line}");
     }
 }
+
+#[test]
+fn an_attempt_is_given_up_at_its_first_unsupported_curved_feature_and_the_refusal_is_whole() {
+    // The impeller on delta5, its features kept (`slicing = "features"`): its blades' curved
+    // layers overhang the hub as modelled and on its face, so every attempt stops at the
+    // first blade; then the part as modelled is planned in full for the refusal reported.
+    let s = Scratch::new("given_up");
+    let out = s.path("plan");
+    let o = plan_at(
+        &fixture("impeller.step"),
+        "delta5",
+        &out,
+        &["--set", "slicing=features"],
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("no placement plans; planning the part as modelled in full"),
+        "{err}"
+    );
+    let r = report(&out);
+    assert_eq!(r["complete"], false);
+    // The whole plan: every feature laid, each blade's unsupported layers listed.
+    let features = r["features"].as_array().expect("features");
+    assert_eq!(features.len(), 7);
+    let unsupported: Vec<_> = r["failures"]
+        .as_array()
+        .expect("failures")
+        .iter()
+        .filter(|f| f["gate"] == "unsupported")
+        .collect();
+    assert_eq!(unsupported.len(), 6, "{unsupported:?}");
+    for f in &features[1..] {
+        assert!(
+            f["unsupported_area_mm2"].as_f64().unwrap_or(0.0) > 0.0,
+            "{f}"
+        );
+    }
+    // Each attempt stopped at the first blade found unsupported, and says so.
+    let tried = r["placement"]["tried"].as_array().expect("tried");
+    assert!(tried.len() >= 2, "{tried:?}");
+    for t in tried {
+        let f = t["failure"].as_str().expect("failure");
+        assert!(
+            f.starts_with("layers not held up: feature 1 (freeform)")
+                && f.contains("the rest of the plan was not made"),
+            "{f}"
+        );
+    }
+}

@@ -43,6 +43,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
         placement_time_limit: std::time::Duration::try_from_secs_f64(args.placement_time_limit)
             .ok(),
         stop_at: None,
+        fail_fast: false,
     };
     // The program goes to its files as the post makes it, under temporary names until every
     // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise. Each
@@ -521,6 +522,15 @@ impl Bar {
                 self.0.inc(1)
             }
             Progress::Planned => {}
+            Progress::Reporting => {
+                let path = &self.1;
+                self.0.suspend(|| {
+                    eprintln!(
+                        "features: {path}: no placement plans; planning the part as modelled in full for its report"
+                    )
+                });
+                self.0.set_position(0);
+            }
             Progress::Stage(stage) => {
                 if stage != Stage::AFTER_FEATURES[0] {
                     self.0.inc(1);

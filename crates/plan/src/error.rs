@@ -50,6 +50,14 @@ pub enum PlanError {
         /// untried. `None`: every placement queued was tried.
         stopped: Option<crate::retry::Stopped>,
     },
+    /// The plan was given up at its first curved feature whose layers are not held up
+    /// ([`crate::Options::fail_fast`]): the features after it were not laid, and there is no
+    /// plan to show; one [`crate::support::line`] for each feature of its group of features.
+    #[error("layers not held up: {} (found as the features were laid; the rest of the plan was not made)", lines.join("; "))]
+    Unsupported {
+        /// The features found unsupported, one line each.
+        lines: Vec<String>,
+    },
     /// The plan was given up at [`crate::Options::stop_at`] (the placement time limit of
     /// [`crate::retry::find`]).
     #[error("given up at the placement time limit")]

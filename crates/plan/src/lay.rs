@@ -70,14 +70,18 @@ pub struct Laid {
 /// Fills and lays every feature of `extracted` in build order. Features are filled a few at a
 /// time in parallel, as many as there are threads, so memory holds no more than that many
 /// fills; then laid one after the other, each from where the one before ended. Past
-/// `stop_at` no further group of features is begun ([`PlanError::TimeLimit`]).
+/// `options.stop_at` no further group of features is begun ([`PlanError::TimeLimit`]); with
+/// [`crate::Options::fail_fast`], none after a group with a curved feature the support gate
+/// refuses ([`PlanError::Unsupported`]).
 pub fn lay(
     extracted: &Extracted,
     process: &Process,
     machine: &MachineProfile,
-    stop_at: Option<std::time::Instant>,
+    options: &crate::Options,
     tell: &dyn Fn(Progress),
 ) -> Result<Laid, PlanError> {
+    let stop_at = options.stop_at;
+    let fail_fast = options.fail_fast && !options.keep_going;
     let base = process.base();
     // What holds up each planar layer, from the features alone (issue 31).
     // Support material (issue 33) carries what it can; `held` is what it leaves.
@@ -91,6 +95,8 @@ pub fn lay(
     let mut grown = vec![];
     for chunk in extracted.order.chunks(window) {
         crate::in_time(stop_at)?;
+        // Curved features of the last group whose layers are not held up.
+        let mut unsupported = vec![];
         let fills: Vec<Result<_, PlanError>> = chunk
             .par_iter()
             .map(|&slot| {
@@ -141,14 +147,13 @@ pub fn lay(
             laid.warnings.extend(below.clone());
             // Curved layers' support is measured as they are laid.
             if let Some(ff) = &plan.freeform {
-                held.insert(
-                    id,
-                    crate::support::Held {
-                        support: ff.support,
-                        angle_deg: params.overhang_angle_deg,
-                        kind: extracted.feature(slot).kind,
-                    },
-                );
+                let h = crate::support::Held {
+                    support: ff.support,
+                    angle_deg: params.overhang_angle_deg,
+                    kind: extracted.feature(slot).kind,
+                };
+                unsupported.extend(crate::support::line(id, &h));
+                held.insert(id, h);
             }
             laid.held = held.get(&id).copied();
             warnings.extend(below);
@@ -158,6 +163,10 @@ pub fn lay(
             features.push(laid);
             plans.push((id, plan));
             tell(Progress::FeatureDone);
+        }
+        // The support gate will refuse the plan: with fail_fast, nothing more is laid.
+        if fail_fast && !unsupported.is_empty() {
+            return Err(PlanError::Unsupported { lines: unsupported });
         }
     }
     measure_allowance(extracted, &grown, &plans, &mut features)?;

@@ -91,6 +91,10 @@ pub enum Progress {
     Planned,
     /// One of [`Stage::AFTER_FEATURES`] begins; the previous one, if any, is done.
     Stage(Stage),
+    /// No placement plans, and the part as modelled was given up at its first unsupported
+    /// curved feature ([`Options::fail_fast`]): it is planned again in full, for the refusal
+    /// reported (whose stages are reported next).
+    Reporting,
 }
 
 /// How to plan.
@@ -123,6 +127,11 @@ pub struct Options<'a> {
     /// group of features is laid and before each stage after them: [`retry::find`] sets it
     /// for the placements after the part as modelled. `None`: never.
     pub stop_at: Option<std::time::Instant>,
+    /// Give the plan up at the first group of features laid with a curved feature whose
+    /// layers the support gate refuses ([`PlanError::Unsupported`], no plan), unless
+    /// [`Options::keep_going`]: the rest is not laid. [`retry::find`] sets it for the
+    /// placements it tries, and plans the part as modelled again in full when none plans.
+    pub fail_fast: bool,
 }
 
 impl Options<'_> {
@@ -281,7 +290,7 @@ fn run(
     tell(Progress::Start {
         features: extracted.order.len() as u64,
     });
-    let laid = lay::lay(&extracted, process, machine, options.stop_at, &tell)?;
+    let laid = lay::lay(&extracted, process, machine, options, &tell)?;
     options.in_time()?;
     tell(Progress::Stage(Stage::Smooth));
     let smoothed = smooth::smooth(laid.toolpath, process, machine);
