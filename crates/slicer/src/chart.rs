@@ -564,9 +564,19 @@ pub(crate) fn translate_chart<'a>(
 /// The mesh with every edge longer than `max_edge` split (conforming: a triangle is cut by
 /// the midpoints of its long edges, shared with its neighbours), as one triangle list. The
 /// distance field is linear over each triangle of the mapped mesh, so a planar face's few large
-/// triangles would cut a curved layer along chords far from the true section curve.
+/// triangles would cut a curved layer along chords far from the true section curve. Each
+/// point's `(u, v)` comes along (a midpoint's the mean of its ends': meaningful within one
+/// face, whose parameters a triangulation gives unwrapped).
 pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
     let mut pos = mesh.positions.clone();
+    let mut uv = vec![[0.0, 0.0]; pos.len()];
+    for f in &mesh.faces {
+        for (&g, &w) in f.vertex.iter().zip(&f.uv) {
+            if let Some(x) = uv.get_mut(g as usize) {
+                *x = w;
+            }
+        }
+    }
     let mut tris = mesh.triangles();
     for _ in 0..12 {
         let long =
@@ -578,8 +588,9 @@ pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
                 if long(a, b, &pos) {
                     let key = (a.min(b), a.max(b));
                     mid.entry(key).or_insert_with(|| {
-                        let m = P3::from(0.5 * (pos[a as usize].coords + pos[b as usize].coords));
-                        pos.push(m);
+                        let (a, b) = (a as usize, b as usize);
+                        pos.push(P3::from(0.5 * (pos[a].coords + pos[b].coords)));
+                        uv.push([0.5 * (uv[a][0] + uv[b][0]), 0.5 * (uv[a][1] + uv[b][1])]);
                         (pos.len() - 1) as u32
                     });
                 }
@@ -632,7 +643,7 @@ pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
                 .first()
                 .map(|f| f.face)
                 .unwrap_or(brep::topology::FaceId(0)),
-            uv: vec![[0.0, 0.0]; n],
+            uv,
             vertex: (0..n as u32).collect(),
             triangles: tris,
         }],

@@ -116,8 +116,10 @@ pub(crate) fn build_top_field(
         one.faces = vec![ft.clone()];
         let mut fine = compact(&refined(&compact(&one), TOP_EDGE));
         let surf = brep.face_surface(ft.face);
-        for p in &mut fine.positions {
-            let (u, v) = surf.project(p, None);
+        // Each point's foot from its (u, v), interpolated over its triangle of the face.
+        let starts = fine.faces.first().map(|f| f.uv.clone()).unwrap_or_default();
+        for (p, uv) in fine.positions.iter_mut().zip(starts) {
+            let (u, v) = surf.project_from(p, (uv[0], uv[1]));
             let on = surf.eval(u, v);
             if (on - *p).norm() < TOP_EDGE {
                 *p = on;
@@ -220,8 +222,18 @@ fn up_share(chart: &Chart, mesh: &Mesh, ft: &FaceTriangulation, id: usize) -> f6
 /// Keeps only the vertices a mesh's triangles use (one face triangulation).
 fn compact(m: &Mesh) -> Mesh {
     let tris = m.triangles();
+    // Each point's (u, v) on its face (one face: the top faces are taken one at a time).
+    let mut uv_of = vec![[0.0, 0.0]; m.positions.len()];
+    for f in &m.faces {
+        for (&g, &w) in f.vertex.iter().zip(&f.uv) {
+            if let Some(x) = uv_of.get_mut(g as usize) {
+                *x = w;
+            }
+        }
+    }
     let mut map = vec![u32::MAX; m.positions.len()];
     let mut positions = vec![];
+    let mut uv = vec![];
     let mut out = Vec::with_capacity(tris.len());
     for t in tris {
         out.push(t.map(|k| {
@@ -229,6 +241,7 @@ fn compact(m: &Mesh) -> Mesh {
             if map[k] == u32::MAX {
                 map[k] = positions.len() as u32;
                 positions.push(m.positions[k]);
+                uv.push(uv_of[k]);
             }
             map[k]
         }));
@@ -238,7 +251,7 @@ fn compact(m: &Mesh) -> Mesh {
         positions,
         faces: vec![FaceTriangulation {
             face: m.faces.first().map(|f| f.face).unwrap_or(FaceId(0)),
-            uv: vec![[0.0, 0.0]; n],
+            uv,
             vertex: (0..n as u32).collect(),
             triangles: out,
         }],

@@ -117,6 +117,18 @@ impl Surface {
         }
     }
 
+    /// The parameters of the foot of `p` found from `start` alone: the closed form where the
+    /// surface has one, else Gauss–Newton steps from `start` (no grid search). For a point
+    /// known to lie near the surface about `start`, such as a point of a face's triangulation
+    /// whose `(u, v)` was interpolated from its triangle's corners: [`Surface::project`]
+    /// without a hint searches the whole surface for each point.
+    pub fn project_from(&self, p: &P3, start: (f64, f64)) -> (f64, f64) {
+        match self {
+            Surface::Nurbs(_) => self.polish(p, start),
+            _ => self.project(p, Some(start)),
+        }
+    }
+
     /// The `k` samples of a grid over the surface nearest to `p` (nearest first), as `(u, v)`:
     /// starts for [`Surface::polish`].
     fn grid_starts(&self, p: &P3, n: &NurbsSurfaceData, k: usize) -> Vec<(f64, f64)> {
