@@ -225,7 +225,8 @@ pub fn lift_needed(avoided: &Avoided, path: &ToolPath, machine: &MachineProfile)
 /// (d) The least `n` in `1..=max` for which `fits(n)` (false at 0, and true from some `n` on:
 /// a taller pedestal never brings the table nearer), `None` when not even `max` fits. Probes
 /// `guess` (clamped into range) first and then the layer under it, which is most often the
-/// answer; where the guess is short, steps up by doubling; then halves the range left.
+/// answer; where the guess is short, steps up by doubling, where it is tall, down; then halves
+/// the range left.
 pub fn least<E>(
     max: usize,
     guess: usize,
@@ -241,7 +242,23 @@ pub fn least<E>(
         if guess == 1 || !fits(guess - 1)? {
             return Ok(Some(guess));
         }
+        // The guess is tall: step down by doubling from it to a height that leaves a hit
+        // (the fan's guess of 81 layers against the 75 it needs: 6 checks, not 10).
         (lo, hi) = (0, guess - 1);
+        let mut step = 2;
+        while hi > 1 {
+            let n = hi.saturating_sub(step).max(1);
+            if fits(n)? {
+                hi = n;
+                step *= 2;
+            } else {
+                lo = n;
+                break;
+            }
+        }
+        if lo == 0 && hi == 1 {
+            return Ok(Some(1));
+        }
     } else {
         lo = guess;
         let mut step = 1;
@@ -618,6 +635,21 @@ mod tests {
             }
         }
         assert_eq!(least(0, 3, |_| Ok::<_, ()>(true)), Ok(None));
+    }
+
+    /// A guess a few layers tall (the fan's: 81 for the 75 it needs) is walked down from, not
+    /// halved from the plate: each check is a whole head check, and the short pedestals' many
+    /// table hits make them the slowest.
+    #[test]
+    fn a_tall_guess_is_walked_down_in_a_few_checks() {
+        let mut asked = vec![];
+        let got = least(200, 81, |n| {
+            asked.push(n);
+            Ok::<_, ()>(n >= 75)
+        });
+        assert_eq!(got, Ok(Some(75)));
+        assert!(asked.len() <= 6, "{asked:?}");
+        assert!(asked.iter().all(|&n| n >= 70), "{asked:?}");
     }
 
     #[test]
