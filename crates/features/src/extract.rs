@@ -74,6 +74,37 @@ pub struct Reference {
     /// For planes and the build plate: the unit normal pointing into the feature (the build
     /// direction of its layers).
     pub normal: Option<[f64; 3]>,
+    /// On the build plate without a face (a part planned whole): a point of the plate, the
+    /// feature's lowest along `normal` ([`lowest_point`]), found once here rather than by
+    /// every stage that needs the plate.
+    pub origin: Option<[f64; 3]>,
+}
+
+/// Chord tolerance (mm) of the mesh that finds how low a feature reaches ([`lowest_point`]).
+pub const EXTREME_TOL: f64 = 0.01;
+
+/// The lowest point of `faces` along `n`: of their mesh at [`EXTREME_TOL`] (a torus or a
+/// cylinder lying on its side is lowest between its vertices, which may all lie at its middle
+/// height), or of their vertices where they do not mesh. `None` without a point.
+pub fn lowest_point(b: &Brep, faces: &[FaceId], n: [f64; 3]) -> Option<[f64; 3]> {
+    let mut pts = brep::mesh::mesh_faces(
+        b,
+        faces,
+        &brep::mesh::MeshOptions::with_tolerance(EXTREME_TOL),
+    )
+    .map(|m| m.positions)
+    .unwrap_or_default();
+    if pts.is_empty() {
+        pts = b
+            .vertices_of(faces)
+            .iter()
+            .map(|v| b.vertices[v.idx()].point)
+            .collect();
+    }
+    let n = V3::new(n[0], n[1], n[2]);
+    pts.into_iter()
+        .min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
+        .map(|p| [p.x, p.y, p.z])
 }
 
 /// One AM feature: a closed shell.
@@ -681,6 +712,7 @@ fn host_reference(b: &Brep, t: FaceId) -> Reference {
         face: Some(t),
         step_face: Some(b.face(t).step_id),
         normal,
+        origin: None,
     }
 }
 
@@ -712,6 +744,8 @@ fn base_reference(b: &Brep, faces: &[FaceId], warnings: &mut Vec<String>) -> Ref
         face: best.map(|x| x.1),
         step_face: best.map(|x| b.face(x.1).step_id),
         normal: Some([0.0, 0.0, 1.0]),
+        // The feature's faces are not final yet (heal faces come later): found when needed.
+        origin: None,
     }
 }
 

@@ -133,6 +133,7 @@ fn solids_together(
         })
         .collect();
     let feature = whole_feature(
+        brep,
         whole_subtype(brep),
         faces,
         voids,
@@ -162,7 +163,9 @@ const MIN_DIAG: f64 = 1e-3;
 
 /// A whole-part feature (id 0, two5d, on the build plate) of shell faces `faces` with
 /// `voids`, of `subtype` ([`WHOLE_PART`] or [`MESH_TWO5D`]).
+#[allow(clippy::too_many_arguments)]
 fn whole_feature(
+    b: &Brep,
     subtype: &str,
     faces: Vec<FaceId>,
     voids: Vec<Vec<FaceId>>,
@@ -175,7 +178,7 @@ fn whole_feature(
         id: 0,
         kind: FeatureKind::Two5d,
         subtype: subtype.to_string(),
-        reference: plate_reference(),
+        reference: plate_reference(b, &faces),
         parents: vec![],
         faces,
         voids,
@@ -189,13 +192,15 @@ fn whole_feature(
     }
 }
 
-/// What a whole-part feature is built on: the build plate, along +Z, with no face.
-fn plate_reference() -> Reference {
+/// What a whole-part feature of `faces` is built on: the build plate, along +Z, with no face,
+/// at the part's lowest point.
+fn plate_reference(b: &Brep, faces: &[FaceId]) -> Reference {
     Reference {
         surface: "build_plate".into(),
         face: None,
         step_face: None,
         normal: Some(PLUS_Z),
+        origin: crate::extract::lowest_point(b, faces, PLUS_Z),
     }
 }
 
@@ -243,6 +248,7 @@ pub fn whole_part_tree(part: &Brep, solid: SolidId) -> Result<FeatureTree, Extra
         ));
     }
     let feature = whole_feature(
+        &b,
         whole_subtype(&b),
         outer,
         voids,

@@ -15,7 +15,6 @@ use crate::params::{InfillPattern, LayerParams, PathMode};
 use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint, Role};
 use brep::math::{P3, V3};
-use brep::mesh::{mesh_faces, MeshOptions};
 use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
@@ -36,42 +35,15 @@ pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
     // point, on its surfaces (a torus or a cylinder lying on its side is lowest between its
     // vertices, which may all lie at its middle height).
     let face = f.heal_faces.first().copied().or(f.reference.face);
-    let p = match face {
-        Some(fc) => b
+    let p = match (face, f.reference.origin) {
+        (Some(fc), _) => b
             .vertices_of(&[fc])
             .first()
             .map(|v| b.vertices[v.idx()].point),
-        None => {
-            let mut pts = surface_points(tree, f);
-            if pts.is_empty() {
-                pts = b
-                    .vertices_of(&f.faces)
-                    .iter()
-                    .map(|v| b.vertices[v.idx()].point)
-                    .collect();
-            }
-            pts.into_iter()
-                .min_by(|a, c| a.coords.dot(&n).total_cmp(&c.coords.dot(&n)))
-        }
+        (None, Some(o)) => Some(P3::from(o)),
+        (None, None) => features::extract::lowest_point(b, &f.faces, [n.x, n.y, n.z]).map(P3::from),
     }?;
     Some(Plane::new(p, n))
-}
-
-/// Chord tolerance (mm) of the mesh that finds how low a feature reaches.
-const EXTREME_TOL: f64 = 0.01;
-
-/// Points of a feature's faces, on their exact surfaces, no farther apart than a chord
-/// tolerance of [`EXTREME_TOL`] allows: where a curved face reaches lowest between its
-/// vertices, one of them lies within that of the lowest point. Empty if the faces do not
-/// mesh.
-fn surface_points(tree: &FeatureTree, f: &Feature) -> Vec<P3> {
-    mesh_faces(
-        &tree.brep,
-        &f.faces,
-        &MeshOptions::with_tolerance(EXTREME_TOL),
-    )
-    .map(|m| m.positions)
-    .unwrap_or_default()
 }
 
 /// How far (mm) `points` (a feature's mesh) reach below the build plate of `tree` (its base
