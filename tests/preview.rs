@@ -69,6 +69,24 @@ fn headless_url(browser: &Path, url: &str, extra: &[&str]) -> std::process::Outp
         .expect("chromium runs")
 }
 
+/// The DOM of the page at `url` once its script ran (`--dump-dom`), which must have run
+/// without an error (`what` names the page in the failure).
+fn dom_at(browser: &Path, url: &str, what: &str) -> String {
+    let out = headless_url(browser, url, &["--dump-dom"]);
+    let dom = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(
+        body_attribute(&dom, "data-error"),
+        None,
+        "{what}: script error"
+    );
+    dom
+}
+
+/// [`dom_at`] of the page in the file `page`.
+fn dom_of(browser: &Path, page: &Path, what: &str) -> String {
+    dom_at(browser, &format!("file://{}", page.display()), what)
+}
+
 /// Opens `page`, checks that its script drew without an error, and that the screenshot holds a
 /// picture: a share of pixels off the background, in several colours.
 fn assert_draws(browser: &Path, page: &Path, dir: &Path) {
@@ -321,17 +339,13 @@ fn the_part_is_coloured_by_the_machining_allowance_left() {
     std::fs::write(&file, &page).unwrap();
     // At first each feature has its own colour; `#part=allowance` (as choosing "machining
     // allowance left" does) colours the two measured boxes' corners by what was left.
-    let dom = headless(&browser, &file, &["--dump-dom"]);
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    let dom = dom_of(&browser, &file, "by feature");
     assert_eq!(
         body_attribute(&dom, "data-part-colour").as_deref(),
         Some("feature")
     );
     let url = format!("file://{}#part=allowance", file.display());
-    let dom = headless_url(&browser, &url, &["--dump-dom"]);
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    let dom = dom_at(&browser, &url, "by the allowance");
     assert_eq!(
         body_attribute(&dom, "data-part-colour").as_deref(),
         Some("allowance")
@@ -533,9 +547,7 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
     // The Problems panel lists every mark's text, and the figures say why the plan was refused.
     let file = dir.join("refused.html");
     std::fs::write(&file, &page).unwrap();
-    let dom = headless(&browser, &file, &["--dump-dom"]);
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    let dom = dom_of(&browser, &file, "refused");
     assert_eq!(
         body_attribute(&dom, "data-marks"),
         Some(marks.len().to_string())
@@ -556,9 +568,7 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
     assert!(dom.contains("refused: 5 problems"), "no refusal line");
     // `#problem=N` selects the N-th problem (as a click on it does) and centres the view there.
     let url = format!("file://{}#problem=2", file.display());
-    let dom = headless_url(&browser, &url, &["--dump-dom"]);
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    assert_eq!(body_attribute(&dom, "data-error"), None, "script error");
+    let dom = dom_at(&browser, &url, "#problem=2");
     assert!(
         dom.contains("class=\"sel\" data-mark=\"2\"")
             || dom.contains("data-mark=\"2\" class=\"sel\""),
@@ -806,13 +816,7 @@ fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
         let mut orange = vec![];
         for (at, f) in [("middle", "0.5"), ("end", "1")] {
             let url = format!("file://{}#sim={f}", file.display());
-            let dom = headless_url(&browser, &url, &["--dump-dom"]);
-            let dom = String::from_utf8_lossy(&dom.stdout);
-            assert_eq!(
-                body_attribute(&dom, "data-error"),
-                None,
-                "{name}: script error"
-            );
+            let dom = dom_at(&browser, &url, name);
             // The scrubber's move: the fraction of the moves (all embedded, so the move itself).
             let shown: usize = body_attribute(&dom, "data-sim-move")
                 .and_then(|s| s.parse().ok())
@@ -925,13 +929,7 @@ fn the_impellers_previews_simulate_the_arm_and_the_table() {
         let mut orange = vec![];
         for (at, f) in [("middle", "0.5"), ("end", "1")] {
             let url = format!("file://{}#sim={f}", page.display());
-            let dom = headless_url(&browser, &url, &["--dump-dom"]);
-            let dom = String::from_utf8_lossy(&dom.stdout);
-            assert_eq!(
-                body_attribute(&dom, "data-error"),
-                None,
-                "{machine}: script error"
-            );
+            let dom = dom_at(&browser, &url, machine);
             let shown: usize = body_attribute(&dom, "data-sim-move")
                 .and_then(|s| s.parse().ok())
                 .expect("the page names the move shown");
