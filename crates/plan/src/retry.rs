@@ -591,6 +591,20 @@ pub fn find(
             Err(e) => first = e,
         }
     }
+    Err(no_placement(first, tried, stopped, k, fits_nowhere))
+}
+
+/// The refusal when no placement plans: the part as modelled's (`first`), its report's
+/// `placement` saying why none other was kept (`k` others tried; `fits_nowhere`: none could
+/// fit, the last of `tried` says why), every placement `tried` listed, the part as modelled
+/// first in its report and left out of the error's list.
+fn no_placement(
+    mut first: PlanError,
+    mut tried: Vec<TriedEntry>,
+    stopped: Option<Stopped>,
+    k: usize,
+    fits_nowhere: bool,
+) -> PlanError {
     if let PlanError::Refused { plan, .. } = &mut first {
         let rule = match &stopped {
             None if fits_nowhere => format!(
@@ -605,13 +619,12 @@ pub fn find(
         entry.tried = tried.clone();
         plan.report.placement = Some(entry);
     }
-    // The part as modelled first in the report; the others are listed with the error.
     tried.remove(0);
-    Err(PlanError::NoPlacement {
+    PlanError::NoPlacement {
         modelled: Box::new(first),
         tried,
         stopped,
-    })
+    }
 }
 
 #[cfg(test)]
