@@ -87,6 +87,21 @@ fn dom_of(browser: &Path, page: &Path, what: &str) -> String {
     dom_at(browser, &format!("file://{}", page.display()), what)
 }
 
+/// With `FEATURES_KEEP_PREVIEW=DIR`, the files of `dir` whose names `wanted` copied into DIR
+/// to look at.
+fn keep_pages(dir: &Path, wanted: impl Fn(&str) -> bool) {
+    let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") else {
+        return;
+    };
+    let keep = PathBuf::from(keep);
+    std::fs::create_dir_all(&keep).unwrap();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        if e.file_name().to_str().is_some_and(&wanted) {
+            std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
+        }
+    }
+}
+
 /// Opens `page`, checks that its script drew without an error, and that the screenshot holds a
 /// picture: a share of pixels off the background, in several colours.
 fn assert_draws(browser: &Path, page: &Path, dir: &Path) {
@@ -377,13 +392,7 @@ fn the_part_is_coloured_by_the_machining_allowance_left() {
         plain.count(is_warm),
         plain.count(is_cool)
     );
-    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
-        let keep = PathBuf::from(keep);
-        std::fs::create_dir_all(&keep).unwrap();
-        for f in ["allowance.html", "allowance.png"] {
-            std::fs::copy(dir.join(f), keep.join(f)).unwrap();
-        }
-    }
+    keep_pages(&dir, |f| ["allowance.html", "allowance.png"].contains(&f));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -614,13 +623,7 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
         without.drawn(),
         bare.drawn()
     );
-    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
-        let keep = PathBuf::from(keep);
-        std::fs::create_dir_all(&keep).unwrap();
-        for f in ["refused.html", "refused.png"] {
-            std::fs::copy(dir.join(f), keep.join(f)).unwrap();
-        }
-    }
+    keep_pages(&dir, |f| ["refused.html", "refused.png"].contains(&f));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -884,13 +887,7 @@ fn the_simulation_view_draws_the_machine_at_the_scrubbers_move() {
         );
         eprintln!("{name}: {orange:?} orange pixels at the middle and the end");
     }
-    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
-        let keep = PathBuf::from(keep);
-        std::fs::create_dir_all(&keep).unwrap();
-        for e in std::fs::read_dir(&dir).unwrap().flatten() {
-            std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
-        }
-    }
+    keep_pages(&dir, |_| true);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -962,14 +959,6 @@ fn the_impellers_previews_simulate_the_arm_and_the_table() {
             "impeller {machine}: {counts:?} orange pixels at the middle and the end, {moved} changed"
         );
     }
-    if let Some(keep) = std::env::var_os("FEATURES_KEEP_PREVIEW") {
-        let keep = PathBuf::from(keep);
-        std::fs::create_dir_all(&keep).unwrap();
-        for e in std::fs::read_dir(&dir).unwrap().flatten() {
-            if e.path().extension().is_some_and(|x| x == "png") {
-                std::fs::copy(e.path(), keep.join(e.file_name())).unwrap();
-            }
-        }
-    }
+    keep_pages(&dir, |f| f.ends_with(".png"));
     let _ = std::fs::remove_dir_all(&dir);
 }

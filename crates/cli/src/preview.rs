@@ -38,8 +38,10 @@ pub fn feature_meshes(
             let samples = allowance.get(&mesh.id).zip(requested(mesh.id));
             match (mesh_faces(&t.brep, &f.faces, &opts), samples) {
                 (Ok(m), Some((samples, requested))) => {
-                    (mesh.positions, mesh.triangles, mesh.allowance) =
-                        allowance_mesh(&m, samples, requested);
+                    let (positions, triangles, allowance) = allowance_mesh(&m, samples, requested);
+                    mesh.positions = positions;
+                    mesh.triangles = triangles;
+                    mesh.allowance = Some(allowance);
                 }
                 (Ok(m), None) => {
                     mesh.positions = m.positions.iter().map(to_f32).collect();
@@ -66,7 +68,7 @@ fn allowance_mesh(
     m: &brep::mesh::Mesh,
     samples: &[AllowanceSample],
     requested: f64,
-) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Option<MeshAllowance>) {
+) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, MeshAllowance) {
     let mut on_face: HashMap<brep::topology::FaceId, Vec<&AllowanceSample>> = HashMap::new();
     for s in samples {
         on_face.entry(s.face).or_default().push(s);
@@ -111,7 +113,7 @@ fn allowance_mesh(
         requested: requested as f32,
         left,
     };
-    (positions, triangles, Some(allowance))
+    (positions, triangles, allowance)
 }
 
 /// The `preview.html` of a plan: its features, its tool path and its figures, and the

@@ -569,14 +569,7 @@ pub(crate) fn translate_chart<'a>(
 /// face, whose parameters a triangulation gives unwrapped).
 pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
     let mut pos = mesh.positions.clone();
-    let mut uv = vec![[0.0, 0.0]; pos.len()];
-    for f in &mesh.faces {
-        for (&g, &w) in f.vertex.iter().zip(&f.uv) {
-            if let Some(x) = uv.get_mut(g as usize) {
-                *x = w;
-            }
-        }
-    }
+    let mut uv = position_uv(mesh);
     let mut tris = mesh.triangles();
     for _ in 0..12 {
         let long =
@@ -650,6 +643,20 @@ pub(crate) fn refined(mesh: &Mesh, max_edge: f64) -> Mesh {
         edge_points: Default::default(),
         edge_params: Default::default(),
     }
+}
+
+/// Each position's `(u, v)` on the face (of the last face triangulation listing it; `(0, 0)`
+/// where none does): meaningful for a mesh of one face.
+pub(crate) fn position_uv(mesh: &Mesh) -> Vec<[f64; 2]> {
+    let mut uv = vec![[0.0, 0.0]; mesh.positions.len()];
+    for f in &mesh.faces {
+        for (&g, &w) in f.vertex.iter().zip(&f.uv) {
+            if let Some(x) = uv.get_mut(g as usize) {
+                *x = w;
+            }
+        }
+    }
+    uv
 }
 
 /// Chart coordinates and distance of every mesh vertex, as a mesh in `(s, t, d)` space.

@@ -223,14 +223,7 @@ fn up_share(chart: &Chart, mesh: &Mesh, ft: &FaceTriangulation, id: usize) -> f6
 fn compact(m: &Mesh) -> Mesh {
     let tris = m.triangles();
     // Each point's (u, v) on its face (one face: the top faces are taken one at a time).
-    let mut uv_of = vec![[0.0, 0.0]; m.positions.len()];
-    for f in &m.faces {
-        for (&g, &w) in f.vertex.iter().zip(&f.uv) {
-            if let Some(x) = uv_of.get_mut(g as usize) {
-                *x = w;
-            }
-        }
-    }
+    let uv_of = crate::chart::position_uv(m);
     let mut map = vec![u32::MAX; m.positions.len()];
     let mut positions = vec![];
     let mut uv = vec![];
