@@ -158,13 +158,15 @@ pub fn delta5(
 
 /// [`delta5`]'s program, with `notes` (comment lines after the one naming the source, see
 /// [`crate::Job::notes`]), written into `sink`: `program.gcode` as it is made, a megabyte at a
-/// time ([`ProgramSink::chunk`]), then `kinematic_error.svg`; the returned program holds neither
-/// ([`Delta5Program::gcode`] and [`Delta5Program::error_plot_svg`] are empty).
+/// time ([`ProgramSink::chunk`]), then `kinematic_error.svg` and `joints.csv`; the returned
+/// program holds none of them ([`Delta5Program::gcode`], [`Delta5Program::error_plot_svg`] and
+/// [`Delta5Program::joints_csv`] are empty).
 ///
 /// The header gives the kinematic figures of every feature, known once every print segment
 /// is split: a first run over the path splits them (measuring the error) and records how,
-/// the second writes the moves split as recorded. The files are opened once the path passed
-/// every check [`delta5`] makes; an error writing them is [`PostError::Write`].
+/// the second writes the moves split as recorded, reading the joint table off them as it
+/// goes. The files are opened once the path passed every check [`delta5`] makes; an error
+/// writing them is [`PostError::Write`].
 pub fn delta5_to(
     path: &ToolPath,
     m: &MachineProfile,
@@ -238,32 +240,27 @@ pub fn delta5_to(
         .collect();
 
     let mut file = Chunked::open(sink, "program.gcode")?;
-    let replay = w.replay();
-    // The third run, for joints.csv, splits the print segments as the second.
-    let again = replay.again();
-    let mut text = Writer::new(m, g, offset, safe_z, replay);
+    let mut text = Writer::new(m, g, offset, safe_z, w.replay());
     text.out = header(m, g, source, offset, safe_z, wanted_safe, &figures);
     insert_notes(&mut text.out, notes);
-    walk(&mut text, path, &poses, g, |out| file.pass_on(out))?;
+    // joints.csv: B and C read off each move as it is written, the header's (start G-code's)
+    // moves left out; held until the program is written (a row is some 25 bytes a move).
+    let mut rows = JointRows::new();
+    let mut scanned = text.out.len();
+    walk(&mut text, path, &poses, g, |out| {
+        rows.scan(&out[scanned..]);
+        file.pass_on(out)?;
+        scanned = out.len();
+        Ok(())
+    })?;
     text.footer()?;
+    rows.scan(&text.out[scanned..]);
     file.finish(&text.out)?;
     drop(text);
 
     let error_plot_svg = error_plot(&w.plot, g.kinematic_error_goal, source);
     write_file(sink, "kinematic_error.svg", error_plot_svg.as_bytes())?;
-
-    // joints.csv: the moves of the path again, B and C read off each as it is made.
-    let mut file = Chunked::open(sink, JOINTS_CSV)?;
-    let mut rows = JointRows::new();
-    let mut moves = Writer::new(m, g, offset, safe_z, again);
-    walk(&mut moves, path, &poses, g, |out| {
-        rows.scan(out);
-        out.clear();
-        file.pass_on(&mut rows.text)
-    })?;
-    moves.footer()?;
-    rows.scan(&moves.out);
-    file.finish(&rows.text)?;
+    write_file(sink, JOINTS_CSV, rows.text.as_bytes())?;
     let mut warnings = Vec::new();
     // A few clamped moves (the short ones B and C turn fast on, nearly every part has some)
     // are a figure; a warning only where a share the user would notice is slowed.

@@ -82,18 +82,6 @@ pub(super) struct Writer<'a> {
     printed_length: f64,
 }
 
-impl Pass {
-    /// A writing pass that splits the print segments as this one does (or, measuring, has
-    /// so far).
-    pub(super) fn again(&self) -> Pass {
-        let splits = match self {
-            Pass::Measure { splits } => splits.clone().into_iter(),
-            Pass::Write { splits } => splits.clone(),
-        };
-        Pass::Write { splits }
-    }
-}
-
 impl<'a> Writer<'a> {
     pub(super) fn new(
         m: &'a MachineProfile,
