@@ -244,6 +244,10 @@ pub fn fill_two5d(
         z += dl;
     }
     let covering = fig.grown.is_some();
+    // Each section simplified within a tenth of the tolerance: a mesh's section has runs of
+    // points micrometres apart where long thin triangles meet the plane (NIST CTC-05's arcs),
+    // which every offset of the fill and every point of the plan would carry.
+    let near = crate::fill::ring_print_tolerance(params.tolerance, bead.width);
     let sections: Vec<Vec<Region>> = tops
         .par_iter()
         .map(|&(mid, top, dl)| {
@@ -251,10 +255,11 @@ pub fn fill_two5d(
                 let cut = plane.offset(z);
                 section_regions(&mesh, &cut, &cut)
             };
-            match covering {
+            let regions = match covering {
                 false => at(mid),
                 true => crate::feature_mesh::covering_section(at, (mid, top, dl)),
-            }
+            };
+            crate::fill::simplified(regions, near)
         })
         .collect();
     let mut fig = fig;

@@ -1382,3 +1382,59 @@ fn holes_of_no_area_do_not_break_the_lines() {
         length(&b)
     );
 }
+
+/// Every mode lays its rings and its zig-zag connectors about a finely chorded hole (a
+/// 1024-sided circle, the chords of a 3 mm hole 18 micrometres long, as a mesh's section
+/// gives them) simplified within a tenth of the tolerance: each chord's middle within that of
+/// the circle through its ends about the hole's centre, and each run of points hugging the
+/// hole (a ring about it, a connector along the infill area's edge) no denser than twice what
+/// a chord sag of that tolerance needs for the angle it turns through, where the hole's own
+/// vertices (and i_overlay's arcs at each) came through before.
+#[test]
+fn every_mode_lays_its_rings_and_connectors_simplified_within_a_tenth_of_the_tolerance() {
+    let c = [15.0, 15.0];
+    let (hole, width) = (3.0, 0.4);
+    let r = Region {
+        outer: rect(0.0, 0.0, 30.0, 30.0),
+        holes: vec![circle(c, hole, 1024, false)],
+    };
+    let radius = |q: &Point2| (q[0] - c[0]).hypot(q[1] - c[1]);
+    let angle = |q: &Point2| (q[1] - c[1]).atan2(q[0] - c[0]);
+    let near = hole + 2.0 * width;
+    for mode in MODES {
+        let p = params(mode);
+        let tol = (0.1 * p.tolerance).min(0.01 * width);
+        // Points a chord sag of `tol` needs a turn at the hole's radius (the least).
+        let need = PI / (1.0 - tol / hole).acos();
+        let paths = fill_layer(std::slice::from_ref(&r), &p, 0, width, width).paths;
+        let mut runs = 0;
+        for path in &paths {
+            for run in path
+                .points
+                .chunk_by(|a, b| (radius(a) < near) == (radius(b) < near))
+            {
+                if radius(&run[0]) >= near {
+                    continue;
+                }
+                runs += 1;
+                let turned: f64 = run
+                    .windows(2)
+                    .map(|w| (angle(&w[1]) - angle(&w[0]) + PI).rem_euclid(2.0 * PI) - PI)
+                    .map(f64::abs)
+                    .sum();
+                let most = 2.0 * need * turned / (2.0 * PI) + 8.0;
+                assert!(
+                    run.len() as f64 <= most,
+                    "{mode:?}: {} points turning {turned:.3} rad about the hole, at most {most:.0}",
+                    run.len()
+                );
+                for w in run.windows(2) {
+                    let m = [0.5 * (w[0][0] + w[1][0]), 0.5 * (w[0][1] + w[1][1])];
+                    let sag = 0.5 * (radius(&w[0]) + radius(&w[1])) - radius(&m);
+                    assert!(sag <= tol + 1e-4, "{mode:?}: a chord sags {sag} mm");
+                }
+            }
+        }
+        assert!(runs > 0, "{mode:?}: nothing laid about the hole");
+    }
+}

@@ -333,7 +333,7 @@ impl Lines<'_> {
                 area,
                 angle,
                 spacing,
-                join,
+                join.then_some(ctx.print_tol),
                 Some(Reach { base: edge, width }),
                 out,
             );
@@ -370,7 +370,14 @@ impl Lines<'_> {
             base: &solid,
             width,
         });
-        scan_fill(&solid_area, angle, spacing, join, reach, out);
+        scan_fill(
+            &solid_area,
+            angle,
+            spacing,
+            join.then_some(ctx.print_tol),
+            reach,
+            out,
+        );
         set_role(&mut out[from..], Role::SolidInfill);
         out.extend(sparse::pattern_lines(
             &rest,
@@ -386,7 +393,7 @@ impl Lines<'_> {
 /// How far (mm) a contour-fill ring may move where it is simplified for printing, for a
 /// feature tolerance `tol` and beads `width` wide: a tenth of the tolerance, at most 1 % of
 /// the width (what the offsets' arcs are chorded within already).
-fn ring_print_tolerance(tol: f64, width: f64) -> f64 {
+pub(crate) fn ring_print_tolerance(tol: f64, width: f64) -> f64 {
     (0.1 * tol).min(0.01 * width)
 }
 

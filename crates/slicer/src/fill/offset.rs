@@ -177,6 +177,36 @@ pub(crate) fn simplified(regions: Vec<Region>, tol: f64) -> Vec<Region> {
         .collect()
 }
 
+/// An open polyline without the points that lie within `tol` of the chord that replaces
+/// them (Douglas–Peucker): the gyroid's samples along its straighter stretches, a zig-zag
+/// connector's run along an offset's arcs.
+pub(super) fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
+    let n = pts.len();
+    if n < 3 || tol.is_nan() || tol <= 0.0 {
+        return pts.to_vec();
+    }
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let mut stack = vec![(0, n - 1)];
+    while let Some((a, b)) = stack.pop() {
+        let far = (a + 1..b)
+            .map(|i| (i, crate::geom2d::seg_dist(pts[i], pts[a], pts[b])))
+            .max_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some((i, d)) = far {
+            if d > tol {
+                keep[i] = true;
+                stack.push((a, i));
+                stack.push((i, b));
+            }
+        }
+    }
+    pts.iter()
+        .zip(keep)
+        .filter_map(|(p, k)| k.then_some(*p))
+        .collect()
+}
+
 /// Douglas-Peucker on one closed contour (see [`simplify`]): every dropped vertex lies within
 /// `tol` of the contour left, whose vertices are original ones. Contours of four points or
 /// fewer, and any that would lose all their area, come back as they were.

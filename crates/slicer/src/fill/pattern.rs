@@ -1,7 +1,9 @@
 //! The paths of the fill patterns: rings inward from the boundary (with the gap fill of the
 //! strips they leave) and scan lines across an area, free or chained into zig-zags.
 
-use super::offset::{clean_offset, dilate_sharp, drop_specks, erode, simplify, simplify_ring};
+use super::offset::{
+    clean_offset, dilate_sharp, drop_specks, erode, simplify, simplify_line, simplify_ring,
+};
 use super::{
     bead_end_reach, shapes_area, Ctx, Path2, PathKind, Shape, Shapes, MAX_LINES, MIN_SEGMENT,
 };
@@ -77,12 +79,12 @@ pub(super) fn drop_short_segments(pts: &mut Vec<Point2>) {
 /// disk took 0.7 s at its radius). With `thin`, rings after the first are simplified within
 /// the chord tolerance, so that inner rings are not as dense as the boundary (contour fill,
 /// where rings go all the way in); contour-zig-zag keeps its few perimeters exact, so its
-/// infill lines end exactly on the offset boundary. With `thin`, too, every ring is laid
+/// infill lines end exactly on the offset boundary. In every mode, every ring is laid
 /// simplified within the print tolerance (`Ctx::print_tol`): i_overlay's offsets leave runs
 /// of points micrometres apart (the two ends of neighbouring offset edges, arcs of a small
-/// radius chorded as finely as the deepest ring's), which only multiply the plan's points.
-/// The next ring is offset from the ring before this simplification, so the error does not
-/// add up.
+/// radius chorded as finely as the deepest ring's), which only multiply the plan's points
+/// (NIST CTC-05's rings had three points in four of them). The next ring is offset from the
+/// ring before this simplification, so the error does not add up.
 pub(super) fn rings(
     base: &Shapes,
     ctx: &Ctx,
@@ -128,11 +130,7 @@ pub(super) fn rings(
             Role::Perimeter
         };
         for c in ring.iter().flatten() {
-            let mut pts = if thin {
-                simplify_ring(c.clone(), ctx.print_tol)
-            } else {
-                c.clone()
-            };
+            let mut pts = simplify_ring(c.clone(), ctx.print_tol);
             let Some(&first) = pts.first() else { continue };
             pts.push(first);
             out.push(Path2 {
@@ -162,7 +160,14 @@ fn line_fill(strips: Shapes, ctx: &Ctx, out: &mut Vec<Path2>) {
     let from = out.len();
     for shape in strips {
         let angle = principal_angle(&shape);
-        scan_fill(&vec![shape], angle, ctx.spacing, true, None, out);
+        scan_fill(
+            &vec![shape],
+            angle,
+            ctx.spacing,
+            Some(ctx.print_tol),
+            None,
+            out,
+        );
     }
     for p in &mut out[from..] {
         p.role = Role::GapFill;
@@ -282,8 +287,10 @@ pub(super) struct Reach<'a> {
 }
 
 /// Lines `spacing` apart at angle `angle` (radians from +x) across `area`, clipped to it.
-/// With `join`, neighbouring lines of a connected piece are chained along the boundary
-/// (zig-zag); without, each line is its own path, printed in the +angle direction. With
+/// With `join` (`Some(tol)`), neighbouring lines of a connected piece are chained along the
+/// boundary (zig-zag), each connector simplified within `tol` (the area's offset arcs, chorded
+/// micrometres apart, only multiply the plan's points); without, each line is its own path,
+/// printed in the +angle direction. With
 /// `reach`, the ends left free (every end without `join`, a chain's first and last with it)
 /// run on past `area`'s edge towards the boundary of `reach.base`. The lines are
 /// [`Role::InternalInfill`]; the caller gives them their role.
@@ -291,7 +298,7 @@ pub(super) fn scan_fill(
     area: &Shapes,
     angle: f64,
     spacing: f64,
-    join: bool,
+    join: Option<f64>,
     reach: Option<Reach>,
     out: &mut Vec<Path2>,
 ) {
@@ -351,7 +358,7 @@ pub(super) fn scan_fill(
             .map_or(0.0, |b| bead_end_reach(width, b, room));
         [end.p[0] + out * r, end.p[1]]
     };
-    if !join {
+    let Some(tol) = join else {
         for &(_, [a, b]) in &segs {
             out.push(Path2 {
                 points: vec![unrot(run_on(a)), unrot(run_on(b))],
@@ -360,7 +367,7 @@ pub(super) fn scan_fill(
             });
         }
         return;
-    }
+    };
 
     // Ends in order along each ring: neighbours there have no other line ending between them.
     let (order, rank) = ring_order(&ends, rings.len());
@@ -405,9 +412,13 @@ pub(super) fn scan_fill(
                 let Some((len, nb, forward)) = best else {
                     break;
                 };
+                let from = pts.len() - 1;
                 connector(r, e, len, forward, &mut pts);
                 let c = ends[nb];
                 pts.push(c.p);
+                let along = simplify_line(&pts[from..], tol);
+                pts.truncate(from);
+                pts.extend(along);
                 let other = segs[c.seg].1[1 - c.side as usize];
                 pts.push(ends[other].p);
                 used[c.seg] = true;

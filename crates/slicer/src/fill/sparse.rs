@@ -9,6 +9,7 @@
 //! other layer, grid and triangle lines repeat on every layer, and gyroid lines are the section
 //! of one gyroid surface at each layer's height.
 
+use super::offset::simplify_line;
 use super::{Path2, PathKind, Shapes};
 use crate::geom2d::{Point2, Region};
 use crate::params::{InfillPattern, LayerParams};
@@ -86,35 +87,6 @@ pub(super) fn pattern_lines(
         }
     }
     out
-}
-
-/// An open polyline without the points that lie within `tol` of the chord that replaces
-/// them (Douglas–Peucker): the gyroid's samples along its straighter stretches.
-fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
-    let n = pts.len();
-    if n < 3 || tol.is_nan() || tol <= 0.0 {
-        return pts.to_vec();
-    }
-    let mut keep = vec![false; n];
-    keep[0] = true;
-    keep[n - 1] = true;
-    let mut stack = vec![(0, n - 1)];
-    while let Some((a, b)) = stack.pop() {
-        let far = (a + 1..b)
-            .map(|i| (i, crate::geom2d::seg_dist(pts[i], pts[a], pts[b])))
-            .max_by(|x, y| x.1.total_cmp(&y.1));
-        if let Some((i, d)) = far {
-            if d > tol {
-                keep[i] = true;
-                stack.push((a, i));
-                stack.push((i, b));
-            }
-        }
-    }
-    pts.iter()
-        .zip(keep)
-        .filter_map(|(p, k)| k.then_some(*p))
-        .collect()
 }
 
 /// The bounding box of `area`'s points, if it has any.
