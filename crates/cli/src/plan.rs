@@ -375,7 +375,7 @@ fn write_plan(
     let page = crate::preview::plan_page(&plan, &path.display().to_string(), simulation);
     written(
         &preview_name,
-        write_atomic(&dir.join(&preview_name), |w| w.write_all(page.as_bytes())),
+        write_atomic(&dir.join(&preview_name), |w| preview::write_html(&page, w)),
     )?;
     if let Some(name) = &collisions_name {
         written(

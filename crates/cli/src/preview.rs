@@ -116,16 +116,17 @@ fn allowance_mesh(
     (positions, triangles, allowance)
 }
 
-/// The `preview.html` of a plan: its features, its tool path and its figures, and the
-/// simulation view of its program when there is one ([`crate::simulation`]).
-pub fn plan_page(
-    plan: &plan::Plan,
+/// The `preview.html` of a plan, for [`preview::write_html`] to write as it is made: its
+/// features, its tool path and its figures, and the simulation view of its program when
+/// there is one ([`crate::simulation`]).
+pub fn plan_page<'a>(
+    plan: &'a plan::Plan,
     title: &str,
     simulation: Option<preview::Simulation>,
-) -> String {
+) -> Preview<'a> {
     let mut page = plan_preview(plan, title);
     page.simulation = simulation;
-    preview::html(&page)
+    page
 }
 
 /// The `preview.html` of a refused plan (issue 31): the plan's page with every failure of its
