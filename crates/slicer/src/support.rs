@@ -96,9 +96,10 @@ pub fn unsupported_area(
         .sum()
 }
 
-/// A planar section of `mesh` by `plane`, as regions in the plane's frame.
-fn section_regions(mesh: &brep::mesh::Mesh, plane: &Plane) -> Vec<Region> {
-    crate::planar::section_regions(mesh, plane, plane)
+/// A planar section of `mesh` by `plane`, as regions in the plane's frame, simplified within
+/// `near` as the fill simplifies the sections it lays (`planar::fill_two5d`).
+fn section_regions(mesh: &brep::mesh::Mesh, plane: &Plane, near: f64) -> Vec<Region> {
+    crate::fill::simplified(crate::planar::section_regions(mesh, plane, plane), near)
 }
 
 /// The support of a two5d feature's planar layers (as [`crate::planar`] lays them: parallel to
@@ -155,6 +156,7 @@ pub fn planar_support(
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let tol = slicing_tolerance(params);
+    let near = crate::fill::ring_print_tolerance(params.tolerance, bead_width);
     let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
     let heights = crate::planar::two5d_layer_heights(params, &mesh, &plane, top);
     let mut mids = Vec::with_capacity(heights.len());
@@ -165,7 +167,7 @@ pub fn planar_support(
     }
     let sections: Vec<Vec<Region>> = mids
         .par_iter()
-        .map(|&mid| section_regions(&mesh, &plane.offset(mid)))
+        .map(|&mid| section_regions(&mesh, &plane.offset(mid), near))
         .collect();
     // Under the first layer: the parents (or the earlier solids) just below the reference
     // plane; the plate, with neither: nothing to check.
@@ -184,7 +186,7 @@ pub fn planar_support(
             for (t, g) in under {
                 // The parents as grown by their allowance, which lifted this feature's base.
                 let mesh = feature_mesh(t, g, tol, Allowance::of_parent(params))?;
-                regions.extend(section_regions(&mesh, &cut));
+                regions.extend(section_regions(&mesh, &cut, near));
             }
             Some(regions)
         }

@@ -28,6 +28,17 @@
 //! Where a part of the region is too narrow for a ring's beads from both sides, or for the
 //! first ring at all, that part is handed back ([`FilledLayer::gaps`]) to be filled with beads
 //! as wide as it is. So contour fills cover the region without laying any of it twice.
+//!
+//! What is printed is no denser than a tenth of the tolerance needs (`ring_print_tolerance`,
+//! Douglas–Peucker): a two5d layer's section (`planar::fill_two5d`), every ring as it is laid
+//! (the next is offset from the exact one) and every zig-zag connector along the infill
+//! area's edge. A mesh's section has runs of points micrometres apart where long thin
+//! triangles meet the plane, and i_overlay's offsets add an arc of points at every vertex a
+//! ring turns at; kept, they were most of a planar plan's points and of what the stages after
+//! the fill carry. Measured on NIST CTC-05 (the 1000 mm Marlin bed, 2026-11-28, b89bb6f):
+//! 8.19 → 4.61 million points, peak RSS 917 → 572 MB, 19.3 → 15.0 s, the extruded volume
+//! 12,692,396 → 12,692,386 mm³ (1 ppm); `sphere_boss` on delta5 (its base and the dome's
+//! planar layers) 199,659 → 80,720 points, 1.45 → 0.97 s.
 
 mod boolean;
 mod offset;
