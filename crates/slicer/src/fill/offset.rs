@@ -178,8 +178,8 @@ pub(crate) fn simplified(regions: Vec<Region>, tol: f64) -> Vec<Region> {
 }
 
 /// An open polyline without the points that lie within `tol` of the chord that replaces
-/// them (Douglas–Peucker): the gyroid's samples along its straighter stretches, a zig-zag
-/// connector's run along an offset's arcs.
+/// them (Douglas–Peucker, [`peucker`]): the gyroid's samples along its straighter stretches, a
+/// zig-zag connector's run along an offset's arcs.
 pub(super) fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
     let n = pts.len();
     if n < 3 || tol.is_nan() || tol <= 0.0 {
@@ -188,23 +188,43 @@ pub(super) fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
     let mut keep = vec![false; n];
     keep[0] = true;
     keep[n - 1] = true;
-    let mut stack = vec![(0, n - 1)];
-    while let Some((a, b)) = stack.pop() {
-        let far = (a + 1..b)
-            .map(|i| (i, crate::geom2d::seg_dist(pts[i], pts[a], pts[b])))
-            .max_by(|x, y| x.1.total_cmp(&y.1));
-        if let Some((i, d)) = far {
-            if d > tol {
-                keep[i] = true;
-                stack.push((a, i));
-                stack.push((i, b));
-            }
-        }
-    }
+    // Walked from the last point, so that of points equally far from a chord the last is
+    // kept (as this simplification always has; `peucker` keeps the first it meets).
+    peucker(|k| pts[n - 1 - k], vec![(0, n - 1)], tol, &mut keep);
     pts.iter()
-        .zip(keep)
+        .zip(keep.iter().rev())
         .filter_map(|(p, k)| k.then_some(*p))
         .collect()
+}
+
+/// Douglas–Peucker over the chains `spans` (`(i, j)`: the points `at(i)` to `at(j)`, both
+/// kept already): in each, the point farthest from the chord (the first of equals) is kept
+/// when it lies more than `tol` from it, and the two chains it splits into are done alike.
+fn peucker(
+    at: impl Fn(usize) -> Point2,
+    mut spans: Vec<(usize, usize)>,
+    tol: f64,
+    keep: &mut [bool],
+) {
+    while let Some((i, j)) = spans.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let (a, b) = (at(i), at(j));
+        let (mut worst, mut far) = (-1.0, i);
+        for k in i + 1..j {
+            let d = seg_dist(at(k), a, b);
+            if d > worst {
+                worst = d;
+                far = k;
+            }
+        }
+        if worst > tol {
+            keep[far] = true;
+            spans.push((i, far));
+            spans.push((far, j));
+        }
+    }
 }
 
 /// Douglas-Peucker on one closed contour (see [`simplify`]): every dropped vertex lies within
@@ -215,33 +235,15 @@ pub(super) fn simplify_ring(c: Contour, tol: f64) -> Contour {
     if n <= 4 {
         return c;
     }
-    // Split at vertex 0 and the vertex farthest from it; simplify both chains.
+    // Split at vertex 0 and the vertex farthest from it; simplify both chains (the second
+    // closes back to vertex 0, index `n`).
     let far = (1..n)
         .max_by(|&a, &b| dist(c[0], c[a]).total_cmp(&dist(c[0], c[b])))
         .unwrap_or(n / 2);
     let mut keep = vec![false; n];
     keep[0] = true;
     keep[far] = true;
-    let mut stack = vec![(0usize, far), (far, n)];
-    while let Some((i, j)) = stack.pop() {
-        if j <= i + 1 {
-            continue;
-        }
-        let (a, b) = (c[i], c[j % n]);
-        let (mut worst, mut at) = (-1.0, i);
-        for (k, &p) in c.iter().enumerate().take(j).skip(i + 1) {
-            let dd = seg_dist(p, a, b);
-            if dd > worst {
-                worst = dd;
-                at = k;
-            }
-        }
-        if worst > tol {
-            keep[at] = true;
-            stack.push((i, at));
-            stack.push((at, j));
-        }
-    }
+    peucker(|k| c[k % n], vec![(0, far), (far, n)], tol, &mut keep);
     let out: Contour = c
         .iter()
         .zip(&keep)
