@@ -402,8 +402,8 @@ fn synthetic_path() -> ToolPath {
     let mut points = vec![];
     let mut push = |feature: usize, layer: usize, p: [f64; 3], kind: MoveKind| {
         points.push(PathPoint {
-            feature,
-            layer,
+            feature: feature as u32,
+            layer: layer as u32,
             kind,
             p,
             axis: [0.0, 0.0, 1.0],
@@ -631,7 +631,7 @@ fn a_refused_plans_preview_marks_each_failure_in_red_and_lists_it() {
 fn sim_point(i: usize, layer: usize, p: [f64; 3], axis: [f64; 3]) -> PathPoint {
     PathPoint {
         feature: 0,
-        layer,
+        layer: layer as u32,
         kind: if i == 0 {
             MoveKind::Travel
         } else {

@@ -605,10 +605,16 @@ fn run_ours(step: &Path, strategy: LayerStrategy) -> Result<Ours, String> {
     for q in &planned.toolpath.points {
         let p = P3::from(q.p);
         let axis = V3::from(q.axis);
-        let centre = p - axis * (q.thickness / 2.0);
+        let centre = p - axis * (f64::from(q.thickness) / 2.0);
         if q.kind == robot_post::MoveKind::Print {
             if let Some(a) = prev {
-                segs.push(Seg::new(a, centre, axis, q.thickness, q.width));
+                segs.push(Seg::new(
+                    a,
+                    centre,
+                    axis,
+                    f64::from(q.thickness),
+                    f64::from(q.width),
+                ));
             }
         }
         prev = Some(centre);

@@ -187,7 +187,7 @@ fn marks(plan: &plan::Plan) -> Vec<Mark> {
         }
         let at = f.position.or_else(|| {
             let id = f.feature?;
-            pts.iter().find(|q| q.feature == id).map(|q| q.p)
+            pts.iter().find(|q| q.feature as usize == id).map(|q| q.p)
         });
         out.push(Mark {
             kind: match f.gate {

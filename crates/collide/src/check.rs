@@ -154,7 +154,9 @@ pub(crate) fn walk(
                     .zip(&after[lead + 1..])
                     .filter(|(b, a)| b.is_some() && a.is_none())
                     .count();
-                *out.cleared.entry(pts[r.start].feature).or_default() += n;
+                *out.cleared
+                    .entry(pts[r.start].feature as usize)
+                    .or_default() += n;
                 found = after;
             }
         }

@@ -12,7 +12,7 @@ use toolpath::{MoveKind, PathPoint, ToolPath};
 /// be laid from another feature's point).
 pub fn interleave(path: &ToolPath, siblings: &[usize]) -> Option<ToolPath> {
     let pts = &path.points;
-    let inside = |q: &PathPoint| siblings.contains(&q.feature);
+    let inside = |q: &PathPoint| siblings.contains(&(q.feature as usize));
     let start = pts.iter().position(inside)?;
     let end = start + pts[start..].iter().take_while(|q| inside(q)).count();
     if pts[end..].iter().any(inside) {
@@ -30,7 +30,7 @@ pub fn interleave(path: &ToolPath, siblings: &[usize]) -> Option<ToolPath> {
         if q.kind != MoveKind::Travel {
             return None;
         }
-        let k = siblings.iter().position(|&s| s == q.feature)?;
+        let k = siblings.iter().position(|&s| s == q.feature as usize)?;
         layers[k].push(i..i + n);
         i += n;
     }
@@ -57,8 +57,8 @@ mod tests {
 
     fn pt(feature: usize, layer: usize, kind: MoveKind) -> PathPoint {
         PathPoint {
-            feature,
-            layer,
+            feature: feature as u32,
+            layer: layer as u32,
             kind,
             p: [feature as f64, 0.0, layer as f64],
             axis: [0.0, 0.0, 1.0],
@@ -80,7 +80,7 @@ mod tests {
         }
         let path = ToolPath { points };
         let mixed = interleave(&path, &[1, 2]).unwrap();
-        let order: Vec<(usize, usize)> = mixed
+        let order: Vec<(u32, u32)> = mixed
             .points
             .iter()
             .step_by(2)

@@ -191,11 +191,11 @@ fn grains(points: &[PathPoint], range: std::ops::Range<usize>, out: &mut impl Fn
         }
         let from = last.unwrap_or(points[j - 1].p);
         if last.is_none() {
-            out(Grain::Point(from, q.feature));
+            out(Grain::Point(from, q.feature as usize));
         }
         let ends = points.get(j + 1).is_none_or(|n| n.kind != MoveKind::Print);
         if ends || norm(sub(q.p, from)) >= GRAIN_SPACING / 2.0 {
-            out(Grain::Bead(from, q.p, q.feature));
+            out(Grain::Bead(from, q.p, q.feature as usize));
             last = Some(q.p);
         } else {
             last = Some(from);
@@ -246,7 +246,7 @@ pub(crate) fn move_hit(
     }?;
     Some(Collision {
         index,
-        feature: q.feature,
+        feature: q.feature as usize,
         kind: q.kind,
         at: hit.0,
         hits: hit.1,
@@ -257,8 +257,8 @@ pub(crate) fn move_hit(
 #[cfg(test)]
 pub(crate) fn test_point(feature: usize, layer: usize, kind: MoveKind, p: V3) -> PathPoint {
     PathPoint {
-        feature,
-        layer,
+        feature: feature as u32,
+        layer: layer as u32,
         kind,
         p,
         axis: [0.0, 0.0, 1.0],

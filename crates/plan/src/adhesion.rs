@@ -71,7 +71,7 @@ pub fn lay(
                 _ => {
                     let d = (q[0] - l.points[k - 1][0]).hypot(q[1] - l.points[k - 1][1]);
                     length += d;
-                    let e = bead.filament_length(bead.width, anchor.thickness, d);
+                    let e = bead.filament_length(bead.width, f64::from(anchor.thickness), d);
                     filament += e;
                     (MoveKind::Print, e)
                 }
@@ -81,7 +81,7 @@ pub fn lay(
                 p: [q[0], q[1], first.z],
                 axis: [0.0, 0.0, 1.0],
                 e,
-                width: bead.width,
+                width: bead.width as f32,
                 role: l.role,
                 ..anchor
             });
@@ -138,10 +138,10 @@ impl FirstLayer {
     fn of(path: &ToolPath) -> Option<FirstLayer> {
         let prints = path.points.iter().filter(|q| q.kind == MoveKind::Print);
         let bottom = prints
-            .map(|q| q.p[2] - q.thickness)
+            .map(|q| q.p[2] - f64::from(q.thickness))
             .fold(f64::INFINITY, f64::min);
         let i = path.points.iter().position(|q| {
-            q.kind == MoveKind::Print && q.p[2] - q.thickness <= bottom + PLATE_SLACK
+            q.kind == MoveKind::Print && q.p[2] - f64::from(q.thickness) <= bottom + PLATE_SLACK
         })?;
         let q = path.points[i];
         let vertical = q.axis[0].abs() <= VERTICAL && q.axis[1].abs() <= VERTICAL;
@@ -164,7 +164,8 @@ impl FirstLayer {
 
     /// Whether `q` is one of its beads.
     fn holds(&self, q: &PathPoint) -> bool {
-        q.kind == MoveKind::Print && (q.p[2] - q.thickness - self.bottom).abs() <= PLATE_SLACK
+        q.kind == MoveKind::Print
+            && (q.p[2] - f64::from(q.thickness) - self.bottom).abs() <= PLATE_SLACK
     }
 
     /// The rings its external perimeters run along (each path: its travel's point and its

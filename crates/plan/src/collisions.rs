@@ -259,7 +259,7 @@ fn with_axes(path: &ToolPath, axes: &[V3]) -> ToolPath {
 pub fn points(path: &ToolPath) -> BTreeMap<usize, usize> {
     let mut out = BTreeMap::new();
     for q in &path.points {
-        *out.entry(q.feature).or_default() += 1;
+        *out.entry(q.feature as usize).or_default() += 1;
     }
     out
 }

@@ -371,13 +371,13 @@ impl LaidFeature {
             .filter(|q| q.kind == MoveKind::Print && !q.role.is_support())
         {
             prints += 1;
-            if q.width < min_bead && q.width > 0.0 {
+            if q.width < min_bead as f32 && q.width > 0.0 {
                 narrow += 1;
-                thinnest = thinnest.min(q.width);
-                let e = q.e * min_bead / q.width;
+                thinnest = thinnest.min(f64::from(q.width));
+                let e = q.e * min_bead / f64::from(q.width);
                 added += e - q.e;
                 q.e = e;
-                q.width = min_bead;
+                q.width = min_bead as f32;
             }
         }
         self.widened = added * machine.bead().filament_area();

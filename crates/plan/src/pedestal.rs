@@ -166,7 +166,7 @@ pub fn layers(
     let floor = outline.plane.offset(-(n as f64) * layer);
     let mut plan = fill_prism(id, floor, &outline.regions, n, layer, params, bead).lay(None);
     for q in &mut plan.points {
-        q.feature = id;
+        q.feature = id as u32;
     }
     plan
 }

@@ -59,7 +59,7 @@ pub fn below_resolution(
         .filter(|q| !q.role.is_support())
     {
         total += q.e;
-        if q.width < min_bead {
+        if q.width < min_bead as f32 {
             narrow += q.e;
         }
     }
@@ -125,7 +125,7 @@ mod tests {
             axis: [0.0, 0.0, 1.0],
             e,
             thickness: 0.2,
-            width,
+            width: width as f32,
             role: slicer::toolpath::Role::GapFill,
         }
     }

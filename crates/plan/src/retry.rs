@@ -378,7 +378,7 @@ fn none_fits(e: &PlanError, machine: &MachineProfile) -> Option<TriedEntry> {
             .filter(|q| {
                 q.kind == slicer::toolpath::MoveKind::Print
                     && !q.role.is_support()
-                    && !pedestals.contains(&q.feature)
+                    && !pedestals.contains(&(q.feature as usize))
             })
             .map(|q| q.p),
     );

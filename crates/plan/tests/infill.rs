@@ -54,7 +54,9 @@ fn infill_by_layer(p: &plan::Plan) -> BTreeMap<(usize, usize), (f64, f64)> {
         if q.kind != MoveKind::Print {
             continue;
         }
-        let e = out.entry((q.feature, q.layer)).or_default();
+        let e = out
+            .entry((q.feature as usize, q.layer as usize))
+            .or_default();
         match q.role {
             Role::SolidInfill => e.0 += q.e,
             Role::InternalInfill => e.1 += q.e,
@@ -274,7 +276,7 @@ fn curved_layers_get_skins_and_sparse_infill() {
         p.toolpath
             .points
             .iter()
-            .filter(|q| q.feature == id)
+            .filter(|q| q.feature == id as u32)
             .map(|q| q.e)
             .sum()
     };

@@ -69,7 +69,7 @@ fn every_solid_of_a_file_is_planned_with_its_own_ids_and_counts() {
                 .toolpath
                 .points
                 .iter()
-                .filter(|q| q.feature == f.feature.id && !adhesion(q))
+                .filter(|q| q.feature as usize == f.feature.id && !adhesion(q))
                 .count();
             assert_eq!(own, f.points, "{name}: feature {}", f.feature.id);
             assert!(

@@ -106,12 +106,12 @@ fn a_part_planned_on_a_pedestal_prints_it_first_as_a_feature_of_its_own() {
     assert!(
         ((ped.extruded_volume_mm3 - ped.feature.volume_mm3) / ped.feature.volume_mm3).abs() < 0.03
     );
-    assert_eq!(p.toolpath.points[0].feature, ped.feature.id);
+    assert_eq!(p.toolpath.points[0].feature as usize, ped.feature.id);
     let own = p
         .toolpath
         .points
         .iter()
-        .filter(|q| q.feature == ped.feature.id)
+        .filter(|q| q.feature as usize == ped.feature.id)
         .count();
     assert_eq!(own, ped.points);
     // Its layers lie under the part's lowest bead, 2 mm of them.
@@ -119,8 +119,8 @@ fn a_part_planned_on_a_pedestal_prints_it_first_as_a_feature_of_its_own() {
         p.toolpath
             .points
             .iter()
-            .filter(|q| q.feature == id && q.kind == MoveKind::Print)
-            .map(|q| q.p[2] - q.thickness)
+            .filter(|q| q.feature as usize == id && q.kind == MoveKind::Print)
+            .map(|q| q.p[2] - f64::from(q.thickness))
             .fold(f64::INFINITY, f64::min)
     };
     let drop = lowest(0) - lowest(ped.feature.id);

@@ -57,7 +57,7 @@ fn split(p: &plan::Plan) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
 /// The lowest bead bottom (its point less its thickness) of `points`.
 fn lowest_bottom<'a>(points: impl Iterator<Item = &'a PathPoint>) -> f64 {
     points
-        .map(|q| q.p[2] - q.thickness)
+        .map(|q| q.p[2] - f64::from(q.thickness))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -239,7 +239,7 @@ fn a_box_over_nothing_gets_support_from_the_plate_to_its_first_layer() {
     );
     let mut layers: Vec<i64> = support
         .iter()
-        .map(|q| ((q.p[2] - plate) / q.thickness).round() as i64)
+        .map(|q| ((q.p[2] - plate) / f64::from(q.thickness)).round() as i64)
         .collect();
     layers.sort();
     layers.dedup();

@@ -275,8 +275,8 @@ fn path_json(tp: &ToolPath, keep: &[usize]) -> serde_json::Value {
         let q = &tp.points[i];
         xyz.extend(q.p.map(|x| x as f32));
         axis.extend(q.axis.map(|x| x as f32));
-        thick.push(q.thickness as f32);
-        info.push(q.feature as u32);
+        thick.push(q.thickness);
+        info.push(q.feature);
         info.push(layer);
         // 0 travel, 1 the part's bead, 2 support material's.
         info.push(match q.kind {
@@ -348,8 +348,8 @@ mod tests {
 
     fn point(feature: usize, layer: usize, x: f64, kind: MoveKind) -> PathPoint {
         PathPoint {
-            feature,
-            layer,
+            feature: feature as u32,
+            layer: layer as u32,
             kind,
             p: [x, 0.0, 0.2],
             axis: [0.0, 0.0, 1.0],

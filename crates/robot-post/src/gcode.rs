@@ -50,18 +50,18 @@ pub(crate) struct LayerMarks {
 impl LayerMarks {
     /// Appends the comment lines `q` starts to `out`; `z` is the point's machine Z.
     pub(crate) fn write(&mut self, q: &PathPoint, z: f64, out: &mut String) {
-        let new_feature = self.feature != Some(q.feature);
-        if new_feature || self.layer != Some(q.layer) {
-            self.layer = Some(q.layer);
+        let new_feature = self.feature != Some(q.feature as usize);
+        if new_feature || self.layer != Some(q.layer as usize) {
+            self.layer = Some(q.layer as usize);
             out.push_str(";LAYER_CHANGE\n;Z:");
             push_fixed(out, z, 3);
             out.push_str("\n;HEIGHT:");
-            push_fixed(out, q.thickness, 3);
+            push_fixed(out, f64::from(q.thickness), 3);
             out.push_str(&format!("\n;LAYER:{}\n", self.count));
             self.count += 1;
             self.role = None;
             if new_feature {
-                self.feature = Some(q.feature);
+                self.feature = Some(q.feature as usize);
                 out.push_str(&format!(";FEATURE:{}\n", q.feature));
             }
             out.push_str(&format!(";FEATURE_LAYER:{}\n", q.layer));
@@ -72,10 +72,14 @@ impl LayerMarks {
             out.push_str(q.role.prusa_name());
             out.push('\n');
         }
-        if q.kind == MoveKind::Print && self.width.is_none_or(|w| (w - q.width).abs() > 5e-4) {
-            self.width = Some(q.width);
+        if q.kind == MoveKind::Print
+            && self
+                .width
+                .is_none_or(|w| (w - f64::from(q.width)).abs() > 5e-4)
+        {
+            self.width = Some(f64::from(q.width));
             out.push_str(";WIDTH:");
-            push_fixed(out, q.width, 3);
+            push_fixed(out, f64::from(q.width), 3);
             out.push('\n');
         }
     }

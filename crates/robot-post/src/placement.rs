@@ -29,7 +29,7 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
     let mut hi = [f64::NEG_INFINITY; 3];
     for q in placed.clone() {
         let bottom = match q.kind {
-            MoveKind::Print => q.p[2] - q.thickness.max(0.0),
+            MoveKind::Print => q.p[2] - f64::from(q.thickness.max(0.0)),
             MoveKind::Travel => q.p[2],
         };
         for k in 0..2 {
@@ -54,7 +54,10 @@ pub fn bed_offset(path: &ToolPath, m: &MachineProfile) -> Result<[f64; 3], PostE
     let mut hi = [f64::NEG_INFINITY; 3];
     for q in &path.points {
         let (r, bottom) = match q.kind {
-            MoveKind::Print => (q.width.max(0.0) / 2.0, q.p[2] - q.thickness.max(0.0)),
+            MoveKind::Print => (
+                f64::from(q.width.max(0.0)) / 2.0,
+                q.p[2] - f64::from(q.thickness.max(0.0)),
+            ),
             MoveKind::Travel => (0.0, q.p[2]),
         };
         for k in 0..2 {
@@ -149,7 +152,7 @@ fn xy_box<'a>(
     for q in points {
         any = true;
         let r = if beads && q.kind == MoveKind::Print {
-            q.width.max(0.0) / 2.0
+            f64::from(q.width.max(0.0)) / 2.0
         } else {
             0.0
         };
@@ -190,7 +193,7 @@ pub fn table_offset(path: &ToolPath) -> [f64; 3] {
     let mut hi = [f64::NEG_INFINITY; 2];
     for q in placed {
         let bottom = match (q.kind, unit(q.axis)) {
-            (MoveKind::Print, Some(a)) => q.p[2] - q.thickness.max(0.0) * a[2],
+            (MoveKind::Print, Some(a)) => q.p[2] - f64::from(q.thickness.max(0.0)) * a[2],
             _ => q.p[2],
         };
         for k in 0..2 {

@@ -95,14 +95,14 @@ fn add_path(
             (MoveKind::Print, m.filament_length(W, T, len))
         };
         path.points.push(PathPoint {
-            feature,
-            layer,
+            feature: feature as u32,
+            layer: layer as u32,
             kind,
             p,
             axis,
             e,
-            thickness: T,
-            width: W,
+            thickness: T as f32,
+            width: W as f32,
             role: robot_post::toolpath::Role::Perimeter,
         });
     }
@@ -347,8 +347,8 @@ fn match_points(planned: &ToolPath, parsed: &Parsed, m: &MachineProfile) -> Vec<
             );
             e_sum += mv.e.unwrap();
             if norm(sub(p, q.p)) <= 0.01 && (e_sum - q.e).abs() <= 1.5e-5 {
-                assert_eq!(mv.feature, Some(q.feature), "point {i}");
-                assert_eq!(mv.layer, Some(q.layer), "point {i}");
+                assert_eq!(mv.feature, Some(q.feature as usize), "point {i}");
+                assert_eq!(mv.layer, Some(q.layer as usize), "point {i}");
                 out.push((i, k - 1));
                 break;
             }
@@ -405,7 +405,7 @@ fn delta5_program_reparsed_reproduces_toolpath_csv() {
         let n = planned
             .points
             .iter()
-            .filter(|q| q.feature == *f && q.kind == MoveKind::Print)
+            .filter(|q| q.feature as usize == *f && q.kind == MoveKind::Print)
             .count();
         assert!(k.print_moves >= n, "feature {f}");
         assert_eq!(
@@ -549,7 +549,7 @@ fn delta5_kinematic_error_within_the_goal() {
             .into_iter()
             .fold(1.0, f64::max)
             .ceil() as usize;
-            let entry = recomputed.entry(q.feature).or_default();
+            let entry = recomputed.entry(q.feature as usize).or_default();
             for s in 1..=steps {
                 let f = s as f64 / steps as f64;
                 let j: [f64; 5] = std::array::from_fn(|k| j0[k] + (j1[k] - j0[k]) * f);

@@ -21,8 +21,8 @@ fn pt(kind: MoveKind, p: [f64; 3], axis: [f64; 3]) -> PathPoint {
         p,
         axis,
         e: if kind == MoveKind::Print { 0.03 } else { 0.0 },
-        thickness: T,
-        width: W,
+        thickness: T as f32,
+        width: W as f32,
         role: Role::Perimeter,
     }
 }

@@ -14,14 +14,14 @@ fn profile() -> MachineProfile {
 
 fn point(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], e: f64) -> PathPoint {
     PathPoint {
-        feature,
-        layer,
+        feature: feature as u32,
+        layer: layer as u32,
         kind,
         p,
         axis: [0.0, 0.0, 1.0],
         e,
-        thickness: T,
-        width: W,
+        thickness: T as f32,
+        width: W as f32,
         role: robot_post::toolpath::Role::Perimeter,
     }
 }
@@ -204,8 +204,8 @@ fn marlin_program_reparsed_reproduces_toolpath_csv() {
             );
         }
         assert!((e - q.e).abs() <= 1e-5, "print {i}: E {e} vs {}", q.e);
-        assert_eq!(*layer, Some(q.layer), "print {i}");
-        assert_eq!(*feature, Some(q.feature), "print {i}");
+        assert_eq!(*layer, Some(q.layer as usize), "print {i}");
+        assert_eq!(*feature, Some(q.feature as usize), "print {i}");
     }
     // Retraction balances: no net filament over any travel between two print moves.
     for (i, g) in parsed.gaps.iter().enumerate() {
@@ -518,8 +518,8 @@ fn marlin_edge_cases_do_not_panic() {
                 MoveKind::Travel
             };
             points.push(PathPoint {
-                feature: (rng.next() % 3) as usize,
-                layer: (rng.next() % 3) as usize,
+                feature: (rng.next() % 3) as u32,
+                layer: (rng.next() % 3) as u32,
                 kind,
                 p: [rng.v(), rng.v(), rng.v()],
                 axis: if rng.next() % 4 == 0 {
@@ -528,8 +528,8 @@ fn marlin_edge_cases_do_not_panic() {
                     [0.0, 0.0, 1.0]
                 },
                 e: rng.v(),
-                thickness: rng.v(),
-                width: rng.v(),
+                thickness: rng.v() as f32,
+                width: rng.v() as f32,
                 role: robot_post::toolpath::Role::Perimeter,
             });
         }

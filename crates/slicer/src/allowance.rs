@@ -141,8 +141,8 @@ impl Envelope {
                 a: P3::from(a.p),
                 b: P3::from(b.p),
                 axis,
-                half_width: 0.5 * b.width,
-                thickness: b.thickness,
+                half_width: 0.5 * f64::from(b.width),
+                thickness: f64::from(b.thickness),
             });
         }
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();

@@ -95,7 +95,7 @@ pub fn sequence(plans: Vec<(usize, FeaturePlan)>) -> ToolPath {
     for (id, plan) in plans {
         let mut own = plan.points;
         for q in &mut own {
-            q.feature = id;
+            q.feature = id as u32;
         }
         // The first plan's points become the path's (no copy); the others are appended.
         if points.is_empty() {
@@ -159,7 +159,7 @@ mod tests {
         let path = sequence(vec![(3, a), (7, b)]);
         let xs: Vec<f64> = path.points.iter().map(|q| q.p[0]).collect();
         assert_eq!(xs, [0.0, 1.0, 2.0, 5.0, 6.0]);
-        let ids: Vec<usize> = path.points.iter().map(|q| q.feature).collect();
+        let ids: Vec<usize> = path.points.iter().map(|q| q.feature as usize).collect();
         assert_eq!(ids, [3, 3, 3, 7, 7]);
         assert_eq!(path.points[3].kind, MoveKind::Travel);
     }

@@ -855,14 +855,14 @@ fn push_prints(
         fig.print_length += l;
         fig.filament += e;
         points.push(PathPoint {
-            feature: id,
-            layer,
+            feature: id as u32,
+            layer: layer as u32,
             kind: MoveKind::Print,
             p: [w[1].p.x, w[1].p.y, w[1].p.z],
             axis: axis(w[1].n),
             e,
-            thickness: t,
-            width,
+            thickness: t as f32,
+            width: width as f32,
             role: w[1].role,
         });
     }
@@ -883,14 +883,14 @@ fn push_travel(
             fig.travel_length += (p - c).norm();
         }
         points.push(PathPoint {
-            feature: id,
-            layer,
+            feature: id as u32,
+            layer: layer as u32,
             kind: MoveKind::Travel,
             p: [p.x, p.y, p.z],
             axis: axis(n),
             e: 0.0,
-            thickness,
-            width,
+            thickness: thickness as f32,
+            width: width as f32,
             role,
         });
         *cursor = Some(p);

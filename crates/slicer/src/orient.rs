@@ -350,7 +350,7 @@ pub fn limit_tilt(
         }
         let (s, c) = target.sin_cos();
         p.axis = [s * a[0] / r, s * a[1] / r, c];
-        let e = out.entry(p.feature).or_default();
+        let e = out.entry(p.feature as usize).or_default();
         e.0 += 1;
         e.1 = e.1.max(tilt.to_degrees() - target.to_degrees());
     }
@@ -507,7 +507,7 @@ pub fn smooth(path: &mut ToolPath, params: &SmoothParams) -> BTreeMap<usize, Ori
             before
         };
         // Per feature, the largest figures over its paths.
-        let e = out.entry(feature).or_default();
+        let e = out.entry(feature as usize).or_default();
         e.step_max_deg_before = e.step_max_deg_before.max(before.0);
         e.rate_max_deg_per_mm_before = e.rate_max_deg_per_mm_before.max(before.1);
         e.step_max_deg_after = e.step_max_deg_after.max(after.0);

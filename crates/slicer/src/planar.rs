@@ -751,14 +751,14 @@ impl Two5dFill {
                 }
                 let start = points.len();
                 points.push(PathPoint {
-                    feature: id,
-                    layer,
+                    feature: id as u32,
+                    layer: layer as u32,
                     kind: MoveKind::Travel,
                     p: [first.x, first.y, first.z],
                     axis,
                     e: 0.0,
-                    thickness: dl,
-                    width: path.widths[0],
+                    thickness: dl as f32,
+                    width: path.widths[0] as f32,
                     role: path.role,
                 });
                 for (i, w) in pts.windows(2).enumerate() {
@@ -772,14 +772,14 @@ impl Two5dFill {
                         false => fig.filament += e,
                     }
                     points.push(PathPoint {
-                        feature: id,
-                        layer,
+                        feature: id as u32,
+                        layer: layer as u32,
                         kind: MoveKind::Print,
                         p: [w[1].x, w[1].y, w[1].z],
                         axis,
                         e,
-                        thickness: dl,
-                        width: path.widths[i + 1],
+                        thickness: dl as f32,
+                        width: path.widths[i + 1] as f32,
                         role: path.role,
                     });
                 }

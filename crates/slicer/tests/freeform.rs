@@ -111,7 +111,7 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
                 .path_points(p)
                 .1
                 .iter()
-                .all(|q| q.layer == l.index && q.thickness == l.thickness)));
+                .all(|q| q.layer == l.index as u32 && q.thickness == l.thickness as f32)));
         }
         let rf = f.reference.face.expect("reference face");
         let surf = t.brep.face_surface(rf);
@@ -119,7 +119,10 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
         let h = params.uniform_layer_height;
         // Layer tops: the running sum of the thicknesses.
         let mut tops: HashMap<usize, f64> = HashMap::new();
-        let mut thick: Vec<(usize, f64)> = pts.iter().map(|p| (p.layer, p.thickness)).collect();
+        let mut thick: Vec<(usize, f64)> = pts
+            .iter()
+            .map(|p| (p.layer as usize, f64::from(p.thickness)))
+            .collect();
         thick.sort_by_key(|x| x.0);
         thick.dedup_by_key(|x| x.0);
         let mut z = 0.0;
@@ -132,8 +135,12 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
             tops.insert(layer, z);
             last = Some(layer);
         }
-        let by_layer =
-            |l: usize| -> Vec<PathPoint> { pts.iter().filter(|p| p.layer == l).copied().collect() };
+        let by_layer = |l: usize| -> Vec<PathPoint> {
+            pts.iter()
+                .filter(|p| p.layer == l as u32)
+                .copied()
+                .collect()
+        };
         let mut below_cache: HashMap<usize, Near> = HashMap::new();
         let (mut sampled, mut unsupported) = (0usize, 0usize);
         let (mut worst_d, mut worst_axis, mut worst_support) = (0.0f64, 0.0f64, 0.0f64);
@@ -151,7 +158,7 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
             let n = surf.normal(u, v).expect("normal");
             let n = if n.dot(&(x - foot)) < 0.0 { -n } else { n };
             let d = (x - foot).dot(&n);
-            let top = tops[&p.layer];
+            let top = tops[&(p.layer as usize)];
             worst_d = worst_d.max((d - top).abs());
             assert!(
                 (d - top).abs() <= 0.02 * h,
@@ -171,7 +178,7 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
             // the tolerance (issue: "exact boundary curves, sampled within tolerance"): there
             // the middle may lie outside, but no farther than the chord tolerance of the mesh
             // the planner cuts (a quarter of the tolerance; 6 µm seen on the capsule).
-            let mid = x - n * (0.5 * p.thickness);
+            let mid = x - n * (0.5 * f64::from(p.thickness));
             if i % 7 == 0 {
                 let w = mesh.winding_number(&mid);
                 let at = format!(
@@ -206,15 +213,15 @@ fn check(name: &str, params: &LayerParams, check_support: bool) -> Vec<Checked> 
                 // layer k is still inside the feature (an overhang puts it outside), and the
                 // beads of layer k−1 run there (a pocket of the fill is smaller than a bead).
                 sampled += 1;
-                let below = x - n * (1.25 * p.thickness);
+                let below = x - n * (1.25 * f64::from(p.thickness));
                 if mesh.winding_number(&below) <= 0.5 {
                     unsupported += 1;
                     continue;
                 }
                 let near = below_cache
-                    .entry(p.layer - 1)
-                    .or_insert_with(|| Near::new(&by_layer(p.layer - 1), 0.5));
-                let gap = near.distance(&(x - n * p.thickness));
+                    .entry((p.layer - 1) as usize)
+                    .or_insert_with(|| Near::new(&by_layer((p.layer - 1) as usize), 0.5));
+                let gap = near.distance(&(x - n * f64::from(p.thickness)));
                 worst_support = worst_support.max(gap);
                 assert!(
                     gap <= BEAD.width,

@@ -35,8 +35,8 @@ fn noise(state: &mut u64) -> f64 {
 
 fn point(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], axis: [f64; 3]) -> PathPoint {
     PathPoint {
-        feature,
-        layer,
+        feature: feature as u32,
+        layer: layer as u32,
         kind,
         p,
         axis,
@@ -470,7 +470,7 @@ fn only_axes_change_and_runs_are_smoothed_apart() {
         let (mut step, mut rate) = (0.0f64, 0.0f64);
         for r in runs
             .iter()
-            .filter(|r| original.points[r.start].feature == *f)
+            .filter(|r| original.points[r.start].feature as usize == *f)
         {
             let (s, t) = orientation_step_rate(&original.points[r.clone()]);
             step = step.max(s);

@@ -94,8 +94,8 @@ fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<
     // Thickness bounds, unit axes.
     for p in &prints {
         assert!(
-            p.thickness >= params.min_layer_height - 1e-9
-                && p.thickness <= params.max_layer_height + 1e-9,
+            f64::from(p.thickness) >= params.min_layer_height - 1e-9
+                && f64::from(p.thickness) <= params.max_layer_height + 1e-9,
             "{name} feature {id}: thickness {} outside [{}, {}]",
             p.thickness,
             params.min_layer_height,
@@ -139,13 +139,13 @@ fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<
             "{name} feature {id}: last-layer point {x:?} lies {d:.4} mm off the top"
         );
         // The bead's centre, half its thickness down the axis, lies that far under the top.
-        let c = x - V3::from(p.axis) * (0.5 * p.thickness);
+        let c = x - V3::from(p.axis) * (0.5 * f64::from(p.thickness));
         let dc = shells
             .iter()
             .map(|m| distance_to_mesh(m, &c))
             .fold(f64::INFINITY, f64::min);
         assert!(
-            (dc - 0.5 * p.thickness).abs() <= params.tolerance,
+            (dc - 0.5 * f64::from(p.thickness)).abs() <= params.tolerance,
             "{name} feature {id}: last-layer bead centre {dc:.4} mm under the top, half its thickness is {:.4}",
             0.5 * p.thickness
         );
@@ -197,7 +197,7 @@ fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<
         }
         let (a, b) = (P3::from(w[0].p), P3::from(w[1].p));
         let n = ((b - a).norm() / 0.05).ceil().max(1.0) as usize;
-        let v = by_layer.entry(w[1].layer).or_default();
+        let v = by_layer.entry(w[1].layer as usize).or_default();
         for i in 0..=n {
             v.extend(foot(&(a + (b - a) * (i as f64 / n as f64))));
         }
@@ -218,7 +218,7 @@ fn check_transition_along(name: &str, t: &FeatureTree, id: usize, along: Option<
         if i > 0 {
             for x in prints
                 .iter()
-                .filter(|p| p.layer == l)
+                .filter(|p| p.layer as usize == l)
                 .map(|p| P3::from(p.p))
             {
                 let Some((fx, dx)) = foot(&x) else {
@@ -434,7 +434,7 @@ fn sst_wall_axes_are_perpendicular_to_the_side_face_and_the_path() {
             continue;
         }
         let axis = V3::from(p.axis);
-        let centre = P3::from(p.p) - axis * (0.5 * p.thickness);
+        let centre = P3::from(p.p) - axis * (0.5 * f64::from(p.thickness));
         let mut near: Vec<(f64, V3)> = sides
             .iter()
             .map(|(m, n)| (distance_to_mesh(m, &centre), *n))

@@ -38,7 +38,7 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
     let plate = pts
         .iter()
         .filter(|q| q.kind == MoveKind::Print)
-        .map(|q| q.p[2] - q.thickness.max(0.0))
+        .map(|q| q.p[2] - f64::from(q.thickness.max(0.0)))
         .fold(f64::INFINITY, f64::min);
     let cap = machine.max_speed.unwrap_or(f64::INFINITY);
     let print_accel = machine.max_acceleration.unwrap_or(f64::INFINITY);
@@ -53,7 +53,7 @@ pub fn estimate(path: &ToolPath, machine: &MachineProfile) -> Estimate {
         let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let (speed, accel) = match q.kind {
             MoveKind::Print => {
-                let on_plate = q.p[2] - q.thickness.max(0.0) <= plate + 0.01;
+                let on_plate = q.p[2] - f64::from(q.thickness.max(0.0)) <= plate + 0.01;
                 let v = if on_plate {
                     machine.first_layer_speed
                 } else {

@@ -191,7 +191,7 @@ pub(super) fn plan_poses(
 
 fn axis_error(q: &PathPoint, name: &str, reason: String, remedy: String) -> PostError {
     PostError::Delta5Axis {
-        feature: q.feature,
+        feature: q.feature as usize,
         i: q.axis[0],
         j: q.axis[1],
         k: q.axis[2],
@@ -332,7 +332,7 @@ fn fit_c_limits(
     let k_max = ((c_hi - hi + ANGLE_TOLERANCE) / 360.0).floor();
     if k_min > k_max || c.is_empty() {
         return Err(PostError::Delta5CLimits {
-            feature: run.first().map_or(0, |q| q.feature),
+            feature: run.first().map_or(0, |q| q.feature as usize),
             span: hi - lo,
             c_min: c_lo,
             c_max: c_hi,

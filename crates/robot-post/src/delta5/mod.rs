@@ -191,7 +191,7 @@ pub fn delta5_to(
         let below = -(q.p[2] + offset[2]);
         if below > FIT_TOLERANCE {
             return Err(PostError::Delta5Envelope {
-                feature: q.feature,
+                feature: q.feature as usize,
                 name: m.name.clone(),
                 excess: format!(
                     "a point lies {} mm below the table surface",
@@ -212,7 +212,7 @@ pub fn delta5_to(
                 q.p[1] + offset[1],
                 q.p[2] + offset[2] + g.table_above_b_axis,
             ];
-            norm(t) + q.width.max(0.0) / 2.0
+            norm(t) + f64::from(q.width.max(0.0)) / 2.0
         })
         .fold(0.0, f64::max);
     let wanted_safe = g.b_axis_z + swing + m.z_hop + g.reorient_clearance;

@@ -147,7 +147,7 @@ impl<'a> Writer<'a> {
 
     /// `;LAYER:` and `;FEATURE:` comments where the point's layer or feature changes.
     pub(super) fn comments(&mut self, q: &PathPoint) {
-        self.current = q.feature;
+        self.current = q.feature as usize;
         self.marks.write(q, q.p[2] + self.offset[2], &mut self.out);
     }
 
@@ -339,7 +339,7 @@ impl<'a> Writer<'a> {
 
         // Planned deposition speed along the part.
         let bottom = match unit(q.axis) {
-            Some(ax) => q.p[2] - q.thickness.max(0.0) * ax[2],
+            Some(ax) => q.p[2] - f64::from(q.thickness.max(0.0)) * ax[2],
             None => q.p[2],
         };
         let on_table = bottom + self.offset[2] <= 0.01;
@@ -350,7 +350,7 @@ impl<'a> Writer<'a> {
         };
         let part_step = length / n as f64;
         let mut from = start;
-        let acc = self.figures.entry(q.feature).or_default();
+        let acc = self.figures.entry(q.feature as usize).or_default();
         if n > 1 {
             acc.figures.subdivided_segments += 1;
         }
@@ -375,7 +375,8 @@ impl<'a> Writer<'a> {
                 acc.sum += sum;
                 acc.figures.samples += count;
                 self.printed_length += part_step;
-                self.plot.push((q.feature, self.printed_length, worst));
+                self.plot
+                    .push((q.feature as usize, self.printed_length, worst));
             }
             // Zero-length in machine coordinates (X, Y, Z, B and C as written), or extruding
             // nothing over a few micrometres: merged into the next move, which carries its E.

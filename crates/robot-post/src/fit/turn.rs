@@ -97,7 +97,7 @@ pub fn envelope_excess(path: &ToolPath, m: &MachineProfile) -> Result<f64, PostE
             for q in &path.points {
                 top = top.max(q.p[2]);
                 if q.kind == MoveKind::Print {
-                    bottom = bottom.min(q.p[2] - q.thickness.max(0.0));
+                    bottom = bottom.min(q.p[2] - f64::from(q.thickness.max(0.0)));
                 } else if !any_print {
                     bottom = bottom.min(q.p[2]);
                 }

@@ -73,7 +73,7 @@ impl<'a> Reach<'a> {
         let n = path.points.len();
         let mut figures: BTreeMap<usize, KukaFigures> = BTreeMap::new();
         for q in &path.points {
-            figures.entry(q.feature).or_default().points += 1;
+            figures.entry(q.feature as usize).or_default().points += 1;
         }
         Reach {
             cell,
@@ -175,7 +175,7 @@ impl<'a> Reach<'a> {
             ..
         } = self;
         for (i, q) in path.points.iter().enumerate() {
-            if let Some(fig) = figures.get_mut(&q.feature) {
+            if let Some(fig) = figures.get_mut(&(q.feature as usize)) {
                 fig.unreachable_points += usize::from(unreachable[i]);
                 fig.wrist_singular_points += usize::from(singular[i]);
             }

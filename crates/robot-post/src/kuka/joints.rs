@@ -37,7 +37,7 @@ pub(super) fn write_joints(
         };
         n += 1;
         let feature = path.points[point].feature;
-        let solved = reach.motion(&pose, point, feature, (JOINTS_CSV, n + 1));
+        let solved = reach.motion(&pose, point, feature as usize, (JOINTS_CSV, n + 1));
         text.push_str(&n.to_string());
         text.push(',');
         text.push_str(&point.to_string());

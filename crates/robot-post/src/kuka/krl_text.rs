@@ -237,7 +237,7 @@ impl Steps<'_> {
             } => {
                 let feature = self.path.points[*point].feature;
                 let at = (self.file.as_str(), self.line + 1);
-                let solved = self.reach.motion(pose, *point, feature, at);
+                let solved = self.reach.motion(pose, *point, feature as usize, at);
                 let f = solved.frame;
                 let mut line = match (kind, solved.joints) {
                     (Kind::Ptp, Some((_, s, t))) => format!("PTP {}", pos_text(&f, s, t)),

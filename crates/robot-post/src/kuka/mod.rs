@@ -209,7 +209,7 @@ pub fn kuka_to(
         if n.is_nan() || (n - 1.0).abs() > AXIS_LENGTH_TOLERANCE {
             return Err(PostError::KukaAxisNotUnit {
                 index,
-                feature: q.feature,
+                feature: q.feature as usize,
                 i: q.axis[0],
                 j: q.axis[1],
                 k: q.axis[2],

@@ -211,9 +211,9 @@ impl<'a> Planner<'a> {
         if q.kind == MoveKind::Travel && !starts_path {
             return;
         }
-        if self.layer != Some(q.layer) || self.feature != Some(q.feature) {
-            self.layer = Some(q.layer);
-            self.feature = Some(q.feature);
+        if self.layer != Some(q.layer as usize) || self.feature != Some(q.feature as usize) {
+            self.layer = Some(q.layer as usize);
+            self.feature = Some(q.feature as usize);
             w.steps.push_back(Step::Comment(format!(
                 "FEATURE {} LAYER {}",
                 q.feature, q.layer
@@ -231,7 +231,7 @@ impl<'a> Planner<'a> {
                     self.cur = Some((pose, i));
                     return;
                 }
-                let on_plate = p[2] - q.thickness.max(0.0) <= 0.01;
+                let on_plate = p[2] - f64::from(q.thickness.max(0.0)) <= 0.01;
                 w.vel(if on_plate { self.first_v } else { self.print_v });
                 if !w.on {
                     w.extruder(true);

@@ -59,11 +59,11 @@ fn trimmed(v: f64, decimals: usize) -> String {
 /// nothing.
 pub fn layer_heights(path: &ToolPath) -> Option<(f64, f64)> {
     let mut prints = path.points.iter().filter(|q| q.kind == MoveKind::Print);
-    let first = prints.next()?.thickness;
+    let first = f64::from(prints.next()?.thickness);
     let mut counts: std::collections::BTreeMap<i64, usize> = Default::default();
     for q in path.points.iter().filter(|q| q.kind == MoveKind::Print) {
         *counts
-            .entry((q.thickness * 1e3).round() as i64)
+            .entry((f64::from(q.thickness) * 1e3).round() as i64)
             .or_default() += 1;
     }
     let common = counts

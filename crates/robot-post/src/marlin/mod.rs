@@ -96,7 +96,7 @@ pub fn marlin_job_to(
     path.check_finite()?;
     if let Some(q) = path.points.iter().find(|q| !is_plus_z(q.axis)) {
         return Err(PostError::ToolAxis {
-            feature: q.feature,
+            feature: q.feature as usize,
             i: q.axis[0],
             j: q.axis[1],
             k: q.axis[2],
@@ -182,7 +182,7 @@ fn arc_run(
         .take_while(|q| {
             q.kind == MoveKind::Print
                 && (q.feature, q.layer, q.role) == (first.feature, first.layer, first.role)
-                && (q.width - first.width).abs() <= WIDTH_STEP
+                && (f64::from(q.width) - f64::from(first.width)).abs() <= WIDTH_STEP
         })
         .map(machine)
         .take_while(|t| t[2] == z)
@@ -426,7 +426,7 @@ impl Writer {
         }
         self.resume();
         // A bead resting on the plate (its bottom within 10 µm of Z0) goes at first-layer speed.
-        let on_plate = t[2] - q.thickness.max(0.0) <= 0.01;
+        let on_plate = t[2] - f64::from(q.thickness.max(0.0)) <= 0.01;
         self.fan.set(on_plate, &mut self.out);
         push_move(&mut self.out, "G1", t);
         self.end_print_move(de, on_plate, t);
@@ -464,7 +464,7 @@ impl Writer {
         self.resume();
         let on_plate = points
             .first()
-            .is_some_and(|q| end[2] - q.thickness.max(0.0) <= 0.01);
+            .is_some_and(|q| end[2] - f64::from(q.thickness.max(0.0)) <= 0.01);
         self.fan.set(on_plate, &mut self.out);
         let out = &mut self.out;
         out.push_str(if arc.ccw { "G3 X" } else { "G2 X" });

@@ -18,14 +18,14 @@ pub fn profile() -> MachineProfile {
 pub fn pt(feature: usize, layer: usize, kind: MoveKind, p: [f64; 3], axis: [f64; 3]) -> PathPoint {
     let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
     PathPoint {
-        feature,
-        layer,
+        feature: feature as u32,
+        layer: layer as u32,
         kind,
         p,
         axis: [axis[0] / n, axis[1] / n, axis[2] / n],
         e: if kind == MoveKind::Print { 0.03 } else { 0.0 },
-        thickness: T,
-        width: W,
+        thickness: T as f32,
+        width: W as f32,
         role: robot_post::toolpath::Role::Perimeter,
     }
 }
