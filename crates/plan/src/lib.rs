@@ -336,16 +336,13 @@ fn run(
     // A KUKA part out of the arm's reach is moved on the table first.
     let moved = reach::into_reach(&stages.checked.toolpath, machine, options);
     let machine = moved.as_ref().map_or(machine, |m| &m.machine);
-    let (settings, est, notes) = post::header(&stages.checked, process, machine);
-    let program = match post::post(
-        &stages.checked.toolpath,
-        machine,
-        &process.base(),
-        options,
-        &notes,
-        sink,
-        csv,
-    ) {
+    let toolpath = &stages.checked.toolpath;
+    let ((settings, est, program), written) = post::beside_csv(toolpath, csv, || {
+        let (settings, est, notes) = post::header(&stages.checked, process, machine);
+        let program = post::post(toolpath, machine, &process.base(), options, &notes, sink);
+        (settings, est, program)
+    });
+    let program = match program.and_then(|p| written.map(|()| p)) {
         Ok(program) => program,
         Err(PlanError::Post(e)) => {
             let plan = stages.assemble(machine, options, None, passed, &est, settings);
@@ -382,7 +379,6 @@ fn refuse(
         options,
         &notes,
         &mut post::Discard,
-        None,
     ) {
         Err(e) => Gate::Machine(e.to_string()),
         Ok(_) => gate,
