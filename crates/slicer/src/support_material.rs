@@ -495,7 +495,10 @@ mod tests {
         let pillar = rect(0.0, 0.0, 10.0, 10.0);
         let active = carried(&[column], &[], &[pillar]);
         assert!((area(&active) - 200.0).abs() < 1e-5, "{}", area(&active));
-        let vertices: usize = active.iter().map(|r| r.outer.len() + r.holes.len()).sum();
+        let vertices: usize = active
+            .iter()
+            .map(|r| r.outer.len() + r.holes.iter().map(Vec::len).sum::<usize>())
+            .sum();
         assert!(vertices <= 6, "{vertices} vertices");
     }
 

@@ -164,7 +164,7 @@ impl ToolPath {
                     clip(f[k])
                 ))),
             };
-            // Thickness and width are kept in single precision (a 0.1 µm step at 1 mm).
+            // Thickness and width are kept in single precision (a 0.1 nm step at 1 mm).
             let num32 = |k: usize, name: &str| match num(k, name).map(|v| v as f32) {
                 Ok(v) if !v.is_finite() => {
                     Err(err(format!("{name} `{}` is too large", clip(f[k]))))
