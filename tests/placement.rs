@@ -362,15 +362,64 @@ fn an_attempt_is_given_up_at_its_first_unsupported_curved_feature_and_the_refusa
             "{f}"
         );
     }
-    // Each attempt stopped at the first blade found unsupported, and says so.
+    // The part as modelled stopped at the first blade found unsupported; the placements after
+    // it extract the same blade and are refused for it before laying anything, with the same
+    // figures; each says which.
     let tried = r["placement"]["tried"].as_array().expect("tried");
     assert!(tried.len() >= 2, "{tried:?}");
-    for t in tried {
-        let f = t["failure"].as_str().expect("failure");
+    let failures: Vec<&str> = tried
+        .iter()
+        .map(|t| t["failure"].as_str().expect("failure"))
+        .collect();
+    // The figures: the failure but its last parenthesis (how it was found).
+    let figures = |f: &str| f[..f.rfind(" (").expect("how found")].to_string();
+    for (k, f) in failures.iter().enumerate() {
         assert!(
-            f.starts_with("layers not held up: feature 1 (freeform)")
-                && f.contains("the rest of the plan was not made"),
+            f.starts_with("layers not held up: feature 1 (freeform)"),
             "{f}"
         );
+        let how = match k {
+            0 => "the rest of the plan was not made",
+            _ => "as an earlier placement laid the same curved feature",
+        };
+        assert!(f.contains(how), "{f}");
+        assert_eq!(figures(f), figures(failures[0]));
     }
+    // Why that holds: planned in full on that face (#3661, the top of the hub, turned down),
+    // each blade's curved layers and their unsupported area are those of the part as modelled.
+    let face = s.path("face");
+    let o = plan_at(
+        &fixture("impeller.step"),
+        "delta5",
+        &face,
+        &[
+            "--set",
+            "slicing=features",
+            "--base-face",
+            "3661",
+            "--keep-going",
+            "--set",
+            "pedestal=off",
+        ],
+    );
+    // (Refused there by the work envelope, the pedestal left off: laid in full all the same.)
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let on_face = report(&face);
+    let curved = |r: &Value| -> Vec<(Value, Value, Value)> {
+        r["features"]
+            .as_array()
+            .expect("features")
+            .iter()
+            .filter(|f| f["kind"] == "freeform")
+            .map(|f| {
+                (
+                    f["faces"].clone(),
+                    f["layers"].clone(),
+                    f["unsupported_area_mm2"].clone(),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(curved(&on_face).len(), 6);
+    assert_eq!(curved(&on_face), curved(&r));
 }

@@ -44,6 +44,7 @@ pub fn run(args: &PlanArgs) -> Result<(), Failure> {
             .ok(),
         stop_at: None,
         fail_fast: false,
+        known_unsupported: None,
     };
     // The program goes to its files as the post makes it, under temporary names until every
     // gate has passed (dropped on any failure: nothing written); toolpath.csv likewise. Each

@@ -53,10 +53,14 @@ pub enum PlanError {
     /// The plan was given up at its first curved feature whose layers are not held up
     /// ([`crate::Options::fail_fast`]): the features after it were not laid, and there is no
     /// plan to show; one [`crate::support::line`] for each feature of its group of features.
-    #[error("layers not held up: {} (found as the features were laid; the rest of the plan was not made)", lines.join("; "))]
+    /// Or refused before anything was laid, for a curved feature an earlier placement found
+    /// so ([`crate::support::KnownUnsupported`]).
+    #[error("layers not held up: {} ({})", lines.join("; "), if *earlier { "as an earlier placement laid the same curved feature: its layers do not change with the placement; nothing of this one was laid" } else { "found as the features were laid; the rest of the plan was not made" })]
     Unsupported {
         /// The features found unsupported, one line each.
         lines: Vec<String>,
+        /// Known from an earlier placement, not laid in this one.
+        earlier: bool,
     },
     /// The plan was given up at [`crate::Options::stop_at`] (the placement time limit of
     /// [`crate::retry::find`]).

@@ -4,6 +4,7 @@
 
 use crate::extract::{Extracted, Slot};
 use crate::report::FeatureEntry;
+use crate::support::{CurvedKey, KnownUnsupported};
 use crate::warning::{Warning, WarningKind};
 use crate::{PlanError, Process, Progress};
 use brep::math::P3;
@@ -83,6 +84,18 @@ pub fn lay(
     let stop_at = options.stop_at;
     let fail_fast = options.fail_fast && !options.keep_going;
     let base = process.base();
+    // Curved features an earlier placement found not held up (their layers do not change
+    // with the placement): refused before anything is laid.
+    let known = options.known_unsupported.filter(|_| fail_fast);
+    if let Some(known) = known {
+        let lines = known_lines(extracted, process, known)?;
+        if !lines.is_empty() {
+            return Err(PlanError::Unsupported {
+                lines,
+                earlier: true,
+            });
+        }
+    }
     // What holds up each planar layer, from the features alone (issue 31).
     // Support material (issue 33) carries what it can; `held` is what it leaves.
     let (mut held, columns) =
@@ -152,7 +165,13 @@ pub fn lay(
                     angle_deg: params.overhang_angle_deg,
                     kind: extracted.feature(slot).kind,
                 };
-                unsupported.extend(crate::support::line(id, &h));
+                if let Some(line) = crate::support::line(id, &h) {
+                    unsupported.push(line);
+                    let key = CurvedKey::of(t, extracted.feature(slot), &params);
+                    if let (Some(known), Some(key)) = (known, key) {
+                        known.add(key, h);
+                    }
+                }
                 held.insert(id, h);
             }
             laid.held = held.get(&id).copied();
@@ -166,7 +185,10 @@ pub fn lay(
         }
         // The support gate will refuse the plan: with fail_fast, nothing more is laid.
         if fail_fast && !unsupported.is_empty() {
-            return Err(PlanError::Unsupported { lines: unsupported });
+            return Err(PlanError::Unsupported {
+                lines: unsupported,
+                earlier: false,
+            });
         }
     }
     measure_allowance(extracted, &grown, &plans, &mut features)?;
@@ -176,6 +198,30 @@ pub fn lay(
         toolpath: slicer::sequence(plans),
         warnings,
     })
+}
+
+/// One [`crate::support::line`] for each curved feature of `extracted` that `known` holds
+/// (an earlier placement found its layers not held up), in build order, with its id here.
+fn known_lines(
+    extracted: &Extracted,
+    process: &Process,
+    known: &KnownUnsupported,
+) -> Result<Vec<String>, PlanError> {
+    let base = process.base();
+    let mut lines = vec![];
+    for &slot in &extracted.order {
+        let f = extracted.feature(slot);
+        if f.kind != features::FeatureKind::Freeform {
+            continue;
+        }
+        let params = process.feature_params(&base, slot.offset, f)?;
+        let t = &extracted.assembly.trees[slot.tree];
+        let held = CurvedKey::of(t, f, &params).and_then(|k| known.find(&k));
+        if let Some(h) = held {
+            lines.extend(crate::support::line(extracted.id(slot), &h));
+        }
+    }
+    Ok(lines)
 }
 
 /// The machining allowance the part's beads leave over each grown feature's nominal faces

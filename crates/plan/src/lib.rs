@@ -132,6 +132,10 @@ pub struct Options<'a> {
     /// [`Options::keep_going`]: the rest is not laid. [`retry::find`] sets it for the
     /// placements it tries, and plans the part as modelled again in full when none plans.
     pub fail_fast: bool,
+    /// Curved features an earlier placement of the part found not held up: with
+    /// [`Options::fail_fast`], a plan that extracts one again is refused for it before anything
+    /// is laid, and one that finds another adds it ([`support::KnownUnsupported`]).
+    pub known_unsupported: Option<&'a support::KnownUnsupported>,
 }
 
 impl Options<'_> {

@@ -136,3 +136,81 @@ pub fn line(id: usize, held: &Held) -> Option<String> {
 pub fn lines(held: &BTreeMap<usize, Held>) -> Vec<String> {
     held.iter().filter_map(|(id, h)| line(*id, h)).collect()
 }
+
+/// A curved feature as another placement of the same part extracts it again: the part's faces
+/// it holds and those of its voids (STEP `#id`s), the face it grows from, its parents' faces,
+/// and its layer parameters. Its curved layers are laid on its reference surface along its
+/// own tool axes, and measured against the layer below along them: gravity does not enter,
+/// so a placement that turns the part extracts the same feature, lays the same layers and
+/// finds the same unsupported area ([`KnownUnsupported`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvedKey {
+    faces: Vec<u64>,
+    voids: Vec<u64>,
+    reference: Option<u64>,
+    parents: Vec<Vec<u64>>,
+    params: slicer::params::LayerParams,
+}
+
+impl CurvedKey {
+    /// The key of feature `f` of `tree` laid with `params`; `None` for a planar feature, or
+    /// one without a face of the file (nothing to know it by).
+    pub fn of(
+        tree: &features::FeatureTree,
+        f: &features::Feature,
+        params: &slicer::params::LayerParams,
+    ) -> Option<CurvedKey> {
+        if f.kind != FeatureKind::Freeform {
+            return None;
+        }
+        let faces = f.step_faces(&tree.brep);
+        if faces.is_empty() {
+            return None;
+        }
+        let mut voids: Vec<u64> = f
+            .voids
+            .iter()
+            .flatten()
+            .map(|&v| tree.brep.face(v).step_id)
+            .collect();
+        voids.sort_unstable();
+        let parents = f
+            .parents
+            .iter()
+            .filter_map(|&p| tree.features.get(p))
+            .map(|p| p.step_faces(&tree.brep))
+            .collect();
+        Some(CurvedKey {
+            faces,
+            voids,
+            reference: f.reference.step_face,
+            parents,
+            params: params.clone(),
+        })
+    }
+}
+
+/// Curved features whose layers one placement of a part found not held up, for the placements
+/// tried after it ([`crate::retry::find`], [`crate::Options::known_unsupported`]): one that
+/// extracts the same curved feature ([`CurvedKey`]) is refused for it before anything is
+/// laid. The impeller on delta5: its second placement refused in 0.4 s where laying it again
+/// to the blade's twelfth layer took 1.7 s (docs/measurements.md).
+#[derive(Debug, Default)]
+pub struct KnownUnsupported(std::sync::Mutex<Vec<(CurvedKey, Held)>>);
+
+impl KnownUnsupported {
+    /// Remembers that the feature `key` names is held up only as `held` says.
+    pub fn add(&self, key: CurvedKey, held: Held) {
+        if let Ok(mut known) = self.0.lock() {
+            if !known.iter().any(|(k, _)| *k == key) {
+                known.push((key, held));
+            }
+        }
+    }
+
+    /// What holds up the feature `key` names, when a placement before found it not held up.
+    pub fn find(&self, key: &CurvedKey) -> Option<Held> {
+        let known = self.0.lock().ok()?;
+        known.iter().find(|(k, _)| k == key).map(|(_, h)| *h)
+    }
+}
