@@ -123,6 +123,21 @@ fn triangle_update(pa: &P3, pb: &P3, pc: &P3, da: f64, db: f64) -> f64 {
     }
 }
 
+/// How far round each vertex [`LayerMesh::local_max`] looks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reach {
+    /// This far (mm) round every vertex.
+    Within(f64),
+    /// `most` mm, but no more than `steps` lattice edges at the vertex ([`LayerMesh::edge_at`]:
+    /// on a lattice far finer than `most`, a search of a few edges' ball).
+    Steps {
+        /// The farthest, mm.
+        most: f64,
+        /// Edges, at most.
+        steps: f64,
+    },
+}
+
 impl LayerMesh {
     /// Exact 3-D distances to the boundary (the lifted ring polylines) of every vertex within
     /// `reach` (chart units) of it, as seeds for [`LayerMesh::march`]: a front started from
@@ -239,19 +254,46 @@ impl LayerMesh {
         out
     }
 
+    /// The edge (mm) of the equilateral triangle as large as the mean of the triangles at
+    /// vertex `v` on the layer surface: how closely the lattice samples it there, also where the
+    /// chart stretches its triangles long and thin; 0 for a vertex of no triangle.
+    pub fn edge_at(&self, v: usize) -> f64 {
+        let tris = &self.around[v];
+        if tris.is_empty() {
+            return 0.0;
+        }
+        let area: f64 = tris
+            .iter()
+            .map(|&t| {
+                let [a, b, c] = self.tris[t as usize].map(|i| self.p[i as usize]);
+                0.5 * (b - a).cross(&(c - a)).norm()
+            })
+            .sum::<f64>()
+            / tris.len() as f64;
+        // An equilateral triangle of edge e has area e²·√3/4.
+        (4.0 * area / 3f64.sqrt()).sqrt()
+    }
+
     /// For each vertex where `mask` holds, the largest `f` over the vertices joined to it
-    /// through the mesh within 3-D distance `radius` (others get `f` itself): the local height
-    /// of a ridge of `f` seen from its flanks. Exact up to the vertex's `cap`: its search stops
-    /// at the first value above that, which it keeps (above `cap`, at most the largest); with
-    /// `f64::INFINITY` the value is exact.
-    pub fn local_max(&self, f: &[f64], radius: f64, mask: &[bool], cap: &[f64]) -> Vec<f64> {
+    /// through the mesh within 3-D distance `reach` of it (others get `f` itself): the local
+    /// height of a ridge of `f` seen from its flanks. Exact up to the vertex's `cap`: its
+    /// search stops at the first value above that, which it keeps (above `cap`, at most the
+    /// largest); with `f64::INFINITY` the value is exact.
+    pub fn local_max(&self, f: &[f64], reach: Reach, mask: &[bool], cap: &[f64]) -> Vec<f64> {
         let mut out = f.to_vec();
         if !mask.iter().any(|&m| m) {
             return out;
         }
         let (first, next) = self.adjacency.get_or_init(|| self.neighbours());
         let around = |u: usize| &next[first[u] as usize..first[u + 1] as usize];
-        let within = sqrt_at_most(radius);
+        let within_at = |v: usize| match reach {
+            Reach::Within(r) => sqrt_at_most(r),
+            Reach::Steps { most, steps } => sqrt_at_most(most.min(steps * self.edge_at(v))),
+        };
+        let uniform = match reach {
+            Reach::Within(r) => Some(sqrt_at_most(r)),
+            Reach::Steps { .. } => None,
+        };
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
         // between vertices; each vertex's distance is taken once per flood).
         let mut seen = vec![0u32; self.q.len()];
@@ -262,6 +304,7 @@ impl LayerMesh {
             }
             let pv = self.p[v];
             let cap = cap[v];
+            let within = uniform.unwrap_or_else(|| within_at(v));
             // A climb first, from each vertex to its highest neighbour inside the ball while
             // that is higher: every vertex on the way is joined to v inside the ball, and a
             // flank's climb passes the cap in a few steps where the search would look at the

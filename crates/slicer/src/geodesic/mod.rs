@@ -23,6 +23,7 @@ mod tests;
 
 pub use crate::geom2d::region_contains;
 pub(crate) use field::segment_distance;
+pub use field::Reach;
 pub use iso::{clip_reaching, Piece, RunOn};
 pub use mesh::{IsoLine, LayerMesh};
 pub use ray::RayTop;

@@ -199,3 +199,60 @@ fn a_ray_up_the_distance_across_a_slanted_strip_stops_on_its_middle() {
         "half width read {bias} mm off on average"
     );
 }
+
+/// The vertex nearest `at` in chart coordinates.
+fn nearest(m: &LayerMesh, at: Point2) -> usize {
+    (0..m.q.len())
+        .min_by(|&a, &b| dist2(m.q[a], at).total_cmp(&dist2(m.q[b], at)))
+        .unwrap_or(0)
+}
+
+/// `edge_at` measures the lattice on the layer surface: the step on a flat square, and on a
+/// chart that squeezes the layer 5 to 1 across (a lattice made for one place of a chart that
+/// stretches unevenly) the edge of an equilateral triangle of the squeezed triangles' area.
+#[test]
+fn the_edge_at_a_vertex_is_the_lattice_step_on_the_surface() {
+    let mut m = LayerMesh::build(&square(4.0), 0.1);
+    m.p = m.q.iter().map(|q| P3::new(q[0], q[1], 0.0)).collect();
+    let v = nearest(&m, [2.0, 2.0]);
+    let e = m.edge_at(v);
+    assert!((e - 0.1).abs() < 0.01, "{e}");
+    m.p = m.q.iter().map(|q| P3::new(q[0], 0.2 * q[1], 0.0)).collect();
+    let squeezed = m.edge_at(v);
+    let want = 0.1 * 0.2f64.sqrt();
+    assert!(
+        (squeezed - want).abs() < 0.1 * want,
+        "{squeezed} for {want}"
+    );
+}
+
+/// A search by steps looks no farther than its lattice edges: a peak 0.5 mm off is the
+/// local maximum within 1 mm, and not within 1 mm but 2 edges of 0.1 mm, which still see the
+/// nearest neighbour.
+#[test]
+fn a_search_by_steps_stays_within_its_edges() {
+    let mut m = LayerMesh::build(&square(4.0), 0.1);
+    m.p = m.q.iter().map(|q| P3::new(q[0], q[1], 0.0)).collect();
+    let v = nearest(&m, [2.0, 2.0]);
+    let peak = nearest(&m, [2.5, 2.0]);
+    let mut f = vec![0.0; m.q.len()];
+    f[peak] = 1.0;
+    let mut mask = vec![false; m.q.len()];
+    mask[v] = true;
+    let cap = vec![f64::INFINITY; m.q.len()];
+    let wide = m.local_max(&f, Reach::Within(1.0), &mask, &cap);
+    assert_eq!(wide[v], 1.0);
+    let steps = Reach::Steps {
+        most: 1.0,
+        steps: 2.0,
+    };
+    assert_eq!(m.local_max(&f, steps, &mask, &cap)[v], 0.0);
+    // Its nearest neighbour lies within the 2 edges.
+    f[peak] = 0.0;
+    let closest = (0..m.q.len())
+        .filter(|&x| x != v)
+        .min_by(|&a, &b| dist2(m.q[a], m.q[v]).total_cmp(&dist2(m.q[b], m.q[v])))
+        .expect("a neighbour");
+    f[closest] = 1.0;
+    assert_eq!(m.local_max(&f, steps, &mask, &cap)[v], 1.0);
+}

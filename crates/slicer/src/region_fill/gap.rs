@@ -2,7 +2,7 @@
 //! as wide as the strip at each point (or, a strip over a bead across, one bead on each half).
 
 use super::FillPath;
-use crate::geodesic::{LayerMesh, RayTop};
+use crate::geodesic::{LayerMesh, RayTop, Reach};
 use crate::geom2d::Point2;
 use crate::toolpath::Role;
 
@@ -21,7 +21,7 @@ pub(super) struct Gap {
 /// above it, mm: far more than the round-off of interpolating between two such values.
 const RIDGE_CAP_MARGIN: f64 = 1e-6;
 
-/// The local ridge height of `db` (within `radius`) seen from the flanks of
+/// The local ridge height of `db` (within `reach`) seen from the flanks of
 /// the region, at the vertices the iso-lines at `levels` interpolate between (the ends of the
 /// lattice edges each `(level, top)` crosses), where the fills read it only through
 /// thresholds no higher than that level's `top` (a ring's width limit, a gap's `below` or
@@ -30,7 +30,7 @@ const RIDGE_CAP_MARGIN: f64 = 1e-6;
 /// own; a vertex above its cap whose crossing edges all end above theirs keeps some value
 /// above it (its search stops there), and so does every value interpolated between two such
 /// ends, which the fills then read as they would the exact one.
-pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], radius: f64) -> Vec<f64> {
+pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], reach: Reach) -> Vec<f64> {
     let n = db.len();
     let crosses = |a: usize, b: usize, l: f64| (db[a] - l) * (db[b] - l) <= 0.0;
     let mut cap = vec![f64::NEG_INFINITY; n];
@@ -47,7 +47,7 @@ pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], radius: f
         }
     }
     let mask: Vec<bool> = cap.iter().map(|c| *c > f64::NEG_INFINITY).collect();
-    let mut r = lm.local_max(db, radius, &mask, &cap);
+    let mut r = lm.local_max(db, reach, &mask, &cap);
     // A crossing edge with one end above its cap and the other exact: that end exact too.
     let above = |v: usize| r[v] > cap[v];
     let mut redo = vec![false; n];
@@ -62,7 +62,7 @@ pub(super) fn ridge(lm: &LayerMesh, db: &[f64], levels: &[(f64, f64)], radius: f
         }
     }
     if any {
-        let exact = lm.local_max(db, radius, &redo, &vec![f64::INFINITY; n]);
+        let exact = lm.local_max(db, reach, &redo, &vec![f64::INFINITY; n]);
         for (v, x) in r.iter_mut().enumerate() {
             if redo[v] {
                 *x = exact[v];
@@ -111,12 +111,16 @@ pub(super) fn gap_fill(
     let mut laid = Laid::new(RETRACE_SHARE * width);
     // The highest distance near each loop point (on a lattice coarse for the strip, the loop
     // breaks into islands along the ridge, and a ray from it may meet the ridge between
-    // vertices that sample it low).
+    // vertices that sample it low). Told apart up to the fill's `below` only: it is read no
+    // higher (`near.min(gap.below)`).
     let near = ridge(
         lm,
         db,
-        &[(level, gap.edge + width)],
-        NEAR_RIDGE_SHARE * width,
+        &[(level, (gap.edge + width).min(gap.below))],
+        Reach::Steps {
+            most: NEAR_RIDGE_SHARE * width,
+            steps: NEAR_RIDGE_STEPS,
+        },
     );
     for line in lm.iso_lines(db, level, &near) {
         // Up the distance from the loop to where it stops rising: the ridge the flanks meet
@@ -219,6 +223,16 @@ pub(super) fn gap_fill(
 /// How far, in bead widths, a gap fill looks round each loop point for the ridge's height
 /// (besides up its ray).
 const NEAR_RIDGE_SHARE: f64 = 0.5;
+
+/// ... and at most this many lattice edges at the point's vertex ([`LayerMesh::edge_at`]): a
+/// lattice finer than a twelfth of a bead finds the ridge up the ray by itself.
+///
+/// Why: the search's ball holds (radius / edge)² vertices, searched from every vertex along
+/// the loop. Where the chart stretches the layer unevenly, its lattice (equilateral on the
+/// surface at one point of the region) is much finer elsewhere: on the curved layers of a
+/// connector's thin fins (AutoCAD's `k1_voids` on delta5, face #2592 down) half a bead held
+/// some 1,650 vertices a search, and this search took 52 of the placement's 69 s.
+const NEAR_RIDGE_STEPS: f64 = 6.0;
 
 /// The shortest step between a gap fill's points, in bead widths.
 const MIN_STEP_SHARE: f64 = 0.002;

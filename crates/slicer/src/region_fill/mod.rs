@@ -593,7 +593,12 @@ fn ring_ridge(lm: &LayerMesh, db: &[f64], levels: &[f64], width: f64, spacing: f
                 )
             })
             .collect();
-        ridge(lm, db, &wanted, 1.5 * spacing)
+        ridge(
+            lm,
+            db,
+            &wanted,
+            crate::geodesic::Reach::Within(1.5 * spacing),
+        )
     }
 }
 
