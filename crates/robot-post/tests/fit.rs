@@ -241,3 +241,42 @@ fn the_corners_of_a_bar_fit_turned_as_its_beads_do() {
         "{fit:?} {beads:?}"
     );
 }
+
+/// On delta5 a planar plan's turn is searched on the few points that decide it: their
+/// envelope excess at every turn is the whole path's (a bar leaving the envelope, with a
+/// second layer inside it and a travel out past it); a tilted axis, or a bed, keeps every
+/// point.
+#[test]
+fn a_planar_path_on_delta5_is_turned_by_the_points_that_decide_it() {
+    use robot_post::fit::turn::deciding_points;
+    let mut path = rectangle(205.0, 30.0, 1.0, UP);
+    for k in 0..200 {
+        let x = 2.0 + k as f64;
+        let y = 15.0 + 10.0 * (x / 7.0).sin();
+        path.points.push(pt(MoveKind::Print, [x, y, 2.0 * T], UP));
+    }
+    path.points
+        .push(pt(MoveKind::Travel, [-4.0, 31.0, 12.0], UP));
+    path.points
+        .push(pt(MoveKind::Print, [100.0, 10.0, 3.0 * T], UP));
+    let m = MachineProfile::builtin(MachineKind::Delta5);
+    let few = deciding_points(&path, &m).expect("a planar path");
+    assert!(
+        few.points.len() * 20 < path.points.len(),
+        "{}",
+        few.points.len()
+    );
+    let mut missed = 0;
+    for k in 0..72 {
+        let a = f64::from(k) * 5.0 - 180.0;
+        let all = envelope_excess(&turned(&path, a), &m).expect("excess");
+        let cheap = envelope_excess(&turned(&few, a), &m).expect("excess");
+        assert!((all - cheap).abs() < 1e-9, "turn {a}: {all} vs {cheap}");
+        missed += usize::from(all > 0.0);
+    }
+    // The bar leaves the envelope at some turns and fits at others.
+    assert!(missed > 0 && missed < 72, "{missed}");
+    assert!(deciding_points(&path, &marlin_bed(220.0, 220.0)).is_none());
+    path.points[3].axis = [0.0, 0.6, 0.8];
+    assert!(deciding_points(&path, &m).is_none());
+}
