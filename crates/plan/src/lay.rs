@@ -98,8 +98,12 @@ pub fn lay(
     }
     // What holds up each planar layer, from the features alone (issue 31).
     // Support material (issue 33) carries what it can; `held` is what it leaves.
-    let (mut held, columns) =
-        crate::support::planar(&extracted.assembly, process, machine.bead().width, true)?;
+    let (mut held, columns) = crate::support::planar(
+        &extracted.assembly,
+        process,
+        machine.bead().width,
+        slicer::support::Carry::Until(stop_at),
+    )?;
     let window = rayon::current_num_threads().max(1);
     let mut plans = vec![];
     let mut cursor: Option<P3> = None;

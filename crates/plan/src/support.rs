@@ -11,7 +11,7 @@
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
-use slicer::support::{planar_support, FeatureSupport};
+use slicer::support::{planar_support, Carry, FeatureSupport};
 use slicer::support_material::SupportRegions;
 use std::collections::BTreeMap;
 
@@ -33,14 +33,16 @@ pub struct Held {
 /// `process` and beads `bead_width` wide: no path filled (freeform features are left out;
 /// their curved layers are measured as they are laid). A solid whose base feature lies above
 /// the plate (the lowest base plane, [`PLATE_SLACK`]) rests on the solids built before it.
-/// With `columns`, support material (issue 33; unless `support_material = "off"`) carries
-/// what it can ([`slicer::support::planar_support`]): each [`Held`] gives what is left, and
-/// the second map each feature's support regions (features with support only).
+/// With [`Carry::Until`], support material (issue 33; unless `support_material = "off"`)
+/// carries what it can ([`slicer::support::planar_support`]): each [`Held`] gives what is
+/// left, and the second map each feature's support regions (features with support only); its
+/// columns are given up past the instant given ([`PlanError::TimeLimit`]: under a part turned
+/// over, NIST CTC-05's columns took minutes).
 pub fn planar(
     assembly: &Assembly,
     process: &Process,
     bead_width: f64,
-    columns: bool,
+    carry: Carry,
 ) -> Result<(BTreeMap<usize, Held>, Columns), PlanError> {
     let base = process.base();
     let trees = &assembly.trees;
@@ -77,7 +79,12 @@ pub fn planar(
                 (true, Some(z)) => z - plate,
                 _ => 0.0,
             };
-            let found = planar_support(t, f, &params, bead_width, &earlier, gap, columns)?;
+            let found = planar_support(t, f, &params, bead_width, &earlier, gap, carry).map_err(
+                |e| match e {
+                    slicer::planar::FeatureError::TimeLimit(_) => PlanError::TimeLimit,
+                    e => e.into(),
+                },
+            )?;
             if let Some(p) = found {
                 let angle_deg = params.overhang_angle_deg;
                 let kind = f.kind;
@@ -111,7 +118,7 @@ pub fn planar_area(
     process: &Process,
     bead_width: f64,
 ) -> Result<f64, PlanError> {
-    Ok(planar(assembly, process, bead_width, false)?
+    Ok(planar(assembly, process, bead_width, Carry::Not)?
         .0
         .values()
         .map(|h| h.support.area_mm2)

@@ -46,4 +46,8 @@ pub enum FeatureError {
         /// Cause.
         msg: String,
     },
+    /// The work on the feature was given up at the caller's time limit
+    /// ([`crate::support::Carry::Until`]).
+    #[error("feature {0}: given up at the time limit")]
+    TimeLimit(usize),
 }

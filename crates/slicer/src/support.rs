@@ -117,7 +117,17 @@ pub fn feature_support(
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
 ) -> Result<Option<FeatureSupport>, FeatureError> {
-    Ok(planar_support(tree, f, params, bead_width, earlier, 0.0, false)?.map(|p| p.left))
+    Ok(planar_support(tree, f, params, bead_width, earlier, 0.0, Carry::Not)?.map(|p| p.left))
+}
+
+/// Whether [`planar_support`] counts what support material carries, and until when.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Carry {
+    /// No support material: the overhangs alone.
+    Not,
+    /// Support material carries what it can (unless `support_material = "off"`); its columns
+    /// are given up past the instant, if one is given ([`FeatureError::TimeLimit`]).
+    Until(Option<std::time::Instant>),
 }
 
 /// What holds up a two5d feature's planar layers, with support material ([`planar_support`]).
@@ -131,7 +141,7 @@ pub struct PlanarSupport {
     pub columns: SupportRegions,
 }
 
-/// [`feature_support`], and with `columns` (and `support_material` not `off`) the support
+/// [`feature_support`], and with [`Carry::Until`] (and `support_material` not `off`) the support
 /// material under the unsupported pieces ([`crate::support_material::columns`]): what it
 /// carries is no longer unsupported. Columns stand on the plate for a base feature on it (no
 /// parent, `earlier` empty), and for the base of a solid lifted `gap` mm over the plate on
@@ -147,7 +157,7 @@ pub fn planar_support(
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
     gap: f64,
-    columns: bool,
+    carry: Carry,
 ) -> Result<Option<PlanarSupport>, FeatureError> {
     if f.kind != FeatureKind::Two5d {
         return Ok(None);
@@ -218,7 +228,14 @@ pub fn planar_support(
     for (k, p) in pieces.iter().enumerate() {
         overhang.add(k + 1, p.iter().map(region_area).sum());
     }
-    if !columns || params.support_material == SupportMaterial::Off || overhang.area_mm2 <= 0.0 {
+    let stop_at = match carry {
+        Carry::Until(stop_at) => stop_at,
+        Carry::Not => None,
+    };
+    if carry == Carry::Not
+        || params.support_material == SupportMaterial::Off
+        || overhang.area_mm2 <= 0.0
+    {
         return Ok(Some(PlanarSupport {
             overhang,
             left: overhang,
@@ -240,7 +257,9 @@ pub fn planar_support(
             foundation.as_deref(),
             params,
             sliver,
-        ),
+            stop_at,
+        )
+        .map_err(|_| FeatureError::TimeLimit(f.id))?,
         _ => {
             let mut all_sections = under.sections;
             all_sections.extend(sections);
@@ -255,7 +274,9 @@ pub fn planar_support(
                 None,
                 params,
                 sliver,
-            );
+                stop_at,
+            )
+            .map_err(|_| FeatureError::TimeLimit(f.id))?;
             c.left.drain(..u);
             c.regions.below = under.heights;
             c

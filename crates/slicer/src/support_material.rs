@@ -28,6 +28,7 @@ use crate::tolerance::HEIGHT_SLACK;
 use crate::toolpath::Role;
 use rayon::prelude::*;
 use std::collections::VecDeque;
+use std::time::Instant;
 
 /// Where support is printed in each layer of a feature, in its reference plane's 2-D frame.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -74,7 +75,8 @@ pub struct Columns {
 /// `None`: the feature's first layer stands on the plate (a column may reach it anywhere);
 /// else what its first layer rests on, and only what lies over it or over the feature's own
 /// lower sections is carried. Pieces left unsupported under `sliver` mm² are not counted.
-/// Nothing is generated when `support_material` is `off`.
+/// Nothing is generated when `support_material` is `off`. Past `stop_at` (checked layer by
+/// layer) the columns are given up ([`Stopped`]).
 pub fn columns(
     sections: &[Vec<Region>],
     heights: &[f64],
@@ -82,7 +84,8 @@ pub fn columns(
     ground: Option<&[Region]>,
     params: &LayerParams,
     sliver: f64,
-) -> Columns {
+    stop_at: Option<Instant>,
+) -> Result<Columns, Stopped> {
     let n = sections.len().min(heights.len()).min(pieces.len());
     let tol = params.tolerance;
     let area = |r: &[Region]| -> f64 {
@@ -120,6 +123,7 @@ pub fn columns(
     let mut below: Vec<Region> = ground.map(|g| union(g, &[])).unwrap_or_default();
     let mut entering: Vec<Vec<Region>> = vec![vec![]; n];
     for k in 0..n {
+        in_time(stop_at)?;
         if !pieces[k].is_empty() {
             let footprint = footprint(sections, k, &pieces[k], ground, heights[k], params);
             let (carried, left) = match on_plate {
@@ -146,10 +150,22 @@ pub fn columns(
         }
     }
     if params.support_material == crate::params::SupportMaterial::Off {
-        return out;
+        return Ok(out);
     }
-    sweep(sections, entering, params, tol, &mut out.regions);
-    out
+    sweep(sections, entering, params, tol, &mut out.regions, stop_at)?;
+    Ok(out)
+}
+
+/// The columns were given up at the caller's time limit ([`columns`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stopped;
+
+/// [`Stopped`] once `stop_at` has passed (`None`: never).
+fn in_time(stop_at: Option<Instant>) -> Result<(), Stopped> {
+    match stop_at {
+        Some(t) if Instant::now() >= t => Err(Stopped),
+        _ => Ok(()),
+    }
 }
 
 /// What a column under the unsupported `pieces` of layer `k` holds: the whole overhang they
@@ -193,14 +209,15 @@ fn footprint(
 const COLUMN_SLACK_MM: f64 = 1e-6;
 
 /// The columns entering at each layer (`entering`) carried down through `sections`, top down:
-/// each layer's printed support into `regions`.
+/// each layer's printed support into `regions`; given up past `stop_at`.
 fn sweep(
     sections: &[Vec<Region>],
     entering: Vec<Vec<Region>>,
     params: &LayerParams,
     tol: f64,
     regions: &mut SupportRegions,
-) {
+    stop_at: Option<Instant>,
+) -> Result<(), Stopped> {
     let n = entering.len();
     let interface_layers = params.support_interface_layers;
     // Top down, one layer after the other: the columns in each layer (what has not landed),
@@ -218,6 +235,7 @@ fn sweep(
         if active.is_empty() && new.is_empty() {
             continue;
         }
+        in_time(stop_at)?;
         active = carried(&active, new, &sections[j]);
         if active.is_empty() {
             continue;
@@ -257,6 +275,7 @@ fn sweep(
         regions.sparse[j] = sparse;
         regions.interface[j] = interface;
     }
+    Ok(())
 }
 
 /// The columns `active` come down from the layer above, with those entering at this layer
@@ -420,11 +439,29 @@ mod tests {
         (sections, pieces)
     }
 
+    /// Past the caller's time limit the columns are given up, not half made; the same columns
+    /// with a limit ahead are those made without one.
+    #[test]
+    fn columns_past_the_time_limit_are_given_up() {
+        let (sections, pieces) = bridge();
+        let params = LayerParams::default();
+        let past = Some(Instant::now());
+        let got = columns(&sections, &[0.2; 15], &pieces, None, &params, 0.48, past);
+        assert_eq!(got.err(), Some(Stopped));
+        let ahead = Instant::now().checked_add(std::time::Duration::from_secs(3600));
+        let later = columns(&sections, &[0.2; 15], &pieces, None, &params, 0.48, ahead);
+        let none = columns(&sections, &[0.2; 15], &pieces, None, &params, 0.48, None);
+        let (later, none) = (later.expect("in time"), none.expect("in time"));
+        assert_eq!(later.left, none.left);
+        assert_eq!(later.regions.sparse, none.regions.sparse);
+    }
+
     #[test]
     fn a_bridge_gets_a_column_between_its_posts_down_to_the_plate() {
         let (sections, pieces) = bridge();
         let params = LayerParams::default();
-        let c = columns(&sections, &[0.2; 15], &pieces, None, &params, 0.48);
+        let c =
+            columns(&sections, &[0.2; 15], &pieces, None, &params, 0.48, None).expect("in time");
         assert!(c.left.iter().all(|a| *a == 0.0));
         // One layer of contact gap: layers 0..=8 carry support, 9 and up none.
         for k in 0..15 {
@@ -461,19 +498,37 @@ mod tests {
         let (sections, pieces) = bridge();
         // Off the plate on nothing: the gap between the posts has nothing below it.
         let params = LayerParams::default();
-        let c = columns(&sections, &[0.2; 15], &pieces, Some(&[]), &params, 0.48);
+        let c = columns(
+            &sections,
+            &[0.2; 15],
+            &pieces,
+            Some(&[]),
+            &params,
+            0.48,
+            None,
+        )
+        .expect("in time");
         assert!((c.left[10] - 200.0).abs() < 1e-6);
         assert!(c.regions.is_empty());
         // Standing on a parent under the whole slab: carried, down to the first layer.
         let ground = [rect(-5.0, -5.0, 45.0, 15.0)];
-        let c = columns(&sections, &[0.2; 15], &pieces, Some(&ground), &params, 0.48);
+        let c = columns(
+            &sections,
+            &[0.2; 15],
+            &pieces,
+            Some(&ground),
+            &params,
+            0.48,
+            None,
+        )
+        .expect("in time");
         assert!(c.left.iter().all(|a| *a == 0.0));
         assert!((area(&c.regions.sparse[0]) - 190.0).abs() < 0.01);
         let off = LayerParams {
             support_material: crate::params::SupportMaterial::Off,
             ..LayerParams::default()
         };
-        let c = columns(&sections, &[0.2; 15], &pieces, None, &off, 0.48);
+        let c = columns(&sections, &[0.2; 15], &pieces, None, &off, 0.48, None).expect("in time");
         assert!((c.left[10] - 200.0).abs() < 1e-6);
         assert!(c.regions.is_empty());
     }
@@ -522,7 +577,9 @@ mod tests {
             None,
             &LayerParams::default(),
             0.48,
-        );
+            None,
+        )
+        .expect("in time");
         let at = |k: usize| area(&c.regions.sparse[k]) + area(&c.regions.interface[k]);
         // Over the step (x 0–10) the column stands on layer 4; between, on the plate.
         assert!((at(8) - 10.0 * 29.5).abs() < 0.01, "{}", at(8));
@@ -536,7 +593,9 @@ mod tests {
             Some(&[]),
             &LayerParams::default(),
             0.48,
-        );
+            None,
+        )
+        .expect("in time");
         assert!((c.left[10] - 200.0).abs() < 1e-6, "{}", c.left[10]);
         let at = |k: usize| area(&c.regions.sparse[k]) + area(&c.regions.interface[k]);
         assert!((at(5) - 10.0 * 10.0).abs() < 0.01, "{}", at(5));
