@@ -286,13 +286,14 @@ impl LayerMesh {
         }
         let (first, next) = self.adjacency.get_or_init(|| self.neighbours());
         let around = |u: usize| &next[first[u] as usize..first[u + 1] as usize];
-        let within_at = |v: usize| match reach {
+        // The squared radius: once for a fixed reach, per vertex for one by steps.
+        let fixed = match reach {
             Reach::Within(r) => sqrt_at_most(r),
-            Reach::Steps { most, steps } => sqrt_at_most(most.min(steps * self.edge_at(v))),
+            Reach::Steps { .. } => 0.0,
         };
-        let uniform = match reach {
-            Reach::Within(r) => Some(sqrt_at_most(r)),
-            Reach::Steps { .. } => None,
+        let within_at = |v: usize| match reach {
+            Reach::Within(_) => fixed,
+            Reach::Steps { most, steps } => sqrt_at_most(most.min(steps * self.edge_at(v))),
         };
         // `seen[x] == v + 1`: x was looked at from v, inside the ball or not (no clearing
         // between vertices; each vertex's distance is taken once per flood).
@@ -304,7 +305,7 @@ impl LayerMesh {
             }
             let pv = self.p[v];
             let cap = cap[v];
-            let within = uniform.unwrap_or_else(|| within_at(v));
+            let within = within_at(v);
             // A climb first, from each vertex to its highest neighbour inside the ball while
             // that is higher: every vertex on the way is joined to v inside the ball, and a
             // flank's climb passes the cap in a few steps where the search would look at the
