@@ -4,7 +4,7 @@
 //! move with [`crate::scene::Scene`].
 
 use crate::head::Head;
-use crate::scene::{move_collision, same_group, Collision, Scene, TOLERANCE};
+use crate::scene::{move_collision, same_group, Collision, Obstacle, Scene, TOLERANCE};
 use crate::table::Table;
 use crate::tilt::{tilt_run, TiltLimits, Tilted};
 use std::collections::BTreeMap;
@@ -23,6 +23,17 @@ pub enum Travels {
     Skip,
 }
 
+/// How far a walk goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stop {
+    /// To the path's end.
+    #[default]
+    AtEnd,
+    /// To the end of the first run that leaves a move hitting the table (a check that only
+    /// asks whether any does: the pedestal's search, where most heights tried fail).
+    AtTableHit,
+}
+
 /// [`check`](crate::check()), re-routing each colliding travel over the material: from its start up its tool
 /// axis, across at one height, and down the next point's axis, by the least lift (a share of the head's
 /// length, or clear of the highest material) that makes all three moves clear. A travel no lift
@@ -35,7 +46,7 @@ pub fn check_and_route(
     table: Option<Table>,
     travels: Travels,
 ) -> Vec<Collision> {
-    walk(path, head, table, Some(travels), None).left
+    walk(path, head, table, Some(travels), None, Stop::AtEnd).left
 }
 
 /// What [`tilt_and_route`] leaves.
@@ -45,12 +56,16 @@ pub struct Routed {
     pub left: Vec<Collision>,
     /// Per feature id, its print moves that collided with the axes given and are clear tilted.
     pub cleared: BTreeMap<usize, usize>,
+    /// The walk stopped ([`Stop::AtTableHit`]) after the run of a move left hitting the table:
+    /// the moves after that run were not checked (nor tilted, nor routed).
+    pub stopped: bool,
 }
 
 /// [`check_and_route`], each continuous path first tilted inside the cone about its `planned`
 /// axes (one per point of `path`) where that clears print moves ([`crate::tilt`]; no tilt
 /// when `limits` is `None`), its travels then routed with the axes tilted: the whole
-/// avoidance in one walk along the path, each move checked once against what lies before it.
+/// avoidance in one walk along the path, each move checked once against what lies before it;
+/// the walk goes as far as `stop` says.
 pub fn tilt_and_route(
     path: &mut ToolPath,
     planned: &[V3],
@@ -58,6 +73,7 @@ pub fn tilt_and_route(
     table: Option<Table>,
     travels: Travels,
     limits: Option<&TiltLimits>,
+    stop: Stop,
 ) -> Routed {
     walk(
         path,
@@ -65,6 +81,7 @@ pub fn tilt_and_route(
         table,
         Some(travels),
         limits.map(|l| (planned, l)),
+        stop,
     )
 }
 
@@ -81,7 +98,14 @@ pub fn tilt(
     limits: &TiltLimits,
 ) -> Tilted {
     let mut out = path.clone();
-    let Routed { left, cleared } = walk(&mut out, head, table, None, Some((planned, limits)));
+    let Routed { left, cleared, .. } = walk(
+        &mut out,
+        head,
+        table,
+        None,
+        Some((planned, limits)),
+        Stop::AtEnd,
+    );
     Tilted {
         path: out,
         cleared,
@@ -93,13 +117,14 @@ pub fn tilt(
 /// run by run (continuous paths), the material before each run's group deposited, its moves
 /// checked, tilted by `tilt` (planned axes and limits) where that clears print moves (or the
 /// head at the travel points leading to its bead), and its colliding travels routed by
-/// `travels` (`None`: checked and reported, not routed).
+/// `travels` (`None`: checked and reported, not routed); as far as `stop` says.
 pub(crate) fn walk(
     path: &mut ToolPath,
     head: &Head,
     table: Option<Table>,
     travels: Option<Travels>,
     tilt: Option<(&[V3], &TiltLimits)>,
+    stop: Stop,
 ) -> Routed {
     let mut scene = Scene::new(head, table);
     // Detours by the index of the point they go before; the path is rebuilt once, if at all.
@@ -160,6 +185,7 @@ pub(crate) fn walk(
                 found = after;
             }
         }
+        let left_before = out.left.len();
         for c in found.into_iter().flatten() {
             let i = c.index;
             let via = match (c.kind, travels, i.checked_sub(1)) {
@@ -175,6 +201,11 @@ pub(crate) fn walk(
                     ..c
                 }),
             }
+        }
+        let hits_table = |c: &Collision| c.hits == Obstacle::Table;
+        if stop == Stop::AtTableHit && out.left[left_before..].iter().any(hits_table) {
+            out.stopped = true;
+            break;
         }
     }
     // What was deposited is not needed any more: its memory goes before the path grows.
@@ -272,7 +303,7 @@ fn detour(scene: &Scene, a: &PathPoint, b: &PathPoint, head: &Head) -> Option<[P
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{check, test_point as pt, Obstacle, Scene};
+    use crate::scene::{check, test_point as pt, Scene};
 
     #[test]
     fn detours_go_in_place_before_their_points() {
@@ -373,6 +404,61 @@ mod tests {
         assert!(!scene.above_pending(&low));
         scene.flush(pts);
         assert_eq!(scene.deposit.z_max(), scene.z_max());
+    }
+
+    /// Beads on the plate laid with the axis lying down (the head's body under the table), two
+    /// features apart: walked to the end, both hit the table; stopped at the first table hit,
+    /// the walk reports the first run's and stops.
+    #[test]
+    fn a_walk_stops_at_its_first_table_hit_when_asked() {
+        let head = Head::default();
+        let table = Some(Table::Plane { z: 0.0 });
+        let lying = unit([1.0, 0.0, 0.05]).unwrap_or([0.0, 0.0, 1.0]);
+        let mut points = vec![];
+        for (feature, y) in [(0, 0.0), (1, 60.0)] {
+            points.push(pt(feature, 0, MoveKind::Travel, [0.0, y, 0.2]));
+            for x in 1..4 {
+                points.push(pt(feature, 0, MoveKind::Print, [f64::from(x), y, 0.2]));
+            }
+        }
+        for q in &mut points {
+            q.axis = lying;
+        }
+        let path = ToolPath { points };
+        let walked = |stop: Stop| {
+            let mut p = path.clone();
+            tilt_and_route(&mut p, &[], &head, table, Travels::Skip, None, stop)
+        };
+        let whole = walked(Stop::AtEnd);
+        assert!(!whole.stopped);
+        let on_table = |r: &Routed, f: usize| {
+            r.left
+                .iter()
+                .any(|c| c.feature == f && c.hits == Obstacle::Table)
+        };
+        assert!(
+            on_table(&whole, 0) && on_table(&whole, 1),
+            "{:?}",
+            whole.left
+        );
+        let stopped = walked(Stop::AtTableHit);
+        assert!(stopped.stopped);
+        assert!(on_table(&stopped, 0) && !stopped.left.iter().any(|c| c.feature == 1));
+        // Nothing on the table: the walk goes to the end either way.
+        let mut up = path.clone();
+        for q in &mut up.points {
+            q.axis = [0.0, 0.0, 1.0];
+        }
+        let r = tilt_and_route(
+            &mut up,
+            &[],
+            &head,
+            table,
+            Travels::Skip,
+            None,
+            Stop::AtTableHit,
+        );
+        assert!(!r.stopped && r.left.is_empty());
     }
 
     #[test]

@@ -26,7 +26,7 @@ mod table;
 mod tilt;
 mod tolerance;
 
-pub use check::{check_and_route, tilt, tilt_and_route, Routed, Travels};
+pub use check::{check_and_route, tilt, tilt_and_route, Routed, Stop, Travels};
 pub use deposit::{Deposit, GRAIN_SPACING};
 pub use head::{Head, HeadShape};
 pub use order::interleave;

@@ -5,7 +5,7 @@
 //! print moves cleared by tilting the tool axis inside the orientation's tolerance cone.
 
 use crate::report::{round, CollisionEntry, FeatureEntry, HitEntry};
-use collide::{interleave, tilt_and_route, Collision, Obstacle, Table, TiltLimits, Travels};
+use collide::{interleave, tilt_and_route, Collision, Obstacle, Stop, Table, TiltLimits, Travels};
 use robot_post::machine::MachineProfile;
 use robot_post::placement::table_offset;
 use robot_post::MachineKind;
@@ -56,6 +56,9 @@ pub struct Avoided {
     /// start and the end of each move of `left`, in its order (the start: the end's, for a
     /// path's first point).
     pub planned: Vec<[V3; 2]>,
+    /// The walk stopped at a move left hitting the table ([`Stop::AtTableHit`]): the path
+    /// hits it, and `left` holds the collisions up to there only.
+    pub stopped: bool,
 }
 
 /// Header of `collisions.csv`: one line per colliding move left, `index` its end point's row
@@ -153,13 +156,17 @@ pub fn tilt_limits(machine: &MachineProfile, orientation: &SmoothParams) -> Opti
 /// siblings, the siblings interleaved (their planned axes along) are walked alike, and that
 /// order kept when it leaves fewer colliding moves; where every sibling group is crowded, that
 /// walk is the one made beside the first, on the other thread. Returns the collisions left, in path order,
-/// and the moves tilt cleared.
+/// and the moves tilt cleared. With [`Stop::AtTableHit`] the walks stop at their first move
+/// left hitting the table where that decides that the order kept would hit it too
+/// ([`Avoided::stopped`]; a part of one sibling group at most: with more, the order kept
+/// may be one no walk made whole).
 pub fn avoid(
     path: &mut ToolPath,
     planned: &[V3],
     machine: &MachineProfile,
     features: &[FeatureEntry],
     limits: Option<TiltLimits>,
+    stop: Stop,
 ) -> Avoided {
     let head = machine.head;
     let table = table(path, machine);
@@ -168,7 +175,7 @@ pub fn avoid(
         MachineKind::Kuka => Travels::Skip,
         _ => Travels::Route,
     };
-    let walk = |path: &mut ToolPath, planned: &[V3], limits: Option<&TiltLimits>| {
+    let walk = |path: &mut ToolPath, planned: &[V3], stop: Stop| {
         // Where the points were before travel was lifted, to find their planned axes after;
         // without planned axes (a 3-axis printer) each point's own axis is its planned one.
         let before: Vec<V3> = if planned.is_empty() {
@@ -176,18 +183,28 @@ pub fn avoid(
         } else {
             path.points.iter().map(|q| q.p).collect()
         };
-        let r = tilt_and_route(path, planned, &head, Some(table), travels, limits);
+        let r = tilt_and_route(
+            path,
+            planned,
+            &head,
+            Some(table),
+            travels,
+            limits.as_ref(),
+            stop,
+        );
         Avoided {
             planned: planned_at(path, &before, planned, &r.left),
             left: r.left,
             cleared: r.cleared,
+            stopped: r.stopped,
         }
     };
     let groups = sibling_groups(features);
     if groups.is_empty() {
         // No order to try but the one built: walked in place, without copies of the path.
-        return walk(path, planned, limits.as_ref());
+        return walk(path, planned, stop);
     }
+    let stop = if groups.len() == 1 { stop } else { Stop::AtEnd };
     // The siblings interleaved: the path and its planned axes (a path of them interleaved
     // alike), `None` where no group interleaves.
     let mixed = |groups: &[&Vec<usize>]| {
@@ -204,18 +221,31 @@ pub fn avoid(
         let planned: Vec<V3> = mixed_planned.points.iter().map(|q| q.axis).collect();
         any.then_some((mixed, planned))
     };
+    let walk_mixed = |groups: &[&Vec<usize>], stop: Stop| {
+        mixed(groups).map(|(mut m, p)| {
+            let w = walk(&mut m, &p, stop);
+            (m, w)
+        })
+    };
     // Where the part has siblings, every group interleaved is walked beside the first walk
     // (the machine's other thread), in case the first leaves them all crowded.
     let all: Vec<&Vec<usize>> = groups.iter().collect();
     let mut first_path = path.clone();
-    let (first, every) = rayon::join(
-        || walk(&mut first_path, planned, limits.as_ref()),
-        || {
-            let (mut m, p) = mixed(&all)?;
-            let w = walk(&mut m, &p, limits.as_ref());
-            Some((m, w))
-        },
+    let (mut first, every) = rayon::join(
+        || walk(&mut first_path, planned, stop),
+        || walk_mixed(&all, stop),
     );
+    // One group: the order kept is the first or `every`. Both hit the table where both
+    // stopped (or nothing interleaves); where only the first did, it is walked whole to
+    // choose.
+    if first.stopped {
+        if every.as_ref().is_none_or(|(_, w)| w.stopped) {
+            *path = first_path;
+            return first;
+        }
+        first_path = path.clone();
+        first = walk(&mut first_path, planned, Stop::AtEnd);
+    }
     // Groups one of whose members hits another.
     let crowded: Vec<&Vec<usize>> = groups
         .iter()
@@ -228,11 +258,11 @@ pub fn avoid(
         .collect();
     let second = match every {
         _ if crowded.is_empty() => None,
+        // Stopped with already as many collisions as the first: not kept, whole or not.
+        Some((_, done)) if done.stopped && done.left.len() >= first.left.len() => None,
+        Some((_, done)) if done.stopped => walk_mixed(&crowded, Stop::AtEnd),
         Some(done) if crowded.len() == all.len() => Some(done),
-        _ => mixed(&crowded).map(|(mut m, p)| {
-            let w = walk(&mut m, &p, limits.as_ref());
-            (m, w)
-        }),
+        _ => walk_mixed(&crowded, Stop::AtEnd),
     };
     match second {
         Some((m, second)) if second.left.len() < first.left.len() => {

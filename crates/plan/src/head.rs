@@ -114,8 +114,8 @@ pub fn head_check(
         allow_collisions: options.allow_collisions,
         stop_at: options.stop_at,
     };
-    let avoid = |p: &mut ToolPath, axes: &[slicer::vec3::V3]| {
-        collisions::avoid(p, axes, machine, &entries, limits)
+    let avoid = |p: &mut ToolPath, axes: &[slicer::vec3::V3], stop: collide::Stop| {
+        collisions::avoid(p, axes, machine, &entries, limits, stop)
     };
     let stood = pedestal::stand(&ctx, toolpath, planned_axes, avoid).map_err(|e| match e {
         pedestal::PedestalError::TimeLimit => PlanError::TimeLimit,
