@@ -11,6 +11,7 @@
 
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
+use rayon::prelude::*;
 use slicer::support::{planar_support, Carry, FeatureSupport};
 use slicer::support_material::SupportRegions;
 use std::collections::BTreeMap;
@@ -60,48 +61,60 @@ pub fn planar(
         .flatten()
         .copied()
         .fold(f64::INFINITY, f64::min);
-    let mut out = BTreeMap::new();
-    let mut regions = BTreeMap::new();
+    // Every feature of every solid with what it needs, file-wide ids in build order.
+    let mut jobs = vec![];
     let mut offset = 0;
     for (ti, t) in trees.iter().enumerate() {
         let lifted = standing[ti].is_some_and(|z| z > plate + PLATE_SLACK);
-        let earlier: Vec<_> = match lifted {
-            true => trees[..ti]
-                .iter()
-                .flat_map(|u| u.features.iter().map(move |g| (u, g)))
-                .collect(),
-            false => vec![],
+        let gap = match (lifted, standing[ti]) {
+            (true, Some(z)) => z - plate,
+            _ => 0.0,
         };
         for f in &t.features {
-            let id = offset + f.id;
-            let params = process.feature_params(&base, offset, f)?;
-            let gap = match (lifted, standing[ti]) {
-                (true, Some(z)) => z - plate,
-                _ => 0.0,
-            };
-            let found = planar_support(t, f, &params, bead_width, &earlier, gap, carry).map_err(
-                |e| match e {
-                    slicer::planar::FeatureError::TimeLimit(_) => PlanError::TimeLimit,
-                    e => e.into(),
-                },
-            )?;
-            if let Some(p) = found {
-                let angle_deg = params.overhang_angle_deg;
-                let kind = f.kind;
-                out.insert(
-                    id,
-                    Held {
-                        support: p.left,
-                        angle_deg,
-                        kind,
-                    },
-                );
-                if !p.columns.is_empty() {
-                    regions.insert(id, p.columns);
-                }
-            }
+            jobs.push((ti, offset, f, lifted, gap));
         }
         offset += t.features.len();
+    }
+    // Each feature's support on its own (in parallel: one feature's meshing and column
+    // carrying run on one core, NIST CTC-05's three features side by side).
+    let found: Vec<Result<_, PlanError>> =
+        jobs.par_iter()
+            .with_max_len(1)
+            .map(|&(ti, offset, f, lifted, gap)| {
+                let t = &trees[ti];
+                let earlier: Vec<_> = match lifted {
+                    true => trees[..ti]
+                        .iter()
+                        .flat_map(|u| u.features.iter().map(move |g| (u, g)))
+                        .collect(),
+                    false => vec![],
+                };
+                let params = process.feature_params(&base, offset, f)?;
+                let found = planar_support(t, f, &params, bead_width, &earlier, gap, carry)
+                    .map_err(|e| match e {
+                        slicer::planar::FeatureError::TimeLimit(_) => PlanError::TimeLimit,
+                        e => e.into(),
+                    })?;
+                Ok((offset + f.id, params.overhang_angle_deg, f.kind, found))
+            })
+            .collect();
+    let mut out = BTreeMap::new();
+    let mut regions = BTreeMap::new();
+    for r in found {
+        let (id, angle_deg, kind, found) = r?;
+        if let Some(p) = found {
+            out.insert(
+                id,
+                Held {
+                    support: p.left,
+                    angle_deg,
+                    kind,
+                },
+            );
+            if !p.columns.is_empty() {
+                regions.insert(id, p.columns);
+            }
+        }
     }
     Ok((out, regions))
 }

@@ -250,6 +250,7 @@ pub fn fill_two5d(
     let near = crate::fill::ring_print_tolerance(params.tolerance, bead.width);
     let sections: Vec<Vec<Region>> = tops
         .par_iter()
+        .with_max_len(1)
         .map(|&(mid, top, dl)| {
             let at = |z: f64| {
                 let cut = plane.offset(z);
@@ -494,6 +495,7 @@ fn fill_sections(
     let mut fills: Vec<Option<LayerFill>> = sections
         .into_par_iter()
         .enumerate()
+        .with_max_len(1)
         .map(|(layer, regions)| {
             let at = sparse.then(|| SparseLayer {
                 skin: &skins[layer],

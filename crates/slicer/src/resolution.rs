@@ -51,6 +51,7 @@ pub fn narrow_sections(
     // Per layer: (all volume, narrow volume, narrowest width).
     let layers: Vec<(f64, f64, f64)> = mids
         .par_iter()
+        .with_max_len(1)
         .map(|&(mid, dl)| {
             let cut = plane.offset(mid);
             let mut out = (0.0, 0.0, f64::INFINITY);

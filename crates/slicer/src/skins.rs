@@ -26,6 +26,7 @@ pub(crate) fn skins(
     let n = sections.len();
     (0..n)
         .into_par_iter()
+        .with_max_len(1)
         .map(|i| {
             let own = &sections[i];
             if own.is_empty() || (top == 0 && bottom == 0) {

@@ -177,6 +177,7 @@ pub fn planar_support(
     }
     let sections: Vec<Vec<Region>> = mids
         .par_iter()
+        .with_max_len(1)
         .map(|&mid| section_regions(&mesh, &plane.offset(mid), near))
         .collect();
     // Under the first layer: the parents (or the earlier solids) just below the reference
@@ -207,6 +208,7 @@ pub fn planar_support(
     let chord = params.tolerance;
     let pieces: Vec<Vec<Region>> = (0..sections.len())
         .into_par_iter()
+        .with_max_len(1)
         .map(|k| {
             let below = match k {
                 0 => match &foundation {

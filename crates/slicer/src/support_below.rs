@@ -99,6 +99,7 @@ pub fn below(
     }
     let sections = mids
         .par_iter()
+        .with_max_len(1)
         .map(|&mid| {
             let cut = plane.offset(mid);
             let mut regions = vec![];

@@ -251,6 +251,7 @@ fn sweep(
     let xy = params.support_xy_distance;
     let printed: Vec<(Vec<Region>, Vec<Region>)> = (0..n)
         .into_par_iter()
+        .with_max_len(1)
         .map(|j| {
             let a = &active_at[j];
             if a.is_empty() {
@@ -393,6 +394,7 @@ pub(crate) fn fill_columns(
         .collect();
     let sparse: Vec<Vec<FillPath>> = firsts
         .par_iter()
+        .with_max_len(1)
         .map(|&k| {
             fill(
                 &regions.sparse[k],

@@ -32,6 +32,7 @@ pub(super) fn fill_stack(
     let sections: Vec<Vec<Region>> = tops
         .par_iter()
         .enumerate()
+        .with_max_len(1)
         .map(|(layer, &(mid, _))| {
             let mesh = match blended {
                 Some((_, m, _)) if layer >= offset_layers => m,
@@ -58,6 +59,7 @@ pub(super) fn fill_stack(
     let filled: Vec<(LayerFill, SparseVolume)> = sections
         .into_par_iter()
         .enumerate()
+        .with_max_len(1)
         .map(|(layer, regions)| {
             let (chart, clip) = match blended {
                 Some((c, _, _)) if layer >= offset_layers => (c, None),
