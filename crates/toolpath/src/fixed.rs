@@ -68,33 +68,107 @@ fn scaled(x: f64, decimals: usize) -> Option<(bool, u64)> {
     u64::try_from(q).ok().map(|q| (negative, q))
 }
 
-/// Writes the integer `n` as a fixed-point number with `decimals` places (at most 19),
-/// `-` before it when `negative` and `n` is not 0: `n = 7, decimals = 5` is `0.00007`. For
-/// quantities kept in integer units (a program's E, in 0.00001 mm).
+/// Writes the integer `n` as a fixed-point number with `decimals` places (at most
+/// [`MAX_SCALED_DECIMALS`]), `-` before it when `negative` and `n` is not 0: `n = 7, decimals
+/// = 5` is `0.00007`. For quantities kept in integer units (a program's E, in 0.00001 mm).
 pub fn push_scaled(out: &mut String, negative: bool, n: u64, decimals: usize) {
-    let mut digits = [0u8; 40];
-    let mut len = 0;
-    let mut v = n;
-    while v > 0 || len <= decimals {
-        digits[len] = b'0' + (v % 10) as u8;
-        v /= 10;
-        len += 1;
-    }
-    if negative && n != 0 {
-        out.push('-');
-    }
-    // The digits, most significant first, with the point before the last `decimals`: ASCII.
-    let mut text = [0u8; 41];
-    let mut k = 0;
-    for i in (0..len).rev() {
-        text[k] = digits[i];
-        k += 1;
-        if i == decimals && decimals > 0 {
-            text[k] = b'.';
-            k += 1;
+    let mut text = Text::new();
+    let start = text.scaled(negative, n, decimals);
+    // ASCII digits, a point and a sign: always UTF-8.
+    out.push_str(std::str::from_utf8(&text.0[start..]).unwrap_or_default());
+}
+
+/// [`push_fixed`] onto bytes (a block of `toolpath.csv`'s lines, written out as bytes):
+/// the same text, without a UTF-8 check per number.
+pub fn push_fixed_bytes(out: &mut Vec<u8>, x: f64, decimals: usize) {
+    match scaled(x, decimals) {
+        Some((negative, n)) => {
+            let mut text = Text::new();
+            let start = text.scaled(negative, n, decimals);
+            out.extend_from_slice(&text.0[start..]);
+        }
+        None => {
+            let mut s = String::new();
+            push_formatted(&mut s, x, decimals);
+            out.extend_from_slice(s.as_bytes());
         }
     }
-    out.push_str(std::str::from_utf8(&text[..k]).unwrap_or_default());
+}
+
+/// The decimal digits of `n` onto bytes (an id in `toolpath.csv`).
+pub fn push_integer_bytes(out: &mut Vec<u8>, n: u64) {
+    let mut text = Text::new();
+    let start = text.scaled(false, n, 0);
+    out.extend_from_slice(&text.0[start..]);
+}
+
+/// The most decimals [`push_scaled`] writes (more are taken as this many).
+pub const MAX_SCALED_DECIMALS: usize = 40;
+
+/// "00" to "99": two digits at a time.
+const PAIRS: &[u8; 200] = b"\
+0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
+/// A number's text made from its last digit back (20 digits of a `u64`, a point, up to
+/// [`MAX_SCALED_DECIMALS`] decimals and a sign fit).
+struct Text([u8; 64]);
+
+impl Text {
+    fn new() -> Self {
+        Text([0; 64])
+    }
+
+    /// Puts one digit before `end`.
+    fn digit(&mut self, end: &mut usize, d: u64) {
+        *end -= 1;
+        self.0[*end] = b'0' + d as u8;
+    }
+
+    /// Puts the two digits of `d` (below 100) before `end`.
+    fn pair(&mut self, end: &mut usize, d: u64) {
+        *end -= 2;
+        let k = 2 * d as usize;
+        self.0[*end..*end + 2].copy_from_slice(&PAIRS[k..k + 2]);
+    }
+
+    /// Writes [`push_scaled`]'s text at the end of the buffer; returns where it starts.
+    fn scaled(&mut self, negative: bool, n: u64, decimals: usize) -> usize {
+        let decimals = decimals.min(MAX_SCALED_DECIMALS);
+        let mut end = self.0.len();
+        let mut v = n;
+        // The decimals (zeros where `n` has run out), two at a time, then the point.
+        for _ in 0..decimals / 2 {
+            self.pair(&mut end, v % 100);
+            v /= 100;
+        }
+        if decimals % 2 == 1 {
+            self.digit(&mut end, v % 10);
+            v /= 10;
+        }
+        if decimals > 0 {
+            end -= 1;
+            self.0[end] = b'.';
+        }
+        // The whole part: one digit at least.
+        while v >= 100 {
+            self.pair(&mut end, v % 100);
+            v /= 100;
+        }
+        if v >= 10 {
+            self.pair(&mut end, v);
+        } else {
+            self.digit(&mut end, v);
+        }
+        if negative && n != 0 {
+            end -= 1;
+            self.0[end] = b'-';
+        }
+        end
+    }
 }
 
 /// The standard formatter, with `-0` written `0`.
@@ -111,7 +185,10 @@ fn push_formatted(out: &mut String, x: f64, decimals: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::{fixed, push_formatted};
+    use super::{
+        fixed, push_fixed_bytes, push_formatted, push_integer_bytes, push_scaled,
+        MAX_SCALED_DECIMALS,
+    };
 
     fn reference(x: f64, d: usize) -> String {
         let mut s = String::new();
@@ -185,6 +262,52 @@ mod tests {
             }
             for d in [0, 1, 2, 3, 4, 5, 6, 9, 12] {
                 assert_eq!(fixed(x, d), reference(x, d), "{x:e} with {d} decimals");
+            }
+        }
+    }
+
+    /// An integer's digits with the point put `decimals` from the end: what `push_scaled`
+    /// writes, made with the standard formatter.
+    fn scaled_reference(negative: bool, n: u64, decimals: usize) -> String {
+        let digits = format!("{n:0>width$}", width = decimals + 1);
+        let (whole, part) = digits.split_at(digits.len() - decimals);
+        let sign = if negative && n != 0 { "-" } else { "" };
+        match decimals {
+            0 => format!("{sign}{whole}"),
+            _ => format!("{sign}{whole}.{part}"),
+        }
+    }
+
+    /// Every count of decimals up to the most, over integers of every length (u64's largest
+    /// among them), signed and not; the byte writers write the same text as the string ones.
+    #[test]
+    fn scaled_integers_and_bytes_match_the_standard_formatter() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut values = vec![0, 1, 9, 10, 99, 100, 101, u64::MAX, u64::MAX - 1];
+        for _ in 0..2_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            values.push(state >> (state % 64));
+        }
+        for &n in &values {
+            for decimals in 0..=MAX_SCALED_DECIMALS {
+                for negative in [false, true] {
+                    let mut out = String::from("x");
+                    push_scaled(&mut out, negative, n, decimals);
+                    assert_eq!(out[1..], scaled_reference(negative, n, decimals));
+                }
+            }
+            let mut bytes = vec![];
+            push_integer_bytes(&mut bytes, n);
+            assert_eq!(bytes, n.to_string().as_bytes());
+            let x = f64::from_bits(n);
+            if x.is_finite() {
+                for d in [0, 3, 6, 9, 12] {
+                    let mut bytes = vec![];
+                    push_fixed_bytes(&mut bytes, x, d);
+                    assert_eq!(bytes, fixed(x, d).as_bytes(), "{x:e} with {d} decimals");
+                }
             }
         }
     }

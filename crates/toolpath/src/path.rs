@@ -1,6 +1,6 @@
 //! The planned tool path the posts consume (the planner fills it), and its `toolpath.csv` form.
 
-use crate::fixed::push_fixed;
+use crate::fixed::{push_fixed_bytes, push_integer_bytes};
 use crate::role::Role;
 
 /// Why a tool path could not be read or used.
@@ -108,10 +108,10 @@ impl ToolPath {
         writeln!(w, "{CSV_HEADER}")?;
         let at_once = BLOCK * rayon::current_num_threads().max(1);
         for points in self.points.chunks(at_once) {
-            let blocks: Vec<String> = points
+            let blocks: Vec<Vec<u8>> = points
                 .par_chunks(BLOCK)
                 .map(|block| {
-                    let mut text = String::with_capacity(96 * block.len());
+                    let mut text = Vec::with_capacity(112 * block.len());
                     for q in block {
                         csv_line(&mut text, q);
                     }
@@ -119,7 +119,7 @@ impl ToolPath {
                 })
                 .collect();
             for text in &blocks {
-                w.write_all(text.as_bytes())?;
+                w.write_all(text)?;
             }
         }
         Ok(())
@@ -247,10 +247,13 @@ fn clip(s: &str) -> String {
     out
 }
 
-/// Appends the line of `q` in toolpath.csv ([`ToolPath::to_csv`]), with its `\n`.
-fn csv_line(line: &mut String, q: &PathPoint) {
-    use std::fmt::Write as _;
-    let _ = write!(line, "{},{},{}", q.feature, q.layer, q.kind.as_str());
+/// Appends the line of `q` in toolpath.csv ([`ToolPath::to_csv`]), with its `\n`: ASCII.
+fn csv_line(line: &mut Vec<u8>, q: &PathPoint) {
+    push_integer_bytes(line, u64::from(q.feature));
+    line.push(b',');
+    push_integer_bytes(line, u64::from(q.layer));
+    line.push(b',');
+    line.extend_from_slice(q.kind.as_str().as_bytes());
     for (x, decimals) in [
         (q.p[0], 6),
         (q.p[1], 6),
@@ -262,12 +265,12 @@ fn csv_line(line: &mut String, q: &PathPoint) {
         (f64::from(q.thickness), 4),
         (f64::from(q.width), 4),
     ] {
-        line.push(',');
-        push_fixed(line, x, decimals);
+        line.push(b',');
+        push_fixed_bytes(line, x, decimals);
     }
-    line.push(',');
-    line.push_str(q.role.as_str());
-    line.push('\n');
+    line.push(b',');
+    line.extend_from_slice(q.role.as_str().as_bytes());
+    line.push(b'\n');
 }
 
 #[cfg(test)]
