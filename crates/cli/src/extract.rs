@@ -77,12 +77,13 @@ pub fn run(args: &ExtractArgs) -> Result<(), Failure> {
 /// and their area summed.
 fn support_json(assembly: &features::Assembly) -> Result<Vec<Value>, plan::PlanError> {
     let bead = robot_post::MachineProfile::builtin(robot_post::MachineKind::Marlin).bead();
-    let (_, columns) = plan::support::planar(
+    let columns = plan::support::planar(
         assembly,
         &plan::Process::default(),
         bead.width,
         slicer::support::Carry::Until(None),
-    )?;
+    )?
+    .columns;
     let next: usize = assembly.trees.iter().map(|t| t.features.len()).sum();
     Ok(columns
         .iter()

@@ -10,6 +10,7 @@ use crate::{PlanError, Process, Progress};
 use brep::math::P3;
 use rayon::prelude::*;
 use robot_post::machine::MachineProfile;
+use slicer::feature_fill::fill_feature_on;
 use slicer::figures::{FreeformFigures, Layering};
 use slicer::params::{LayerParams, LayerStrategy};
 use slicer::toolpath::{MoveKind, PathPoint, ToolPath};
@@ -98,7 +99,11 @@ pub fn lay(
     }
     // What holds up each planar layer, from the features alone (issue 31).
     // Support material (issue 33) carries what it can; `held` is what it leaves.
-    let (mut held, columns) = crate::support::planar(
+    let crate::support::Planar {
+        mut held,
+        columns,
+        mut meshes,
+    } = crate::support::planar(
         &extracted.assembly,
         process,
         machine.bead().width,
@@ -119,7 +124,9 @@ pub fn lay(
             .map(|&slot| {
                 let t = &extracted.assembly.trees[slot.tree];
                 let params = process.feature_params(&base, slot.offset, extracted.feature(slot))?;
-                let fill = fill_feature(t, extracted.feature(slot), &params, machine.bead())?;
+                let f = extracted.feature(slot);
+                let meshed = meshes.get(&extracted.id(slot));
+                let fill = fill_feature_on(t, f, &params, machine.bead(), meshed)?;
                 let fill = match columns.get(&extracted.id(slot)) {
                     Some(c) => fill.with_support(c, &params),
                     None => fill,
@@ -147,7 +154,10 @@ pub fn lay(
                 &plan.points,
                 machine.min_bead_width(),
                 machine.nozzle_diameter,
+                meshes.get(&id),
             )?;
+            // Its mesh is not needed again.
+            meshes.remove(&id);
             let mut laid = laid.widen(&mut plan.points, machine);
             if let Some(b) = &below_resolution {
                 laid.planned.tolerance = crate::resolution::tolerance(b.narrow_share);

@@ -561,15 +561,38 @@ pub fn stand(
             (stood, p, a)
         }
     };
-    let moves = table_hits(&a);
-    let first = layer_count(stood.height + lift_needed(&a, &p, ctx.machine), layer).max(max + 1);
-    let (height, cleared) = named_height(first, layer, |n| {
+    let e = refusal(ctx, (&stood, &p, &a), max, layer, |n| {
         let s = build(&o, n);
         let (q, b) = check(&s, Stop::AtEnd)?;
         let lift = lift_needed(&b, &q, ctx.machine);
         Ok((table_hits(&b) == 0, s.height + lift))
     })?;
-    let e = if cleared {
+    if !ctx.allow_collisions {
+        return Err(e);
+    }
+    Ok(Checked {
+        path: p,
+        avoided: a,
+        pedestal: Some(stood),
+        warnings: vec![e.to_string()],
+    })
+}
+
+/// Why not even the machine's tallest pedestal (`tallest`, of `max` layers `layer` mm thick,
+/// with its check of its path) will do: the height that would, from how deep the head still
+/// reaches, checked by `check` ([`named_height`]), or the tallest tried where none cleared.
+fn refusal(
+    ctx: &Context,
+    (stood, p, a): (&Stood, &ToolPath, &Avoided),
+    max: usize,
+    layer: f64,
+    check: impl FnMut(usize) -> Result<(bool, f64), PedestalError>,
+) -> Result<PedestalError, PedestalError> {
+    let max_height = ctx.machine.max_pedestal_height();
+    let moves = table_hits(a);
+    let first = layer_count(stood.height + lift_needed(a, p, ctx.machine), layer).max(max + 1);
+    let (height, cleared) = named_height(first, layer, check)?;
+    Ok(if cleared {
         PedestalError::TooLow {
             max: max_height,
             moves,
@@ -581,15 +604,6 @@ pub fn stand(
             moves,
             tried: height,
         }
-    };
-    if !ctx.allow_collisions {
-        return Err(e);
-    }
-    Ok(Checked {
-        path: p,
-        avoided: a,
-        pedestal: Some(stood),
-        warnings: vec![e.to_string()],
     })
 }
 

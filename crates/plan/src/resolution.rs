@@ -42,7 +42,8 @@ pub struct BelowResolution {
 /// `min_bead` mm wide at the narrowest: its beads narrower than that carry at least
 /// [`NARROW_BEAD_SHARE`] of its material, and its sections' regions narrower than that hold at
 /// least [`BELOW_RESOLUTION_SHARE`] of it ([`slicer::resolution::narrow_sections`]; two5d
-/// features only).
+/// features only; `meshed`: its planar mesh made already).
+#[allow(clippy::too_many_arguments)]
 pub fn below_resolution(
     tree: &FeatureTree,
     f: &Feature,
@@ -50,6 +51,7 @@ pub fn below_resolution(
     points: &[PathPoint],
     min_bead: f64,
     nozzle: f64,
+    meshed: Option<&slicer::planar::PlanarMesh>,
 ) -> Result<Option<BelowResolution>, slicer::planar::FeatureError> {
     let (mut total, mut narrow) = (0.0, 0.0);
     for q in points
@@ -66,7 +68,7 @@ pub fn below_resolution(
     if total <= 0.0 || narrow < NARROW_BEAD_SHARE * total || min_bead.is_nan() || min_bead <= 0.0 {
         return Ok(None);
     }
-    let Some(n) = slicer::resolution::narrow_sections(tree, f, params, min_bead)? else {
+    let Some(n) = slicer::resolution::narrow_sections(tree, f, params, min_bead, meshed)? else {
         return Ok(None);
     };
     Ok(
@@ -144,7 +146,7 @@ mod tests {
         let assembly = features::extract_all(&part.brep, &Default::default()).expect("features");
         let t = &assembly.trees[0];
         let params = LayerParams::default();
-        let none = below_resolution(t, &t.features[0], &params, &points, 0.24, 0.4);
+        let none = below_resolution(t, &t.features[0], &params, &points, 0.24, 0.4, None);
         assert!(matches!(none, Ok(None)));
         // The same plate's contact (0.297 mm wide) is below the resolution of a nozzle whose
         // narrowest bead is 0.4 mm (not of the delta5's, 0.24 mm), and nothing else is.
@@ -153,7 +155,7 @@ mod tests {
             .features
             .iter()
             .filter_map(|f| {
-                below_resolution(t, f, &params, &narrow, 0.4, 0.6)
+                below_resolution(t, f, &params, &narrow, 0.4, 0.6, None)
                     .ok()
                     .flatten()
             })

@@ -12,12 +12,28 @@
 use crate::{PlanError, Process};
 use features::{Assembly, FeatureKind};
 use rayon::prelude::*;
+use slicer::planar::PlanarMesh;
 use slicer::support::{planar_support, Carry, FeatureSupport};
 use slicer::support_material::SupportRegions;
 use std::collections::BTreeMap;
 
 /// Each feature's support material regions by file-wide id (features with support only).
 pub type Columns = BTreeMap<usize, SupportRegions>;
+
+/// Each two5d feature's planar mesh by file-wide id, with the sections its support was found
+/// on: the fill and the resolution check take them from here rather than mesh and cut the
+/// feature again.
+pub type Meshes = BTreeMap<usize, PlanarMesh>;
+
+/// What [`planar`] finds.
+pub struct Planar {
+    /// What holds up each two5d feature, by file-wide id.
+    pub held: BTreeMap<usize, Held>,
+    /// Support material regions (features with support only).
+    pub columns: Columns,
+    /// The features' planar meshes.
+    pub meshes: Meshes,
+}
 
 /// What holds up one feature.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,15 +52,15 @@ pub struct Held {
 /// the plate (the lowest base plane, [`PLATE_SLACK`]) rests on the solids built before it.
 /// With [`Carry::Until`], support material (issue 33; unless `support_material = "off"`)
 /// carries what it can ([`slicer::support::planar_support`]): each [`Held`] gives what is
-/// left, and the second map each feature's support regions (features with support only); its
-/// columns are given up past the instant given ([`PlanError::TimeLimit`]: under a part turned
-/// over, NIST CTC-05's columns took minutes).
+/// left, and [`Planar::columns`] each feature's support regions (features with support only);
+/// its columns are given up past the instant given ([`PlanError::TimeLimit`]: under a part
+/// turned over, NIST CTC-05's columns took minutes).
 pub fn planar(
     assembly: &Assembly,
     process: &Process,
     bead_width: f64,
     carry: Carry,
-) -> Result<(BTreeMap<usize, Held>, Columns), PlanError> {
+) -> Result<Planar, PlanError> {
     let base = process.base();
     let trees = &assembly.trees;
     // How high each solid's base plane stands along the build direction (+Z).
@@ -77,31 +93,59 @@ pub fn planar(
     }
     // Each feature's support on its own (in parallel: one feature's meshing and column
     // carrying run on one core, NIST CTC-05's three features side by side).
-    let found: Vec<Result<_, PlanError>> =
-        jobs.par_iter()
-            .with_max_len(1)
-            .map(|&(ti, offset, f, lifted, gap)| {
-                let t = &trees[ti];
-                let earlier: Vec<_> = match lifted {
-                    true => trees[..ti]
-                        .iter()
-                        .flat_map(|u| u.features.iter().map(move |g| (u, g)))
-                        .collect(),
-                    false => vec![],
-                };
-                let params = process.feature_params(&base, offset, f)?;
-                let found = planar_support(t, f, &params, bead_width, &earlier, gap, carry)
-                    .map_err(|e| match e {
-                        slicer::planar::FeatureError::TimeLimit(_) => PlanError::TimeLimit,
-                        e => e.into(),
-                    })?;
-                Ok((offset + f.id, params.overhang_angle_deg, f.kind, found))
-            })
-            .collect();
+    let found: Vec<Result<_, PlanError>> = jobs
+        .par_iter()
+        .with_max_len(1)
+        .map(|&(ti, offset, f, lifted, gap)| {
+            let t = &trees[ti];
+            let earlier: Vec<_> = match lifted {
+                true => trees[..ti]
+                    .iter()
+                    .flat_map(|u| u.features.iter().map(move |g| (u, g)))
+                    .collect(),
+                false => vec![],
+            };
+            let params = process.feature_params(&base, offset, f)?;
+            // Parameters that do not validate are refused by `planar_support`, before
+            // a mesh is made.
+            let mut meshed = (f.kind == FeatureKind::Two5d && params.validate().is_ok())
+                .then(|| PlanarMesh::of(t, f, &params))
+                .transpose()?;
+            let mut found = planar_support(
+                t,
+                f,
+                &params,
+                bead_width,
+                &earlier,
+                gap,
+                carry,
+                meshed.as_ref(),
+            )
+            .map_err(|e| match e {
+                slicer::planar::FeatureError::TimeLimit(_) => PlanError::TimeLimit,
+                e => e.into(),
+            })?;
+            // The sections the support was found on are the fill's.
+            if let (Some(m), Some(p)) = (meshed.as_mut(), found.as_mut()) {
+                m.mid_sections = Some(std::mem::take(&mut p.sections));
+            }
+            Ok((
+                offset + f.id,
+                params.overhang_angle_deg,
+                f.kind,
+                found,
+                meshed,
+            ))
+        })
+        .collect();
     let mut out = BTreeMap::new();
     let mut regions = BTreeMap::new();
+    let mut meshes = BTreeMap::new();
     for r in found {
-        let (id, angle_deg, kind, found) = r?;
+        let (id, angle_deg, kind, found, meshed) = r?;
+        if let Some(m) = meshed {
+            meshes.insert(id, m);
+        }
         if let Some(p) = found {
             out.insert(
                 id,
@@ -116,7 +160,11 @@ pub fn planar(
             }
         }
     }
-    Ok((out, regions))
+    Ok(Planar {
+        held: out,
+        columns: regions,
+        meshes,
+    })
 }
 
 /// How far (mm) above the lowest solid's base plane another solid's base may stand and still
@@ -132,7 +180,7 @@ pub fn planar_area(
     bead_width: f64,
 ) -> Result<f64, PlanError> {
     Ok(planar(assembly, process, bead_width, Carry::Not)?
-        .0
+        .held
         .values()
         .map(|h| h.support.area_mm2)
         .sum())

@@ -6,7 +6,7 @@ use crate::error::FeatureError;
 use crate::feature_plan::FeaturePlan;
 use crate::freeform::{fill_freeform, FreeformFill};
 use crate::params::LayerParams;
-use crate::planar::{fill_two5d, Two5dFill};
+use crate::planar::{fill_two5d_on, PlanarMesh, Two5dFill};
 use crate::toolpath::Bead;
 use brep::math::P3;
 use features::{Feature, FeatureKind, FeatureTree};
@@ -29,8 +29,20 @@ pub fn fill_feature<'a>(
     params: &LayerParams,
     bead: Bead,
 ) -> Result<FeatureFill<'a>, FeatureError> {
+    fill_feature_on(tree, f, params, bead, None)
+}
+
+/// [`fill_feature`], a two5d feature on its planar mesh made already (`meshed`; `None`: made
+/// here).
+pub fn fill_feature_on<'a>(
+    tree: &'a FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+    meshed: Option<&PlanarMesh>,
+) -> Result<FeatureFill<'a>, FeatureError> {
     Ok(match f.kind {
-        FeatureKind::Two5d => FeatureFill::Two5d(fill_two5d(tree, f, params, bead)?),
+        FeatureKind::Two5d => FeatureFill::Two5d(fill_two5d_on(tree, f, params, bead, meshed)?),
         FeatureKind::Freeform => FeatureFill::Freeform(fill_freeform(tree, f, params, bead)?),
     })
 }

@@ -6,7 +6,7 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
-use crate::feature_mesh::{grown_mesh, slicing_tolerance, Allowance, Grown};
+pub use crate::feature_mesh::{reference_plane, PlanarMesh};
 use crate::fill::{
     fill_layer_with, order_greedy, regions_from_loops, thinner_than, Region, SparseLayer,
 };
@@ -14,7 +14,7 @@ use crate::geom2d::{dist, region_area, Point2};
 use crate::params::{InfillPattern, LayerParams, PathMode};
 use crate::region_fill::{fill_flat_region, solid_on_skins, Boundary, FillPath};
 use crate::toolpath::{MoveKind, PathPoint, Role};
-use brep::math::{P3, V3};
+use brep::math::P3;
 use brep::section::{section, Plane};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
@@ -25,26 +25,6 @@ pub use crate::figures::FeatureFigures;
 use crate::support_material::SupportRegions;
 use crate::tolerance::{COLLINEAR, KEY_GRID};
 pub use toolpath::Bead;
-
-/// The reference plane of a two5d feature: through its healing faces (or build-plate face),
-/// normal pointing into the feature.
-pub fn reference_plane(tree: &FeatureTree, f: &Feature) -> Option<Plane> {
-    let n = f.reference.normal.map(|n| V3::new(n[0], n[1], n[2]))?;
-    let b = &tree.brep;
-    // A point of the reference: a vertex of the reference face; else the feature's lowest
-    // point, on its surfaces (a torus or a cylinder lying on its side is lowest between its
-    // vertices, which may all lie at its middle height).
-    let face = f.heal_faces.first().copied().or(f.reference.face);
-    let p = match (face, f.reference.origin) {
-        (Some(fc), _) => b
-            .vertices_of(&[fc])
-            .first()
-            .map(|v| b.vertices[v.idx()].point),
-        (None, Some(o)) => Some(P3::from(o)),
-        (None, None) => features::extract::lowest_point(b, &f.faces, [n.x, n.y, n.z]).map(P3::from),
-    }?;
-    Some(Plane::new(p, n))
-}
 
 /// How far (mm) `points` (a feature's mesh) reach below the build plate of `tree` (its base
 /// feature's reference plane): 0 when they do not, or when the tree has no plate.
@@ -221,14 +201,33 @@ pub fn fill_two5d(
     params: &LayerParams,
     bead: Bead,
 ) -> Result<Two5dFill, FeatureError> {
+    fill_two5d_on(tree, f, params, bead, None)
+}
+
+/// [`fill_two5d`] on the feature's planar mesh made already (`None`: made here).
+pub fn fill_two5d_on(
+    tree: &FeatureTree,
+    f: &Feature,
+    params: &LayerParams,
+    bead: Bead,
+    meshed: Option<&PlanarMesh>,
+) -> Result<Two5dFill, FeatureError> {
     if f.kind != FeatureKind::Two5d {
         return Err(FeatureError::NotTwo5d(f.id));
     }
     params
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
-    let (plane, (mesh, grown), top) = plane_grown_mesh_top(tree, f, params)?;
-    let heights = two5d_layer_heights(params, &mesh, &plane, top);
+    let made;
+    let pm = match meshed {
+        Some(m) => m,
+        None => {
+            made = PlanarMesh::of(tree, f, params)?;
+            &made
+        }
+    };
+    let (plane, mesh, grown, top) = (pm.plane, &pm.mesh, pm.grown.clone(), pm.top);
+    let heights = two5d_layer_heights(params, mesh, &plane, top);
     let spacing = params.spacing(bead.width);
     let fig = FeatureFigures {
         below_plate: below_plate(tree, &mesh.positions),
@@ -248,21 +247,14 @@ pub fn fill_two5d(
     // points micrometres apart where long thin triangles meet the plane (NIST CTC-05's arcs),
     // which every offset of the fill and every point of the plan would carry.
     let near = crate::fill::ring_print_tolerance(params.tolerance, bead.width);
-    let sections: Vec<Vec<Region>> = tops
-        .par_iter()
-        .with_max_len(1)
-        .map(|&(mid, top, dl)| {
-            let at = |z: f64| {
-                let cut = plane.offset(z);
-                section_regions(&mesh, &cut, &cut)
-            };
-            let regions = match covering {
-                false => at(mid),
-                true => crate::feature_mesh::covering_section(at, (mid, top, dl)),
-            };
-            crate::fill::simplified(regions, near)
-        })
-        .collect();
+    let found = pm
+        .mid_sections
+        .as_ref()
+        .filter(|s| !covering && s.len() == tops.len());
+    let sections: Vec<Vec<Region>> = match found {
+        Some(s) => s.clone(),
+        None => sections_at(mesh, &plane, &tops, covering, near),
+    };
     let mut fig = fig;
     if let Some(g) = fig.grown.as_mut() {
         g.layered_volume = Some(
@@ -294,46 +286,14 @@ pub fn plate_regions(
     f: &Feature,
     params: &LayerParams,
 ) -> Result<(Plane, Vec<Region>), FeatureError> {
-    let (plane, mesh, top) = plane_mesh_top(tree, f, params)?;
+    let PlanarMesh {
+        plane, mesh, top, ..
+    } = PlanarMesh::of(tree, f, params)?;
     let Some(&first) = two5d_layer_heights(params, &mesh, &plane, top).first() else {
         return Ok((plane, vec![]));
     };
     let regions = section_regions(&mesh, &plane.offset(0.5 * first), &plane);
     Ok((plane, regions))
-}
-
-/// A two5d feature's reference plane, its mesh at the slicing tolerance, and its top: the
-/// height of its highest mesh point over the plane.
-pub(crate) fn plane_mesh_top(
-    tree: &FeatureTree,
-    f: &Feature,
-    params: &LayerParams,
-) -> Result<(Plane, brep::mesh::Mesh, f64), FeatureError> {
-    let (plane, (mesh, _), top) = plane_grown_mesh_top(tree, f, params)?;
-    Ok((plane, mesh, top))
-}
-
-/// A feature's mesh and what growing it by its machining allowance gave.
-type GrownMesh = (brep::mesh::Mesh, Option<Grown>);
-
-/// [`plane_mesh_top`] with what growing the feature by its machining allowance gave. A feature
-/// standing on its parent's grown face (`base_allowance`) has its layers' plane lifted onto
-/// that face.
-fn plane_grown_mesh_top(
-    tree: &FeatureTree,
-    f: &Feature,
-    params: &LayerParams,
-) -> Result<(Plane, GrownMesh, f64), FeatureError> {
-    let plane = reference_plane(tree, f).ok_or(FeatureError::NoPlane(f.id))?;
-    let lift = params.base_allowance;
-    let plane = plane.offset(lift);
-    let (mesh, grown) = grown_mesh(tree, f, slicing_tolerance(params), Allowance::of(params))?;
-    let top = mesh
-        .positions
-        .iter()
-        .map(|p| plane.height(p))
-        .fold(0.0f64, f64::max);
-    Ok((plane, (mesh, grown), top))
 }
 
 /// The faces of a mesh whose points lie within this of one height over the layers' plane
@@ -455,6 +415,32 @@ pub fn fill_prism(
         sparse,
         fig: FeatureFigures::default(),
     }
+}
+
+/// Each layer's section of `mesh` (`tops`: each layer's middle, top and thickness over
+/// `plane`): at its middle, or where `covering` (a feature grown by an allowance) the union of
+/// its sections over its thickness; simplified within `near`. In parallel.
+fn sections_at(
+    mesh: &brep::mesh::Mesh,
+    plane: &Plane,
+    tops: &[(f64, f64, f64)],
+    covering: bool,
+    near: f64,
+) -> Vec<Vec<Region>> {
+    tops.par_iter()
+        .with_max_len(1)
+        .map(|&(mid, top, dl)| {
+            let at = |z: f64| {
+                let cut = plane.offset(z);
+                section_regions(mesh, &cut, &cut)
+            };
+            let regions = match covering {
+                false => at(mid),
+                true => crate::feature_mesh::covering_section(at, (mid, top, dl)),
+            };
+            crate::fill::simplified(regions, near)
+        })
+        .collect()
 }
 
 /// Each layer's paths from its section's regions, filled in parallel, and each layer's area

@@ -8,7 +8,7 @@ use crate::error::FeatureError;
 use crate::fill::{thinner_than, Region};
 use crate::geom2d::area2;
 use crate::params::LayerParams;
-use crate::planar::reference_plane;
+use crate::planar::{reference_plane, PlanarMesh};
 use features::{Feature, FeatureKind, FeatureTree};
 use rayon::prelude::*;
 
@@ -29,11 +29,13 @@ pub struct NarrowSections {
 /// its middle) narrower than `limit` mm, their narrowest width and share of the feature;
 /// `None` when no region is narrower or the feature is not two5d (curved layers' slivers at a
 /// blade's edge are cut-offs, not a narrow feature).
+/// `meshed`: the feature's planar mesh made already (`None`: made here).
 pub fn narrow_sections(
     tree: &FeatureTree,
     f: &Feature,
     params: &LayerParams,
     limit: f64,
+    meshed: Option<&PlanarMesh>,
 ) -> Result<Option<NarrowSections>, FeatureError> {
     if f.kind != FeatureKind::Two5d || limit.is_nan() || limit <= 0.0 {
         return Ok(None);
@@ -41,10 +43,19 @@ pub fn narrow_sections(
     if reference_plane(tree, f).is_none() {
         return Ok(None);
     }
-    let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
+    let made;
+    let PlanarMesh {
+        plane, mesh, top, ..
+    } = match meshed {
+        Some(m) => m,
+        None => {
+            made = PlanarMesh::of(tree, f, params)?;
+            &made
+        }
+    };
     let mut mids = vec![];
     let mut z = 0.0;
-    for dl in crate::planar::two5d_layer_heights(params, &mesh, &plane, top) {
+    for dl in crate::planar::two5d_layer_heights(params, mesh, plane, *top) {
         mids.push((z + 0.5 * dl, dl));
         z += dl;
     }
@@ -55,7 +66,7 @@ pub fn narrow_sections(
         .map(|&(mid, dl)| {
             let cut = plane.offset(mid);
             let mut out = (0.0, 0.0, f64::INFINITY);
-            for r in crate::planar::section_regions(&mesh, &cut, &cut) {
+            for r in crate::planar::section_regions(mesh, &cut, &cut) {
                 let v = region_area(&r) * dl;
                 out.0 += v;
                 if thinner_than(&r, 0.5 * limit) {

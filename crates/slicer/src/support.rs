@@ -16,7 +16,7 @@
 //! feature's mesh at each layer's middle, as the planar planner does, and stops there).
 
 use crate::error::FeatureError;
-use crate::feature_mesh::{feature_mesh, slicing_tolerance, Allowance};
+use crate::feature_mesh::{feature_mesh, slicing_tolerance, Allowance, PlanarMesh};
 use crate::fill::{outside_grown, pieces_outside};
 use crate::geom2d::{region_area, Region};
 use crate::params::{LayerParams, SupportMaterial};
@@ -117,7 +117,8 @@ pub fn feature_support(
     bead_width: f64,
     earlier: &[(&FeatureTree, &Feature)],
 ) -> Result<Option<FeatureSupport>, FeatureError> {
-    Ok(planar_support(tree, f, params, bead_width, earlier, 0.0, Carry::Not)?.map(|p| p.left))
+    let support = planar_support(tree, f, params, bead_width, earlier, 0.0, Carry::Not, None)?;
+    Ok(support.map(|p| p.left))
 }
 
 /// Whether [`planar_support`] counts what support material carries, and until when.
@@ -139,6 +140,42 @@ pub struct PlanarSupport {
     pub left: FeatureSupport,
     /// The support material's regions, layer by layer (empty without support).
     pub columns: SupportRegions,
+    /// Each layer's section at its middle, simplified as the fill lays it: the fill's own
+    /// sections (a feature not grown by an allowance), made once
+    /// ([`crate::planar::PlanarMesh::mid_sections`]).
+    pub sections: Vec<Vec<Region>>,
+}
+
+/// What feature `f`'s first layer rests on: the sections by `cut` (half that layer's thickness
+/// below its reference plane) of its parents, or for a base feature of `earlier` (the solids
+/// built before a lifted one), each grown by its allowance (which lifted this feature's base),
+/// simplified within `near`; `None` on the plate (neither: nothing to check).
+fn foundation(
+    tree: &FeatureTree,
+    f: &Feature,
+    earlier: &[(&FeatureTree, &Feature)],
+    cut: &Plane,
+    params: &LayerParams,
+    near: f64,
+) -> Result<Option<Vec<Region>>, FeatureError> {
+    let under: Vec<(&FeatureTree, &Feature)> = match f.parents.is_empty() {
+        false => f
+            .parents
+            .iter()
+            .map(|&p| (tree, &tree.features[p]))
+            .collect(),
+        true => earlier.to_vec(),
+    };
+    if under.is_empty() {
+        return Ok(None);
+    }
+    let tol = slicing_tolerance(params);
+    let mut regions = vec![];
+    for (t, g) in under {
+        let mesh = feature_mesh(t, g, tol, Allowance::of_parent(params))?;
+        regions.extend(section_regions(&mesh, cut, near));
+    }
+    Ok(Some(regions))
 }
 
 /// [`feature_support`], and with [`Carry::Until`] (and `support_material` not `off`) the support
@@ -149,7 +186,8 @@ pub struct PlanarSupport {
 /// plate, landing on the earlier solids where they lie under them ([`crate::support_below`];
 /// the regions' [`SupportRegions::below`] layers). Elsewhere they stand on the feature's own
 /// lower layers, or at its first layer on what that layer rests on (its parents' sections),
-/// never lower.
+/// never lower. `meshed`: the feature's planar mesh made already (`None`: made here).
+#[allow(clippy::too_many_arguments)]
 pub fn planar_support(
     tree: &FeatureTree,
     f: &Feature,
@@ -158,6 +196,7 @@ pub fn planar_support(
     earlier: &[(&FeatureTree, &Feature)],
     gap: f64,
     carry: Carry,
+    meshed: Option<&PlanarMesh>,
 ) -> Result<Option<PlanarSupport>, FeatureError> {
     if f.kind != FeatureKind::Two5d {
         return Ok(None);
@@ -167,8 +206,18 @@ pub fn planar_support(
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let tol = slicing_tolerance(params);
     let near = crate::fill::ring_print_tolerance(params.tolerance, bead_width);
-    let (plane, mesh, top) = crate::planar::plane_mesh_top(tree, f, params)?;
-    let heights = crate::planar::two5d_layer_heights(params, &mesh, &plane, top);
+    let made;
+    let PlanarMesh {
+        plane, mesh, top, ..
+    } = match meshed {
+        Some(m) => m,
+        None => {
+            made = PlanarMesh::of(tree, f, params)?;
+            &made
+        }
+    };
+    let (plane, top) = (*plane, *top);
+    let heights = crate::planar::two5d_layer_heights(params, mesh, &plane, top);
     let mut mids = Vec::with_capacity(heights.len());
     let mut z = 0.0;
     for &dl in &heights {
@@ -178,30 +227,11 @@ pub fn planar_support(
     let sections: Vec<Vec<Region>> = mids
         .par_iter()
         .with_max_len(1)
-        .map(|&mid| section_regions(&mesh, &plane.offset(mid), near))
+        .map(|&mid| section_regions(mesh, &plane.offset(mid), near))
         .collect();
-    // Under the first layer: the parents (or the earlier solids) just below the reference
-    // plane; the plate, with neither: nothing to check.
-    let under: Vec<(&FeatureTree, &Feature)> = match f.parents.is_empty() {
-        false => f
-            .parents
-            .iter()
-            .map(|&p| (tree, &tree.features[p]))
-            .collect(),
-        true => earlier.to_vec(),
-    };
-    let foundation = match (under.is_empty(), heights.first()) {
-        (false, Some(&h0)) => {
-            let cut = plane.offset(-0.5 * h0);
-            let mut regions = vec![];
-            for (t, g) in under {
-                // The parents as grown by their allowance, which lifted this feature's base.
-                let mesh = feature_mesh(t, g, tol, Allowance::of_parent(params))?;
-                regions.extend(section_regions(&mesh, &cut, near));
-            }
-            Some(regions)
-        }
-        _ => None,
+    let foundation = match heights.first() {
+        Some(&h0) => foundation(tree, f, earlier, &plane.offset(-0.5 * h0), params, near)?,
+        None => None,
     };
     let sliver = sliver_area(bead_width);
     let angle = params.overhang_angle_deg;
@@ -242,6 +272,7 @@ pub fn planar_support(
             overhang,
             left: overhang,
             columns: SupportRegions::default(),
+            sections,
         }));
     }
     // A lifted solid's base: its layers carried on below its first one, down to the plate.
@@ -264,7 +295,7 @@ pub fn planar_support(
         .map_err(|_| FeatureError::TimeLimit(f.id))?,
         _ => {
             let mut all_sections = under.sections;
-            all_sections.extend(sections);
+            all_sections.extend(sections.iter().cloned());
             let mut all_heights = under.heights.clone();
             all_heights.extend(&heights);
             let mut all_pieces = vec![vec![]; u];
@@ -295,6 +326,7 @@ pub fn planar_support(
         overhang,
         left,
         columns: c.regions,
+        sections,
     }))
 }
 
