@@ -134,6 +134,19 @@ pub struct PlanarMesh {
 }
 
 impl PlanarMesh {
+    /// `given` (made already for the feature), or the feature's own made now ([`PlanarMesh::of`]).
+    pub fn given_or_of<'a>(
+        given: Option<&'a PlanarMesh>,
+        tree: &FeatureTree,
+        f: &Feature,
+        params: &crate::params::LayerParams,
+    ) -> Result<std::borrow::Cow<'a, PlanarMesh>, FeatureError> {
+        Ok(match given {
+            Some(m) => std::borrow::Cow::Borrowed(m),
+            None => std::borrow::Cow::Owned(PlanarMesh::of(tree, f, params)?),
+        })
+    }
+
     /// The planar mesh of two5d feature `f` of `tree` with its `params`.
     pub fn of(
         tree: &FeatureTree,

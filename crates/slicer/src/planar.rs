@@ -218,14 +218,7 @@ pub fn fill_two5d_on(
     params
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
-    let made;
-    let pm = match meshed {
-        Some(m) => m,
-        None => {
-            made = PlanarMesh::of(tree, f, params)?;
-            &made
-        }
-    };
+    let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
     let (plane, mesh, grown, top) = (pm.plane, &pm.mesh, pm.grown.clone(), pm.top);
     let heights = two5d_layer_heights(params, mesh, &plane, top);
     let spacing = params.spacing(bead.width);

@@ -43,16 +43,10 @@ pub fn narrow_sections(
     if reference_plane(tree, f).is_none() {
         return Ok(None);
     }
-    let made;
+    let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
     let PlanarMesh {
         plane, mesh, top, ..
-    } = match meshed {
-        Some(m) => m,
-        None => {
-            made = PlanarMesh::of(tree, f, params)?;
-            &made
-        }
-    };
+    } = pm.as_ref();
     let mut mids = vec![];
     let mut z = 0.0;
     for dl in crate::planar::two5d_layer_heights(params, mesh, plane, *top) {

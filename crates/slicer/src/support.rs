@@ -206,16 +206,10 @@ pub fn planar_support(
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let tol = slicing_tolerance(params);
     let near = crate::fill::ring_print_tolerance(params.tolerance, bead_width);
-    let made;
+    let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
     let PlanarMesh {
         plane, mesh, top, ..
-    } = match meshed {
-        Some(m) => m,
-        None => {
-            made = PlanarMesh::of(tree, f, params)?;
-            &made
-        }
-    };
+    } = pm.as_ref();
     let (plane, top) = (*plane, *top);
     let heights = crate::planar::two5d_layer_heights(params, mesh, &plane, top);
     let mut mids = Vec::with_capacity(heights.len());
