@@ -99,3 +99,41 @@ fn no_placement_is_planned_when_the_part_is_larger_than_any_placement_holds() {
         Ok(_) => panic!("the box was planned on a 5 mm bed"),
     }
 }
+
+/// The bound allows another placement's path 2 % and 2 mm less across than the part as
+/// modelled's (its layers reach the part's extremes to within about half a bead and half a
+/// layer): on a bed that holds just less than that, none is planned; on one that holds just
+/// more, the placements are tried.
+#[test]
+fn the_bound_allows_two_percent_and_two_millimetres() {
+    let options = Options {
+        placement: Placement::Find,
+        ..Default::default()
+    };
+    let m = MachineProfile::builtin(MachineKind::Marlin);
+    let mut out = InMemory::default();
+    let plan = plan::plan_file_to(&the_box(), &Process::default(), &m, &options, &mut out)
+        .expect("the box plans on the built-in bed");
+    let across = robot_post::fit::across(
+        plan.toolpath
+            .points
+            .iter()
+            .filter(|q| q.kind == slicer::toolpath::MoveKind::Print && q.role.is_part())
+            .map(|q| q.p),
+    );
+    assert!(across > 10.0, "the box measures {across} mm across");
+    let allowed = across * 0.98 - 2.0;
+    for (holds, none) in [(allowed - 0.3, true), (allowed + 0.3, false)] {
+        let mut small = MachineProfile::builtin(MachineKind::Marlin);
+        // A cube bed whose diagonal is `holds`.
+        small.bed_size = [holds / 3f64.sqrt(); 3];
+        let mut out = InMemory::default();
+        let refused =
+            plan::plan_file_to(&the_box(), &Process::default(), &small, &options, &mut out);
+        let Err(PlanError::NoPlacement { tried, .. }) = refused else {
+            panic!("the box planned or was refused otherwise on a bed holding {holds:.2} mm");
+        };
+        let said = tried.iter().any(|t| t.failure.contains("none fits"));
+        assert_eq!(said, none, "holds {holds:.2} mm of {across:.2}: {tried:?}");
+    }
+}
