@@ -67,8 +67,8 @@ pub const MAX_FACES: usize = 4;
 /// built-in profiles' 0.45 mm beads and 0.2 mm layers).
 const ACROSS_SLACK_SHARE: f64 = 0.02;
 
-/// ... and as much again, mm. With 5 % and 5 mm before, NIST CTC-05 on delta5 (571 mm across
-/// its print points, 531.6 mm held) was planned in four placements to the 150 s limit.
+/// ... and as much again, mm. With 5 % and 5 mm before, NIST CTC-05 on delta5 (558 mm across
+/// its print points, 531.6 mm held) was planned in other placements until the 150 s limit.
 const ACROSS_SLACK_MM: f64 = 2.0;
 
 /// The `features plan` default of [`crate::Options::placement_time_limit`], seconds: the
