@@ -19,6 +19,8 @@ mod tolerance;
 pub mod vec3;
 
 pub use bead::Bead;
-pub use fixed::{fixed, push_fixed, push_fixed_bytes, push_integer_bytes, push_scaled};
+pub use fixed::{
+    fixed, push_fixed, push_fixed_bytes, push_integer_bytes, push_scaled, MAX_SCALED_DECIMALS,
+};
 pub use path::{MoveKind, PathPoint, ToolPath, ToolPathError, CSV_HEADER};
 pub use role::Role;
