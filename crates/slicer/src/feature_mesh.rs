@@ -124,8 +124,11 @@ pub struct PlanarMesh {
     pub mesh: brep::mesh::Mesh,
     /// What growing it by its machining allowance gave (`None` without one).
     pub grown: Option<Grown>,
-    /// The height of its highest point over `plane`, mm.
-    pub top: f64,
+    /// Its layers in order, each `(middle, top, thickness)` over `plane`, mm: the layer
+    /// heights `params` give up to its highest mesh point, through the heights of its faces
+    /// parallel to the plane ([`two5d_layer_heights`]). The support, the fill and the
+    /// resolution check all cut these layers.
+    pub layers: Vec<(f64, f64, f64)>,
     /// Each layer's section at its middle, simplified as the fill lays it, where found
     /// already (by the feature's support, [`crate::support::PlanarSupport::sections`]): the
     /// fill of a feature not grown by an allowance takes them (NIST CTC-05's largest feature:
@@ -161,14 +164,59 @@ impl PlanarMesh {
             .iter()
             .map(|p| plane.height(p))
             .fold(0.0f64, f64::max);
+        let layers = layer_tops(0.0, &two5d_layer_heights(params, &mesh, &plane, top));
         Ok(PlanarMesh {
             plane,
             mesh,
             grown,
-            top,
+            layers,
             mid_sections: None,
         })
     }
+}
+
+/// Layers `thicknesses` thick stacked from height `from`: each `(middle, top, thickness)`.
+pub(crate) fn layer_tops(from: f64, thicknesses: &[f64]) -> Vec<(f64, f64, f64)> {
+    let mut z = from;
+    thicknesses
+        .iter()
+        .map(|&dl| {
+            let layer = (z + 0.5 * dl, z + dl, dl);
+            z += dl;
+            layer
+        })
+        .collect()
+}
+
+/// The faces of a mesh whose points lie within this of one height over the layers' plane
+/// (mm) are parallel to it: steps of the feature's section.
+const FLAT_FACE_SPAN: f64 = 1e-4;
+
+/// The layer thicknesses of a two5d feature meshed as `mesh`, `top` high over its reference
+/// `plane`: [`crate::params::LayerParams::layer_heights_through`] the heights of its faces parallel to the
+/// plane (each face's points within [`FLAT_FACE_SPAN`] of one height), so that a layer
+/// boundary lies where the section changes at once.
+fn two5d_layer_heights(
+    params: &crate::params::LayerParams,
+    mesh: &brep::mesh::Mesh,
+    plane: &brep::section::Plane,
+    top: f64,
+) -> Vec<f64> {
+    let mut steps = vec![];
+    for f in &mesh.faces {
+        let (lo, hi) = f
+            .vertex
+            .iter()
+            .filter_map(|&v| mesh.positions.get(v as usize))
+            .map(|p| plane.height(p))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+                (lo.min(z), hi.max(z))
+            });
+        if hi - lo <= FLAT_FACE_SPAN && !f.triangles.is_empty() {
+            steps.push(0.5 * (lo + hi));
+        }
+    }
+    params.layer_heights_through(top, &steps)
 }
 
 /// The mesh of a feature's shell and its voids, at chord tolerance `tol`, grown by `allowance`.

@@ -6,6 +6,7 @@
 //! paths are lifted to the layer's top (where the nozzle runs) with the reference normal as the
 //! tool axis, and each segment gets its filament length from Eq. 1.
 
+use crate::feature_mesh::layer_tops;
 pub use crate::feature_mesh::{reference_plane, PlanarMesh};
 use crate::fill::{
     fill_layer_with, order_greedy, regions_from_loops, thinner_than, Region, SparseLayer,
@@ -219,8 +220,7 @@ pub fn fill_two5d_on(
         .validate()
         .map_err(|msg| FeatureError::Params { id: f.id, msg })?;
     let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
-    let (plane, mesh, grown, top) = (pm.plane, &pm.mesh, pm.grown.clone(), pm.top);
-    let heights = two5d_layer_heights(params, mesh, &plane, top);
+    let (plane, mesh, grown) = (pm.plane, &pm.mesh, pm.grown.clone());
     let spacing = params.spacing(bead.width);
     let fig = FeatureFigures {
         below_plate: below_plate(tree, &mesh.positions),
@@ -229,12 +229,7 @@ pub fn fill_two5d_on(
     };
     // Each layer's section and fill depend on that layer alone: computed in parallel, then
     // ordered and joined by travel one layer after the other.
-    let mut tops = Vec::with_capacity(heights.len());
-    let mut z = 0.0;
-    for &dl in &heights {
-        tops.push((z + 0.5 * dl, z + dl, dl));
-        z += dl;
-    }
+    let tops = pm.layers.clone();
     let covering = fig.grown.is_some();
     // Each section simplified within a tenth of the tolerance: a mesh's section has runs of
     // points micrometres apart where long thin triangles meet the plane (NIST CTC-05's arcs),
@@ -280,44 +275,16 @@ pub fn plate_regions(
     params: &LayerParams,
 ) -> Result<(Plane, Vec<Region>), FeatureError> {
     let PlanarMesh {
-        plane, mesh, top, ..
+        plane,
+        mesh,
+        layers,
+        ..
     } = PlanarMesh::of(tree, f, params)?;
-    let Some(&first) = two5d_layer_heights(params, &mesh, &plane, top).first() else {
+    let Some(&(mid, _, _)) = layers.first() else {
         return Ok((plane, vec![]));
     };
-    let regions = section_regions(&mesh, &plane.offset(0.5 * first), &plane);
+    let regions = section_regions(&mesh, &plane.offset(mid), &plane);
     Ok((plane, regions))
-}
-
-/// The faces of a mesh whose points lie within this of one height over the layers' plane
-/// (mm) are parallel to it: steps of the feature's section.
-const FLAT_FACE_SPAN: f64 = 1e-4;
-
-/// The layer thicknesses of a two5d feature meshed as `mesh`, `top` high over its reference
-/// `plane`: [`LayerParams::layer_heights_through`] the heights of its faces parallel to the
-/// plane (each face's points within [`FLAT_FACE_SPAN`] of one height), so that a layer
-/// boundary lies where the section changes at once.
-pub(crate) fn two5d_layer_heights(
-    params: &LayerParams,
-    mesh: &brep::mesh::Mesh,
-    plane: &Plane,
-    top: f64,
-) -> Vec<f64> {
-    let mut steps = vec![];
-    for f in &mesh.faces {
-        let (lo, hi) = f
-            .vertex
-            .iter()
-            .filter_map(|&v| mesh.positions.get(v as usize))
-            .map(|p| plane.height(p))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
-                (lo.min(z), hi.max(z))
-            });
-        if hi - lo <= FLAT_FACE_SPAN && !f.triangles.is_empty() {
-            steps.push(0.5 * (lo + hi));
-        }
-    }
-    params.layer_heights_through(top, &steps)
 }
 
 /// The regions of `mesh`'s section by the plane `cut`, in the 2-D frame of `frame` (a plane
@@ -674,12 +641,8 @@ impl Two5dFill {
         }
         let u = under.len();
         if u > 0 {
-            let mut z = -columns.below[..u].iter().sum::<f64>();
-            let mut tops = Vec::with_capacity(u + self.tops.len());
-            for &dl in &columns.below[..u] {
-                tops.push((z + 0.5 * dl, z + dl, dl));
-                z += dl;
-            }
+            let below = &columns.below[..u];
+            let mut tops = layer_tops(-below.iter().sum::<f64>(), below);
             tops.append(&mut self.tops);
             self.tops = tops;
             let mut filled = under;

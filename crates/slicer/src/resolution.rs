@@ -45,14 +45,12 @@ pub fn narrow_sections(
     }
     let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
     let PlanarMesh {
-        plane, mesh, top, ..
+        plane,
+        mesh,
+        layers,
+        ..
     } = pm.as_ref();
-    let mut mids = vec![];
-    let mut z = 0.0;
-    for dl in crate::planar::two5d_layer_heights(params, mesh, plane, *top) {
-        mids.push((z + 0.5 * dl, dl));
-        z += dl;
-    }
+    let mids: Vec<(f64, f64)> = layers.iter().map(|&(mid, _, dl)| (mid, dl)).collect();
     // Per layer: (all volume, narrow volume, narrowest width).
     let layers: Vec<(f64, f64, f64)> = mids
         .par_iter()

@@ -208,16 +208,14 @@ pub fn planar_support(
     let near = crate::fill::ring_print_tolerance(params.tolerance, bead_width);
     let pm = PlanarMesh::given_or_of(meshed, tree, f, params)?;
     let PlanarMesh {
-        plane, mesh, top, ..
+        plane,
+        mesh,
+        layers,
+        ..
     } = pm.as_ref();
-    let (plane, top) = (*plane, *top);
-    let heights = crate::planar::two5d_layer_heights(params, mesh, &plane, top);
-    let mut mids = Vec::with_capacity(heights.len());
-    let mut z = 0.0;
-    for &dl in &heights {
-        mids.push(z + 0.5 * dl);
-        z += dl;
-    }
+    let plane = *plane;
+    let heights: Vec<f64> = layers.iter().map(|l| l.2).collect();
+    let mids: Vec<f64> = layers.iter().map(|l| l.0).collect();
     let sections: Vec<Vec<Region>> = mids
         .par_iter()
         .with_max_len(1)

@@ -16,7 +16,7 @@
 //!   gap support leaves under a held surface): no column is built under it.
 
 use crate::error::FeatureError;
-use crate::feature_mesh::{feature_mesh, Allowance};
+use crate::feature_mesh::{feature_mesh, layer_tops, Allowance};
 use crate::fill::{union, Region};
 use crate::params::LayerParams;
 use crate::tolerance::HEIGHT_SLACK;
@@ -91,12 +91,7 @@ pub fn below(
         .map(|(t, g)| feature_mesh(t, g, tol, Allowance::of_parent_solid(params)))
         .collect::<Result<Vec<_>, _>>()?;
     // Each layer's middle over the plane (negative: below it).
-    let mut mids = Vec::with_capacity(heights.len());
-    let mut z = -gap;
-    for &h in &heights {
-        mids.push(z + 0.5 * h);
-        z += h;
-    }
+    let mids: Vec<f64> = layer_tops(-gap, &heights).iter().map(|l| l.0).collect();
     let sections = mids
         .par_iter()
         .with_max_len(1)
