@@ -73,20 +73,15 @@ fn scaled(x: f64, decimals: usize) -> Option<(bool, u64)> {
 /// = 5` is `0.00007`. For quantities kept in integer units (a program's E, in 0.00001 mm).
 pub fn push_scaled(out: &mut String, negative: bool, n: u64, decimals: usize) {
     let mut text = Text::new();
-    let start = text.scaled(negative, n, decimals);
     // ASCII digits, a point and a sign: always UTF-8.
-    out.push_str(std::str::from_utf8(&text.0[start..]).unwrap_or_default());
+    out.push_str(std::str::from_utf8(text.scaled(negative, n, decimals)).unwrap_or_default());
 }
 
 /// [`push_fixed`] onto bytes (a block of `toolpath.csv`'s lines, written out as bytes):
 /// the same text, without a UTF-8 check per number.
 pub fn push_fixed_bytes(out: &mut Vec<u8>, x: f64, decimals: usize) {
     match scaled(x, decimals) {
-        Some((negative, n)) => {
-            let mut text = Text::new();
-            let start = text.scaled(negative, n, decimals);
-            out.extend_from_slice(&text.0[start..]);
-        }
+        Some((negative, n)) => out.extend_from_slice(Text::new().scaled(negative, n, decimals)),
         None => {
             let mut s = String::new();
             push_formatted(&mut s, x, decimals);
@@ -97,9 +92,7 @@ pub fn push_fixed_bytes(out: &mut Vec<u8>, x: f64, decimals: usize) {
 
 /// The decimal digits of `n` onto bytes (an id in `toolpath.csv`).
 pub fn push_integer_bytes(out: &mut Vec<u8>, n: u64) {
-    let mut text = Text::new();
-    let start = text.scaled(false, n, 0);
-    out.extend_from_slice(&text.0[start..]);
+    out.extend_from_slice(Text::new().scaled(false, n, 0));
 }
 
 /// The most decimals [`push_scaled`] writes (more are taken as this many).
@@ -135,8 +128,8 @@ impl Text {
         self.0[*end..*end + 2].copy_from_slice(&PAIRS[k..k + 2]);
     }
 
-    /// Writes [`push_scaled`]'s text at the end of the buffer; returns where it starts.
-    fn scaled(&mut self, negative: bool, n: u64, decimals: usize) -> usize {
+    /// Writes [`push_scaled`]'s text at the end of the buffer, and gives it.
+    fn scaled(&mut self, negative: bool, n: u64, decimals: usize) -> &[u8] {
         let decimals = decimals.min(MAX_SCALED_DECIMALS);
         let mut end = self.0.len();
         let mut v = n;
@@ -167,7 +160,7 @@ impl Text {
             end -= 1;
             self.0[end] = b'-';
         }
-        end
+        &self.0[end..]
     }
 }
 
