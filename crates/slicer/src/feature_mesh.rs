@@ -126,7 +126,7 @@ pub struct PlanarMesh {
     pub grown: Option<Grown>,
     /// Its layers in order, each `(middle, top, thickness)` over `plane`, mm: the layer
     /// heights `params` give up to its highest mesh point, through the heights of its faces
-    /// parallel to the plane ([`two5d_layer_heights`]). The support, the fill and the
+    /// parallel to the plane (`two5d_layer_heights`). The support, the fill and the
     /// resolution check all cut these layers.
     pub layers: Vec<(f64, f64, f64)>,
     /// Each layer's section at its middle, simplified as the fill lays it, where found
