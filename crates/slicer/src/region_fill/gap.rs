@@ -1,6 +1,7 @@
 //! Gap fill: the strip of a region too narrow for a bead, filled along its ridge by one bead
 //! as wide as the strip at each point (or, a strip over a bead across, one bead on each half).
 
+use super::thin_out::{thin_out, THIN_LINE_SHARE, THIN_WIDTH_SHARE};
 use super::FillPath;
 use crate::geodesic::{LayerMesh, RayTop, Reach};
 use crate::geom2d::Point2;
@@ -217,7 +218,13 @@ pub(super) fn gap_fill(
         }
         laid.next_path();
     }
-    out
+    // The ridge's wander between lattice edges thinned out of the points.
+    out.into_iter()
+        .map(|p| {
+            let (line, spread) = (THIN_LINE_SHARE * width, THIN_WIDTH_SHARE * width);
+            thin_out(p, |q| lm.metric_point(q), line, spread)
+        })
+        .collect()
 }
 
 /// How far, in bead widths, a gap fill looks round each loop point for the ridge's height

@@ -11,6 +11,7 @@ pub(crate) mod sparse;
 mod spurs;
 #[cfg(test)]
 mod tests;
+mod thin_out;
 
 use crate::chart::Chart;
 use crate::geodesic::{clip_reaching, LayerMesh, Piece, RunOn};
