@@ -1,8 +1,8 @@
 //! Filling one region of a layer, curved (in the chart of its reference surface) or planar
 //! (thin regions and the strips rings leave): rings and lines as iso-lines of geodesic
 //! distances on the layer surface ([`crate::geodesic`]), gap fill of strips too narrow for a
-//! bead ([`gap`]), spurs into sharp corners ([`spurs`]), zig-zag connectors along the infill
-//! boundary ([`border`]).
+//! bead ([`gap`], its points thinned by [`thin_out`]), spurs into sharp corners ([`spurs`]),
+//! zig-zag connectors along the infill boundary ([`border`]).
 
 mod border;
 mod conserve;
