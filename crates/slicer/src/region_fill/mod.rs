@@ -119,18 +119,23 @@ pub fn fill_flat_region(
         Boundary::Part => SLIVER_INSET,
         Boundary::Beads => GAP_INSET,
     } * width;
-    let mut paths = fill_region(
-        &chart,
-        region,
-        0.0,
-        params,
-        layer,
-        width,
-        spacing,
-        sliver_inset,
-    );
-    let spurs = corner_spurs_beside(&chart, region, 0.0, width, &paths);
-    paths.extend(spurs);
+    let mut paths = vec![];
+    // Each piece a seam joined on its own (its width sets its lattice's step).
+    for piece in crate::fill::parted_at_seams(region, SEAM_SHARE * width) {
+        let mut laid = fill_region(
+            &chart,
+            &piece,
+            0.0,
+            params,
+            layer,
+            width,
+            spacing,
+            sliver_inset,
+        );
+        let spurs = corner_spurs_beside(&chart, &piece, 0.0, width, &laid);
+        laid.extend(spurs);
+        paths.extend(laid);
+    }
     paths.retain(|p| p.points.len() >= 2);
     if boundary == Boundary::Beads {
         // A strip the rings leave: its beads, as wide as the strip, are gap fill.
@@ -140,6 +145,12 @@ pub fn fill_flat_region(
     }
     paths
 }
+
+/// Half the width (in bead widths) of the thinnest part of a planar region that
+/// [`fill_flat_region`] fills: thinner parts are seams, where the region is parted
+/// ([`crate::fill::parted_at_seams`]). 0.0045 mm for 0.45 mm beads: parts under 0.009 mm
+/// across, a tenth of the narrowest gap fill's bead ([`SLIVER_MIN_WIDTH_SHARE`]).
+const SEAM_SHARE: f64 = 0.01;
 
 /// What bounds a region filled by [`fill_flat_region`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

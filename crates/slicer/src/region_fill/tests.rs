@@ -600,3 +600,56 @@ fn a_frame_one_bead_wide_gets_one_bead_along_the_middle_of_each_wall() {
         }
     }
 }
+
+#[test]
+fn strips_joined_by_a_seam_are_filled_each_on_its_own() {
+    // Two strips 20 mm long and 0.3 mm wide joined along one edge by a seam a micrometre
+    // thin and 100 mm long (NIST CTC-05's contour fill left such strips between rings).
+    // Read whole, the region's mean width (2 area / perimeter) is under a quarter of the
+    // strips', and its lattice would be some 20 times as fine.
+    let t = 1e-6;
+    let outer = vec![
+        [0.0, 0.0],
+        [140.0, 0.0],
+        [140.0, 0.3],
+        [120.0, 0.3],
+        [120.0, t],
+        [20.0, t],
+        [20.0, 0.3],
+        [0.0, 0.3],
+    ];
+    let region = Region {
+        outer: outer.clone(),
+        holes: vec![],
+    };
+    let pieces = crate::fill::parted_at_seams(&region, 0.0045);
+    assert_eq!(pieces.len(), 2, "{pieces:?}");
+    for p in &pieces {
+        let a = crate::geom2d::region_area(p);
+        assert!((a - 6.0).abs() < 0.01, "a piece of {a} mm², not 6");
+    }
+    // The fill lays both strips, and nothing along the seam.
+    let params = LayerParams {
+        path_mode: PathMode::Contour,
+        ..LayerParams::default()
+    };
+    let paths = fill_flat_region(&region, &params, 0, 0.45, 0.45, Boundary::Beads);
+    let covered = covered_area(&paths);
+    assert!(
+        (covered / 12.0 - 1.0).abs() < 0.05,
+        "{covered} mm² of beads for 12 mm² of strips"
+    );
+    for p in &paths {
+        for q in &p.points {
+            assert!(q[0] < 20.0 || q[0] > 120.0, "a bead at {q:?}, on the seam");
+        }
+    }
+    // A region without a seam is one piece, as it was.
+    let plain = Region {
+        outer: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 0.3], [0.0, 0.3]],
+        holes: vec![],
+    };
+    let one = crate::fill::parted_at_seams(&plain, 0.0045);
+    assert_eq!(one.len(), 1);
+    assert!((crate::geom2d::region_area(&one[0]) - 3.0).abs() < 1e-6);
+}
