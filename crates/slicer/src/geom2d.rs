@@ -181,6 +181,28 @@ impl Row {
     }
 }
 
+/// Douglas–Peucker's recursion over the chains `spans` (`(i, j)`: point indices, both ends
+/// kept already): `split(i, j)` names the point between that must be kept (`None`: the chord
+/// from `i` to `j` replaces the points between), and the two chains it splits into are done
+/// alike, the later one first. The simplifications of rings, lines, lifted paths and gap
+/// fills differ only in what `split` asks of a chord.
+pub(crate) fn peucker_by(
+    mut spans: Vec<(usize, usize)>,
+    keep: &mut [bool],
+    mut split: impl FnMut(usize, usize) -> Option<usize>,
+) {
+    while let Some((i, j)) = spans.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        if let Some(k) = split(i, j) {
+            keep[k] = true;
+            spans.push((i, k));
+            spans.push((k, j));
+        }
+    }
+}
+
 /// Distance from `p` to the segment `a`–`b`.
 pub(crate) fn seg_dist(p: Point2, a: Point2, b: Point2) -> f64 {
     dist(p, segment_foot(p, a, b).1)

@@ -99,11 +99,7 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
         for k in 1..dense.len() {
             run.push(run[k - 1] + (dense[k].p - dense[k - 1].p).norm());
         }
-        let mut stack = vec![(0usize, dense.len() - 1)];
-        while let Some((i, j)) = stack.pop() {
-            if j <= i + 1 {
-                continue;
-            }
+        crate::geom2d::peucker_by(vec![(0, dense.len() - 1)], &mut keep, |i, j| {
             let (a, b) = (dense[i].p, dense[j].p);
             let (mut worst, mut at) = (0.0f64, i);
             for (k, x) in dense.iter().enumerate().take(j).skip(i + 1) {
@@ -118,15 +114,8 @@ pub(crate) fn lift(chart: &Chart, path: &FillPath, z: f64, tol: f64) -> Vec<Lift
             // mm across, a loop of nine points, was laid 45 % short).
             let along = run[j] - run[i];
             let long_enough = along - (b - a).norm() <= LENGTH_SLACK * along;
-            if worst > 0.5 * tol || !long_enough {
-                if at == i {
-                    at = (i + j) / 2;
-                }
-                keep[at] = true;
-                stack.push((i, at));
-                stack.push((at, j));
-            }
-        }
+            (worst > 0.5 * tol || !long_enough).then_some(if at == i { (i + j) / 2 } else { at })
+        });
         dense
             .into_iter()
             .zip(keep)

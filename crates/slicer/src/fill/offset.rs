@@ -3,7 +3,7 @@
 
 use super::region::{bounds, region_shapes};
 use super::{Contour, Shapes};
-use crate::geom2d::{area2, dist, perimeter, seg_dist, Point2, Region};
+use crate::geom2d::{area2, dist, perimeter, peucker_by, seg_dist, Point2, Region};
 use crate::tolerance::{EMPTY_AREA2, ROUND_OFF};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
@@ -200,16 +200,8 @@ pub(super) fn simplify_line(pts: &[Point2], tol: f64) -> Vec<Point2> {
 /// Douglas–Peucker over the chains `spans` (`(i, j)`: the points `at(i)` to `at(j)`, both
 /// kept already): in each, the point farthest from the chord (the first of equals) is kept
 /// when it lies more than `tol` from it, and the two chains it splits into are done alike.
-fn peucker(
-    at: impl Fn(usize) -> Point2,
-    mut spans: Vec<(usize, usize)>,
-    tol: f64,
-    keep: &mut [bool],
-) {
-    while let Some((i, j)) = spans.pop() {
-        if j <= i + 1 {
-            continue;
-        }
+fn peucker(at: impl Fn(usize) -> Point2, spans: Vec<(usize, usize)>, tol: f64, keep: &mut [bool]) {
+    peucker_by(spans, keep, |i, j| {
         let (a, b) = (at(i), at(j));
         let (mut worst, mut far) = (-1.0, i);
         for k in i + 1..j {
@@ -219,12 +211,8 @@ fn peucker(
                 far = k;
             }
         }
-        if worst > tol {
-            keep[far] = true;
-            spans.push((i, far));
-            spans.push((far, j));
-        }
-    }
+        (worst > tol).then_some(far)
+    });
 }
 
 /// Douglas-Peucker on one closed contour (see [`simplify`]): every dropped vertex lies within

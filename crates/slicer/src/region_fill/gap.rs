@@ -219,11 +219,9 @@ pub(super) fn gap_fill(
         laid.next_path();
     }
     // The ridge's wander between lattice edges thinned out of the points.
+    let (line, spread) = (THIN_LINE_SHARE * width, THIN_WIDTH_SHARE * width);
     out.into_iter()
-        .map(|p| {
-            let (line, spread) = (THIN_LINE_SHARE * width, THIN_WIDTH_SHARE * width);
-            thin_out(p, |q| lm.metric_point(q), line, spread)
-        })
+        .map(|p| thin_out(p, |q| lm.metric_point(q), line, spread))
         .collect()
 }
 

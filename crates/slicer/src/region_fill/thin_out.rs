@@ -5,7 +5,7 @@
 //! every 1.8 mm); [`thin_out`] keeps the ones the bead's line, width and length need.
 
 use super::FillPath;
-use crate::geom2d::{dist, seg_dist, Point2};
+use crate::geom2d::{dist, peucker_by, segment_foot, Point2};
 
 /// How far (in bead widths) a thinned gap fill's line may move from the ridge its points
 /// were read at: a tenth of a bead (0.045 mm for 0.45 mm beads), under the lattice's own
@@ -84,44 +84,34 @@ fn kept_points(
     let mut keep = vec![false; n];
     keep[0] = true;
     keep[n - 1] = true;
-    let mut stack = vec![(0usize, n - 1)];
-    while let Some((i, j)) = stack.pop() {
-        if j <= i + 1 {
-            continue;
-        }
+    peucker_by(vec![(0, n - 1)], &mut keep, |i, j| {
         let (a, b) = (m[i], m[j]);
         let len = dist(a, b);
         let (mut worst, mut at_k) = (0.0f64, i);
         for k in i + 1..j {
-            // Where along the chord `k` falls, for the width there.
-            let t = if len > 0.0 {
-                (((m[k][0] - a[0]) * (b[0] - a[0]) + (m[k][1] - a[1]) * (b[1] - a[1]))
-                    / (len * len))
-                    .clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+            // Where along the chord `k` falls (for the width there), and how far off it.
+            let (t, foot, _) = segment_foot(m[k], a, b);
             let wk = w[i] + (w[j] - w[i]) * t;
-            let err = (seg_dist(m[k], a, b) / line).max((w[k] - wk).abs() / spread);
+            let err = (dist(m[k], foot) / line).max((w[k] - wk).abs() / spread);
             if err > worst {
                 worst = err;
                 at_k = k;
             }
         }
         let along = run[j] - run[i];
-        if worst > 1.0 || along - len > THIN_LENGTH_SHARE * along {
-            let mid = if at_k == i { (i + j) / 2 } else { at_k };
-            keep[mid] = true;
-            stack.push((i, mid));
-            stack.push((mid, j));
-        }
-    }
+        (worst > 1.0 || along - len > THIN_LENGTH_SHARE * along).then_some(if at_k == i {
+            (i + j) / 2
+        } else {
+            at_k
+        })
+    });
     keep
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom2d::seg_dist;
     use crate::toolpath::Role;
 
     fn strip(p: &FillPath) -> f64 {
