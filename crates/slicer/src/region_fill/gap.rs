@@ -240,7 +240,7 @@ const NEAR_RIDGE_SHARE: f64 = 0.5;
 const NEAR_RIDGE_STEPS: f64 = 6.0;
 
 /// The shortest step between a gap fill's points, in bead widths.
-const MIN_STEP_SHARE: f64 = 0.002;
+pub(super) const MIN_STEP_SHARE: f64 = 0.002;
 
 /// How far past the last rise of the distance, in bead widths, a gap fill's point looks for
 /// it to rise again before taking that rise for the ridge ([`LayerMesh::ray_max`]).
@@ -350,17 +350,17 @@ impl Beside {
 /// The narrowest single bead on a ridge, as a multiple of the gap's narrowest flank bead
 /// (`Gap::min_width`): a little wider, so that a bead into a sharp corner keeps its middle
 /// half a layer from the part's sides (a blade's last layer is checked so).
-const SINGLE_MIN_SHARE: f64 = 1.1;
+pub(super) const SINGLE_MIN_SHARE: f64 = 1.1;
 
 /// The narrowest single bead on a ridge in bead widths where the strip is wider (twice that,
 /// or more, as a rule): narrower, the medial axis's branches into a region's corners got beads
 /// a tenth of a bead wide, which a nozzle lays several times as wide (the plan widens them to
 /// the machine's narrowest bead), and the head leaned into the corner to lay them.
-const SINGLE_MIN_WIDTH: f64 = 0.25;
+pub(super) const SINGLE_MIN_WIDTH: f64 = 0.25;
 
 /// The widest strip, in bead widths, a gap fill lays as one bead on its ridge ([`gap_fill`]);
 /// a wider one gets a bead on each flank.
-const SINGLE_BEAD_MAX: f64 = 1.1;
+pub(super) const SINGLE_BEAD_MAX: f64 = 1.1;
 
 /// How close, in bead widths, a point of a gap fill's single beads may come to a stretch
 /// laid before (other than the last [`RETRACE_SHARE`]·[`OWN_RUN`] of its own path) and still

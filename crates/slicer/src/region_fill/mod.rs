@@ -9,6 +9,7 @@ mod conserve;
 mod gap;
 pub(crate) mod sparse;
 mod spurs;
+mod strip;
 #[cfg(test)]
 mod tests;
 mod thin_out;
@@ -121,7 +122,22 @@ pub fn fill_flat_region(
     } * width;
     let mut paths = vec![];
     // Each piece a seam joined on its own (its width sets its lattice's step).
+    // Rings where a strip is wide enough for one (the modes with rings, as fill_region's
+    // `ring_levels` has them).
+    let rings = match params.path_mode {
+        PathMode::Contour => true,
+        PathMode::ContourZigzag => params.perimeters > 0,
+        PathMode::Raster | PathMode::Zigzag => false,
+    };
     for piece in crate::fill::parted_at_seams(region, SEAM_SHARE * width) {
+        // A plain strip too narrow for a ring: its gap fill from its chordal axis.
+        let min_width = SLIVER_MIN_WIDTH_SHARE * width;
+        if let Some(laid) = strip::strip_fill(&piece, width, min_width, rings) {
+            let spurs = corner_spurs_beside(&chart, &piece, 0.0, width, &laid);
+            paths.extend(laid);
+            paths.extend(spurs);
+            continue;
+        }
         let mut laid = fill_region(
             &chart,
             &piece,
