@@ -1,7 +1,8 @@
 //! Filling one region of a layer, curved (in the chart of its reference surface) or planar
 //! (thin regions and the strips rings leave): rings and lines as iso-lines of geodesic
 //! distances on the layer surface ([`crate::geodesic`]), gap fill of strips too narrow for a
-//! bead ([`gap`], its points thinned by [`thin_out`]), spurs into sharp corners ([`spurs`]),
+//! bead ([`gap`], its points thinned by [`thin_out`]; on a planar strip without rings, from
+//! its chordal axis, [`strip`]), spurs into sharp corners ([`spurs`]),
 //! zig-zag connectors along the infill boundary ([`border`]).
 
 mod border;
@@ -121,7 +122,6 @@ pub fn fill_flat_region(
         Boundary::Beads => GAP_INSET,
     } * width;
     let mut paths = vec![];
-    // Each piece a seam joined on its own (its width sets its lattice's step).
     // Rings where a strip is wide enough for one (the modes with rings, as fill_region's
     // `ring_levels` has them).
     let rings = match params.path_mode {
@@ -129,6 +129,7 @@ pub fn fill_flat_region(
         PathMode::ContourZigzag => params.perimeters > 0,
         PathMode::Raster | PathMode::Zigzag => false,
     };
+    // Each piece a seam joined on its own (its width sets its lattice's step).
     for piece in crate::fill::parted_at_seams(region, SEAM_SHARE * width) {
         // A plain strip too narrow for a ring: its gap fill from its chordal axis.
         let min_width = SLIVER_MIN_WIDTH_SHARE * width;

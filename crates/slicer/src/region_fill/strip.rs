@@ -1,7 +1,7 @@
 //! The gap fill of a planar strip without rings, from its chordal axis: the strip's own
 //! boundary triangulated (a few points per strip width), the triangles crossing it chained end
-//! to end, and one bead laid through the middles of the edges they cross, as wide as the strip
-//! there. It lays what [`super::gap::gap_fill`] lays on such a strip (one bead on the ridge,
+//! to end and fork to fork, and one bead laid through the middles of the edges they cross, as
+//! wide as the strip there. It lays what [`super::gap::gap_fill`] lays on such a strip (one bead on the ridge,
 //! 2β wide, the narrow ends left out, extruded for the strip's area) without the lattice, the
 //! distance field and the ridge search under it.
 //!
@@ -11,9 +11,8 @@
 //! fill spent 54 of its 113 s of strip fills on 447 such strips, 0.3 s each. Their boundary
 //! triangulated holds some 3,000 points.
 //!
-//! Strips this does not take (a hole, a branch of the axis, a part wide enough for a ring or
-//! two beads, a polygon that crosses itself) are left to the lattice: [`strip_fill`] says
-//! `None`.
+//! Strips this does not take (a hole, a part wide enough for a ring or two beads, a polygon
+//! that crosses itself) are left to the lattice: [`strip_fill`] says `None`.
 
 use super::gap::{MIN_STEP_SHARE, SINGLE_BEAD_MAX, SINGLE_MIN_SHARE, SINGLE_MIN_WIDTH};
 use super::thin_out::{thin_out, THIN_LINE_SHARE, THIN_WIDTH_SHARE};
@@ -442,6 +441,132 @@ mod tests {
         Region {
             outer,
             holes: vec![],
+        }
+    }
+
+    /// A strip `w` wide about the wave `y = a·sin(x / l)` for x in 0..`len`, `n` points a side
+    /// (its sides the wave moved square to itself by half the width).
+    fn wavy_strip(a: f64, l: f64, w: f64, len: f64, n: usize) -> Region {
+        let side = |s: f64| -> Vec<Point2> {
+            (0..=n)
+                .map(|i| {
+                    let x = len * i as f64 / n as f64;
+                    let slope = a / l * (x / l).cos();
+                    let k = 0.5 * w * s / (1.0 + slope * slope).sqrt();
+                    [x - k * slope, a * (x / l).sin() + k]
+                })
+                .collect()
+        };
+        let mut outer = side(-1.0);
+        outer.extend(side(1.0).into_iter().rev());
+        Region {
+            outer,
+            holes: vec![],
+        }
+    }
+
+    /// The lattice's fill of a strip the rings leave (`fill_region` on the plane, as
+    /// `fill_flat_region` lays it without this module), contour mode, 0.45 mm beads.
+    fn lattice_fill(region: &Region) -> Vec<FillPath> {
+        let plane = brep::surface::Surface::Plane {
+            frame: brep::math::Frame::world(brep::math::P3::origin()),
+        };
+        let chart = crate::chart::Chart::unit(&plane);
+        let params = crate::params::LayerParams {
+            path_mode: crate::params::PathMode::Contour,
+            ..Default::default()
+        };
+        super::super::fill_region(&chart, region, 0.0, &params, 0, 0.45, 0.45, 0.02 * 0.45)
+    }
+
+    /// The distance from `q` to the nearest segment of `paths`.
+    fn off(q: Point2, paths: &[FillPath]) -> f64 {
+        paths
+            .iter()
+            .flat_map(|p| p.points.windows(2))
+            .map(|s| crate::geom2d::seg_dist(q, s[0], s[1]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn the_chordal_axis_lays_what_the_lattice_lays_on_plain_strips() {
+        let t = Region {
+            outer: vec![
+                [0.0, 0.0],
+                [10.0, 0.0],
+                [10.0, 0.25],
+                [5.125, 0.25],
+                [5.125, 5.0],
+                [4.875, 5.0],
+                [4.875, 0.25],
+                [0.0, 0.25],
+            ],
+            holes: vec![],
+        };
+        let wedge = Region {
+            outer: vec![[0.0, -0.2], [12.0, 0.0], [0.0, 0.2]],
+            holes: vec![],
+        };
+        let strips = [
+            ("arc", arc_strip(20.0, 0.2, 1.0, 200)),
+            ("wavy", wavy_strip(1.0, 2.0, 0.3, 20.0, 400)),
+            ("wedge", wedge),
+            ("T", t),
+        ];
+        for (name, region) in strips {
+            let new = strip_fill(&region, 0.45, 0.09, true).expect(name);
+            let old = lattice_fill(&region);
+            let area = region_area(&region);
+            let laid = |ps: &[FillPath]| ps.iter().map(|p| p.strip_area(dist)).sum::<f64>();
+            // The strip's area laid by each, within 3 % of it (the lattice's within its own
+            // conservation, the axis's exactly).
+            assert!(
+                (laid(&new) / area - 1.0).abs() < 1e-6,
+                "{name}: {}",
+                laid(&new)
+            );
+            assert!(
+                (laid(&old) / area - 1.0).abs() < 0.03,
+                "{name}: {}",
+                laid(&old)
+            );
+            // The same line: each fill's points, where its bead is at least half the strip's
+            // median width and a bead from either fill's ends (where the lattice's follows the
+            // ridge into a square end's corner, the axis's into the end's middle), within a
+            // tenth of a bead of the other's beads.
+            let ends: Vec<Point2> = new
+                .iter()
+                .chain(&old)
+                .flat_map(|p| [p.points[0], p.points[p.points.len() - 1]])
+                .collect();
+            let inner = |q: Point2| ends.iter().all(|e| dist(*e, q) > 0.45);
+            for (a, b, which) in [(&new, &old, "new off old"), (&old, &new, "old off new")] {
+                let mut ws: Vec<f64> = a.iter().flat_map(|p| p.widths.iter().copied()).collect();
+                ws.sort_by(f64::total_cmp);
+                let half = 0.5 * ws[ws.len() / 2];
+                for p in a.iter() {
+                    for (q, w) in p.points.iter().zip(&p.widths) {
+                        if *w >= half && inner(*q) {
+                            let d = off(*q, b);
+                            assert!(d < 0.045, "{name}: {which} by {d} at {q:?}");
+                        }
+                    }
+                }
+            }
+            // As long: the bead lengths within a bead and a half of each other per end.
+            let len = |ps: &[FillPath]| {
+                ps.iter()
+                    .flat_map(|p| p.points.windows(2))
+                    .map(|s| dist(s[0], s[1]))
+                    .sum::<f64>()
+            };
+            let ends = 2.0 * (1 + usize::from(name == "T")) as f64;
+            assert!(
+                (len(&new) - len(&old)).abs() < ends * 0.675,
+                "{name}: {} vs {}",
+                len(&new),
+                len(&old)
+            );
         }
     }
 
