@@ -94,7 +94,7 @@ pub(super) fn rings(
     gaps: &mut Shapes,
 ) -> Shapes {
     let half = 0.5 * ctx.spacing;
-    let slack = 0.25 * ctx.width;
+    let slack = CLEAN_SLACK * ctx.width;
     let mut cur = erode(base, 0.5 * ctx.width, &ctx.join);
     // Whether the offset that made `cur` dropped part of what lay before it, and the ring
     // before (`None`: the region's boundary, where the first ring's beads reach).
@@ -174,6 +174,10 @@ fn line_fill(strips: Shapes, ctx: &Ctx, out: &mut Vec<Path2>) {
     }
 }
 
+/// How far (in bead widths) an offset's perimeter may stray from the one a clean offset has
+/// ([`clean_offset`]) and still count as clean.
+const CLEAN_SLACK: f64 = 0.25;
+
 /// A ring keeps only the parts of its offset at least `2 · OPEN_SHARE` spacings wide: where
 /// the offset is narrower, the ring's beads from either side overlap by more than a tenth of
 /// a bead (a ring about a part exactly a spacing wide covers it, beads edge to edge).
@@ -190,7 +194,7 @@ fn opening(cur: &Shapes, d: f64, ctx: &Ctx) -> Shapes {
     // An erosion that loses nothing (the same contours, the perimeter it should have, as
     // `rings` tells a clean offset): no part of `cur` is narrower than `2·d`, and the core
     // grown back is `cur` again, up to corners sharper than the mitre's limit.
-    if clean_offset(cur, &core, d, 0.25 * ctx.width) {
+    if clean_offset(cur, &core, d, CLEAN_SLACK * ctx.width) {
         return cur.clone();
     }
     let grown = dilate_sharp(&core, d);

@@ -122,33 +122,25 @@ pub fn fill_flat_region(
         Boundary::Beads => GAP_INSET,
     } * width;
     let mut paths = vec![];
-    // Rings where a strip is wide enough for one (the modes with rings, as fill_region's
-    // `ring_levels` has them).
-    let rings = match params.path_mode {
-        PathMode::Contour => true,
-        PathMode::ContourZigzag => params.perimeters > 0,
-        PathMode::Raster | PathMode::Zigzag => false,
-    };
-    // Each piece a seam joined on its own (its width sets its lattice's step).
+    // Rings where a strip is wide enough for one, and the narrowest bead of a strip without.
+    let rings = ring_count(params) > 0;
+    let min_width = SLIVER_MIN_WIDTH_SHARE * width;
+    // Each piece a seam joined on its own (its width sets its lattice's step); a plain strip
+    // too narrow for a ring gets its gap fill from its chordal axis.
     for piece in crate::fill::parted_at_seams(region, SEAM_SHARE * width) {
-        // A plain strip too narrow for a ring: its gap fill from its chordal axis.
-        let min_width = SLIVER_MIN_WIDTH_SHARE * width;
-        if let Some(laid) = strip::strip_fill(&piece, width, min_width, rings) {
-            let spurs = corner_spurs_beside(&chart, &piece, 0.0, width, &laid);
-            paths.extend(laid);
-            paths.extend(spurs);
-            continue;
-        }
-        let mut laid = fill_region(
-            &chart,
-            &piece,
-            0.0,
-            params,
-            layer,
-            width,
-            spacing,
-            sliver_inset,
-        );
+        let mut laid = match strip::strip_fill(&piece, width, min_width, rings) {
+            Some(laid) => laid,
+            None => fill_region(
+                &chart,
+                &piece,
+                0.0,
+                params,
+                layer,
+                width,
+                spacing,
+                sliver_inset,
+            ),
+        };
         let spurs = corner_spurs_beside(&chart, &piece, 0.0, width, &laid);
         laid.extend(spurs);
         paths.extend(laid);
@@ -425,16 +417,22 @@ const SMALL_CORE_LINES: f64 = 4.0;
 /// The rings asked for by the path mode, and their levels: half a bead in, then a spacing
 /// apart, down to a tenth of a bead below the deepest point `dmax`.
 fn ring_levels(params: &LayerParams, width: f64, spacing: f64, dmax: f64) -> (usize, Vec<f64>) {
-    let rings = match params.path_mode {
-        PathMode::Raster | PathMode::Zigzag => 0,
-        PathMode::Contour => usize::MAX,
-        PathMode::ContourZigzag => params.perimeters,
-    };
+    let rings = ring_count(params);
     let levels: Vec<f64> = (0..rings)
         .map(|j| 0.5 * width + j as f64 * spacing)
         .take_while(|c| *c <= dmax - 0.1 * width)
         .collect();
     (rings, levels)
+}
+
+/// The rings the path mode asks for: none with raster or zig-zag lines, as many as fit in
+/// contour mode, the perimeters in contour-zig-zag.
+fn ring_count(params: &LayerParams) -> usize {
+    match params.path_mode {
+        PathMode::Raster | PathMode::Zigzag => 0,
+        PathMode::Contour => usize::MAX,
+        PathMode::ContourZigzag => params.perimeters,
+    }
 }
 
 /// The chart direction of the infill's lines: the raster angle, turned a quarter on the odd
@@ -860,16 +858,19 @@ fn conserved(
     len: impl Fn(Point2, Point2) -> f64,
 ) -> Vec<FillPath> {
     let covered: f64 = paths.iter().map(|p| p.strip_area(&len)).sum();
-    let held = lm.area_above(db, edge);
+    scale_to_area(&mut paths, covered, lm.area_above(db, edge));
+    paths
+}
+
+/// Scales the widths of `paths`, whose beads cover `covered` mm², so that they cover `held`
+/// (by at most [`MAX_CORE_WIDENING`]), where the two differ by more than round-off.
+fn scale_to_area(paths: &mut [FillPath], covered: f64, held: f64) {
     if covered > 0.0 && (covered - held).abs() > ROUND_OFF * held {
         let k = (held / covered).min(MAX_CORE_WIDENING);
-        for p in &mut paths {
-            for w in &mut p.widths {
-                *w *= k;
-            }
+        for w in paths.iter_mut().flat_map(|p| p.widths.iter_mut()) {
+            *w *= k;
         }
     }
-    paths
 }
 
 /// The length on the layer surface at `d` of the chart segment `a`–`b` (its chord there).

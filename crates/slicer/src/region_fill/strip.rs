@@ -16,10 +16,9 @@
 
 use super::gap::{MIN_STEP_SHARE, SINGLE_BEAD_MAX, SINGLE_MIN_SHARE, SINGLE_MIN_WIDTH};
 use super::thin_out::{thin_out, THIN_LINE_SHARE, THIN_WIDTH_SHARE};
-use super::{FillPath, MAX_CORE_WIDENING};
+use super::{scale_to_area, FillPath};
 use crate::fast_hash::FastMap;
 use crate::geom2d::{dist, perimeter, region_area, Point2, Region, RegionIndex};
-use crate::tolerance::ROUND_OFF;
 use crate::toolpath::Role;
 use spade::{ConstrainedDelaunayTriangulation, Point2 as SPoint, Triangulation};
 
@@ -49,7 +48,7 @@ const WIDEST_SHARE: f64 = SINGLE_BEAD_MAX;
 /// `min_width` (the gap's narrowest flank bead, as [`super::gap::Gap::min_width`]): beads
 /// along the strip's chordal axis, as wide as the strip at each point, tapering into each end
 /// down to the narrowest bead a single bead on a ridge gets, then widened or narrowed (by at
-/// most [`MAX_CORE_WIDENING`]) to put down the region's area. `rings` says whether the fill
+/// most [`super::MAX_CORE_WIDENING`]) to put down the region's area. `rings` says whether the fill
 /// would lay rings where the region is wide enough (a ring needs a half width of 0.6 of a
 /// bead); without, a strip over a bead across gets infill lines, so only narrower strips are
 /// taken. `None` where the strip is not one this fill takes (the module's docs).
@@ -82,12 +81,7 @@ pub(super) fn strip_fill(
     let mut paths = beads(&axis, width, min_width);
     // The strip's area put down ([`super::conserved`], whose held area is the whole region's).
     let covered: f64 = paths.iter().map(|p| p.strip_area(dist)).sum();
-    if covered > 0.0 && (covered - area).abs() > ROUND_OFF * area {
-        let k = (area / covered).min(MAX_CORE_WIDENING);
-        for w in paths.iter_mut().flat_map(|p| p.widths.iter_mut()) {
-            *w *= k;
-        }
-    }
+    scale_to_area(&mut paths, covered, area);
     Some(paths)
 }
 
@@ -424,6 +418,7 @@ fn resample(ring: &[Point2], step: f64) -> Vec<Point2> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::MAX_CORE_WIDENING;
     use super::*;
 
     /// A strip `w` wide along an arc of radius `r` through `sweep` radians, `n` points a side.
